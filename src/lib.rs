@@ -1,0 +1,10 @@
+//! scx: the information-theoretic scene complexity framework of Feixas, del Acebo, Bekaert and Sbert,
+//! *An information theory framework for the analysis of scene complexity* (Eurographics 1999).
+//!
+//! Data flows one way: [`scene`] -> global lines ([`sample`]) -> hits ([`trace`]) -> pairs and counts
+//! ([`sample`]) -> measures ([`measure`]) -> report.
+
+#![forbid(unsafe_op_in_unsafe_fn)]
+
+pub mod scene;
+pub mod trace;

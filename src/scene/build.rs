@@ -1,0 +1,312 @@
+//! Building a [`Scene`] from polygons: validation, triangulation, patch planes, normalisation.
+
+use std::collections::HashMap;
+
+use super::{Material, Normalization, Patch, Scene, SceneError};
+
+/// A triangle whose area, relative to the squared bounding radius, is below this is degenerate.
+const DEGENERATE_AREA: f64 = 1e-14;
+/// A polygon whose vertices leave its plane by more than this fraction of its own size is not planar.
+const PLANARITY_TOLERANCE: f64 = 1e-4;
+
+/// Collects polygons (each one patch) and turns them into a [`Scene`].
+///
+/// Vertices at exactly the same position are welded, so triangles that meet along an edge share vertex
+/// indices whatever the file did; the tracers rely on that to count a crossing of a shared edge once.
+#[derive(Debug)]
+pub struct SceneBuilder {
+    name: String,
+    vertices: Vec<[f64; 3]>,
+    weld: HashMap<[u64; 3], u32>,
+    polygons: Vec<Polygon>,
+    materials: Vec<Material>,
+    warnings: Vec<String>,
+}
+
+#[derive(Debug)]
+struct Polygon {
+    vertices: Vec<u32>,
+    material: u32,
+    /// Where it came from, for messages (`face 12`, `line 40`).
+    origin: String,
+}
+
+impl SceneBuilder {
+    /// An empty scene called `name`.
+    pub fn new(name: impl Into<String>) -> Self {
+        SceneBuilder {
+            name: name.into(),
+            vertices: Vec::new(),
+            weld: HashMap::new(),
+            polygons: Vec::new(),
+            materials: Vec::new(),
+            warnings: Vec::new(),
+        }
+    }
+
+    /// Adds a vertex (welded with an identical earlier one) and returns its index.
+    pub fn vertex(&mut self, p: [f64; 3]) -> u32 {
+        // -0.0 and 0.0 are the same point.
+        let key = p.map(|c| (c + 0.0).to_bits());
+        if let Some(&i) = self.weld.get(&key) {
+            return i;
+        }
+        let i = self.vertices.len() as u32;
+        self.vertices.push(p);
+        self.weld.insert(key, i);
+        i
+    }
+
+    /// Adds a material and returns its index.
+    pub fn material(&mut self, m: Material) -> u32 {
+        self.materials.push(m);
+        (self.materials.len() - 1) as u32
+    }
+
+    /// Adds a planar convex polygon (counter-clockwise seen from its front side) as one patch.
+    pub fn polygon(&mut self, vertices: &[u32], material: u32, origin: impl Into<String>) {
+        self.polygons.push(Polygon {
+            vertices: vertices.to_vec(),
+            material,
+            origin: origin.into(),
+        });
+    }
+
+    /// Records a non-fatal problem to report with the scene.
+    pub fn warn(&mut self, message: impl Into<String>) {
+        self.warnings.push(message.into());
+    }
+
+    /// Validates the geometry, triangulates the polygons and scales the scene to its unit bounding sphere.
+    pub fn build(mut self) -> Result<Scene, SceneError> {
+        if self.materials.is_empty() {
+            self.materials.push(Material::default());
+        }
+        self.check_finite()?;
+        let normalization = self.normalization()?;
+        let traced: Vec<[f64; 3]> = self
+            .vertices
+            .iter()
+            .map(|p| to_tracing_space(*p, &normalization))
+            .collect();
+
+        let mut scene = Scene {
+            name: self.name.clone(),
+            positions: traced.iter().map(|p| p.map(|c| c as f32)).collect(),
+            triangles: Vec::new(),
+            triangle_patch: Vec::new(),
+            patches: Vec::new(),
+            materials: std::mem::take(&mut self.materials),
+            normalization,
+            warnings: std::mem::take(&mut self.warnings),
+        };
+        let mut dropped_triangles = 0usize;
+        let mut dropped_polygons = Vec::new();
+        for poly in &self.polygons {
+            if poly.vertices.len() < 3 {
+                return Err(self.geometry_error(format!(
+                    "{}: a face needs at least 3 vertices, it has {}",
+                    poly.origin,
+                    poly.vertices.len()
+                )));
+            }
+            if poly.material as usize >= scene.materials.len() {
+                return Err(self.geometry_error(format!(
+                    "{}: material index {} out of range",
+                    poly.origin, poly.material
+                )));
+            }
+            let pts: Vec<[f64; 3]> = poly.vertices.iter().map(|&v| traced[v as usize]).collect();
+            let (normal, area) = newell(&pts);
+            check_planar(&pts, normal, area)
+                .map_err(|m| self.geometry_error(format!("{}: {m}", poly.origin)))?;
+            let first = scene.triangles.len() as u32;
+            let patch_index = scene.patches.len() as u32;
+            let mut patch_area = 0.0;
+            for k in 1..poly.vertices.len() - 1 {
+                let tri = [poly.vertices[0], poly.vertices[k], poly.vertices[k + 1]];
+                let a = triangle_area(traced[tri[0] as usize], traced[tri[1] as usize], traced[tri[2] as usize]);
+                if a <= DEGENERATE_AREA {
+                    dropped_triangles += 1;
+                    continue;
+                }
+                patch_area += a;
+                scene.triangles.push(tri);
+                scene.triangle_patch.push(patch_index);
+            }
+            let count = scene.triangles.len() as u32 - first;
+            if count == 0 {
+                dropped_polygons.push(poly.origin.clone());
+                continue;
+            }
+            let centroid = centroid(&pts);
+            scene.patches.push(Patch {
+                area: patch_area,
+                normal,
+                offset: dot(normal, centroid),
+                material: poly.material,
+                first_triangle: first,
+                triangle_count: count,
+            });
+        }
+        if dropped_triangles > 0 {
+            scene.warnings.push(format!(
+                "{}: dropped {dropped_triangles} zero-area triangle(s)",
+                self.name
+            ));
+        }
+        if !dropped_polygons.is_empty() {
+            scene.warnings.push(format!(
+                "{}: dropped {} zero-area face(s), first: {}",
+                self.name,
+                dropped_polygons.len(),
+                dropped_polygons[0]
+            ));
+        }
+        if scene.patches.is_empty() {
+            return Err(self.geometry_error("the scene has no faces of non-zero area".into()));
+        }
+        Ok(scene)
+    }
+
+    fn geometry_error(&self, message: String) -> SceneError {
+        SceneError::Geometry {
+            scene: self.name.clone(),
+            message,
+        }
+    }
+
+    fn check_finite(&self) -> Result<(), SceneError> {
+        for poly in &self.polygons {
+            for &v in &poly.vertices {
+                let p = self.vertices.get(v as usize).ok_or_else(|| {
+                    self.geometry_error(format!("{}: vertex index {v} out of range", poly.origin))
+                })?;
+                if p.iter().any(|c| !c.is_finite()) {
+                    return Err(self.geometry_error(format!(
+                        "{}: vertex {} has a non-finite coordinate ({}, {}, {})",
+                        poly.origin,
+                        v + 1,
+                        p[0],
+                        p[1],
+                        p[2]
+                    )));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Centre of the bounding box of the used vertices, and the largest distance from it.
+    fn normalization(&self) -> Result<Normalization, SceneError> {
+        let used: Vec<[f64; 3]> = self
+            .polygons
+            .iter()
+            .flat_map(|p| p.vertices.iter().map(|&v| self.vertices[v as usize]))
+            .collect();
+        if used.is_empty() {
+            return Err(self.geometry_error("the scene is empty: no faces".into()));
+        }
+        let mut lo = [f64::INFINITY; 3];
+        let mut hi = [f64::NEG_INFINITY; 3];
+        for p in &used {
+            for a in 0..3 {
+                lo[a] = lo[a].min(p[a]);
+                hi[a] = hi[a].max(p[a]);
+            }
+        }
+        let center = [0, 1, 2].map(|a| 0.5 * (lo[a] + hi[a]));
+        let radius = used
+            .iter()
+            .map(|p| norm(sub(*p, center)))
+            .fold(0.0f64, f64::max);
+        if !(radius > 0.0 && radius.is_finite()) {
+            return Err(self.geometry_error(format!(
+                "the scene has no extent (bounding radius {radius})"
+            )));
+        }
+        Ok(Normalization {
+            center,
+            scale: radius,
+        })
+    }
+}
+
+fn to_tracing_space(p: [f64; 3], n: &Normalization) -> [f64; 3] {
+    [0, 1, 2].map(|a| (p[a] - n.center[a]) / n.scale)
+}
+
+/// Newell's normal of a polygon: unit normal and area (exact for planar polygons).
+fn newell(pts: &[[f64; 3]]) -> ([f64; 3], f64) {
+    let mut n = [0.0; 3];
+    let c = centroid(pts);
+    for k in 0..pts.len() {
+        let a = sub(pts[k], c);
+        let b = sub(pts[(k + 1) % pts.len()], c);
+        let x = cross(a, b);
+        for i in 0..3 {
+            n[i] += x[i];
+        }
+    }
+    let len = norm(n);
+    if len > 0.0 {
+        (n.map(|c| c / len), 0.5 * len)
+    } else {
+        ([0.0; 3], 0.0)
+    }
+}
+
+fn check_planar(pts: &[[f64; 3]], normal: [f64; 3], area: f64) -> Result<(), String> {
+    if pts.len() <= 3 || area <= 0.0 {
+        return Ok(());
+    }
+    let c = centroid(pts);
+    let size = pts.iter().map(|p| norm(sub(*p, c))).fold(0.0, f64::max);
+    let off = pts
+        .iter()
+        .map(|p| dot(normal, sub(*p, c)).abs())
+        .fold(0.0, f64::max);
+    if off > PLANARITY_TOLERANCE * size {
+        return Err(format!(
+            "non-planar polygon with {} vertices: a vertex is {:.3e} of the face's size off its plane \
+             (tolerance {PLANARITY_TOLERANCE:e}); triangulate it",
+            pts.len(),
+            off / size
+        ));
+    }
+    Ok(())
+}
+
+fn triangle_area(a: [f64; 3], b: [f64; 3], c: [f64; 3]) -> f64 {
+    0.5 * norm(cross(sub(b, a), sub(c, a)))
+}
+
+fn centroid(pts: &[[f64; 3]]) -> [f64; 3] {
+    let mut c = [0.0; 3];
+    for p in pts {
+        for a in 0..3 {
+            c[a] += p[a];
+        }
+    }
+    c.map(|x| x / pts.len() as f64)
+}
+
+pub(crate) fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+pub(crate) fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+pub(crate) fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+pub(crate) fn norm(a: [f64; 3]) -> f64 {
+    dot(a, a).sqrt()
+}

@@ -1,0 +1,157 @@
+//! The scene model: triangles grouped into planar patches, each with an area, a normal and a material.
+//!
+//! Every scene is centred and scaled to a unit bounding sphere when it is built ("tracing space"): all
+//! measures are scale invariant, and f32 tracing is most precise there. Geometry is kept twice: f32 vertex
+//! positions for the tracers, and f64 patch planes, normals and areas for the measures, computed from the
+//! original f64 coordinates.
+
+pub mod builtin;
+mod build;
+pub mod obj;
+
+pub use build::SceneBuilder;
+
+use std::fmt;
+
+/// Diffuse material of a patch (paper eq. (2)): emission `E_i` and reflectance `R_i`, one channel each.
+///
+/// From an MTL file, the single value is the mean of the three RGB channels of `Ke` and `Kd`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Material {
+    /// Name as in the MTL file, or a built-in name.
+    pub name: String,
+    /// Emitted radiosity `E_i` (>= 0).
+    pub emission: f64,
+    /// Diffuse reflectance `R_i` (in [0, 1] for a physical material).
+    pub reflectance: f64,
+}
+
+impl Default for Material {
+    fn default() -> Self {
+        Material {
+            name: "default".into(),
+            emission: 0.0,
+            reflectance: 0.5,
+        }
+    }
+}
+
+/// A patch: one or more coplanar triangles, the unit of the discretisation (`i` in F_ij).
+#[derive(Clone, Debug)]
+pub struct Patch {
+    /// Area in tracing space (the scene scaled to its unit bounding sphere).
+    pub area: f64,
+    /// Unit normal in tracing space; the *front* side is the side it points to.
+    pub normal: [f64; 3],
+    /// Plane offset: points `x` of the patch satisfy `normal . x = offset` (tracing space).
+    pub offset: f64,
+    /// Index into [`Scene::materials`].
+    pub material: u32,
+    /// The range of this patch's triangles in [`Scene::triangles`].
+    pub first_triangle: u32,
+    /// How many triangles the patch has.
+    pub triangle_count: u32,
+}
+
+/// How tracing space relates to the scene's own units: `original = center + scale * traced`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Normalization {
+    /// Centre of the bounding sphere, scene units.
+    pub center: [f64; 3],
+    /// Radius of the bounding sphere, scene units.
+    pub scale: f64,
+}
+
+/// A triangle scene ready for tracing and measuring.
+#[derive(Clone, Debug)]
+pub struct Scene {
+    /// A name for reports (`@cube:10`, or the file path).
+    pub name: String,
+    /// Vertex positions in tracing space (f32, for the tracers).
+    pub positions: Vec<[f32; 3]>,
+    /// Triangles as vertex indices, ordered so that each patch's triangles are contiguous.
+    pub triangles: Vec<[u32; 3]>,
+    /// The patch of each triangle.
+    pub triangle_patch: Vec<u32>,
+    /// The patches.
+    pub patches: Vec<Patch>,
+    /// The materials patches refer to.
+    pub materials: Vec<Material>,
+    /// Mapping back to the scene's own units.
+    pub normalization: Normalization,
+    /// Non-fatal problems found while loading (missing MTL, dropped degenerate triangles, ...).
+    pub warnings: Vec<String>,
+}
+
+impl Scene {
+    /// Number of patches `n_p`.
+    pub fn patch_count(&self) -> usize {
+        self.patches.len()
+    }
+
+    /// Total area `A_T` in tracing space.
+    pub fn total_area(&self) -> f64 {
+        self.patches.iter().map(|p| p.area).sum()
+    }
+
+    /// Total area in the scene's own units.
+    pub fn total_area_scene_units(&self) -> f64 {
+        self.total_area() * self.normalization.scale * self.normalization.scale
+    }
+
+    /// Radius of the bounding sphere in tracing space (1 by construction).
+    pub fn bounding_radius(&self) -> f64 {
+        1.0
+    }
+
+    /// The f64 unit normal of each triangle's patch, indexed by triangle.
+    pub fn triangle_normals(&self) -> Vec<[f64; 3]> {
+        self.triangle_patch
+            .iter()
+            .map(|&p| self.patches[p as usize].normal)
+            .collect()
+    }
+}
+
+/// A scene that could not be loaded or built.
+#[derive(Debug, thiserror::Error)]
+pub enum SceneError {
+    /// A file could not be read or parsed.
+    #[error("{path}: {message}")]
+    File {
+        /// The file.
+        path: String,
+        /// What is wrong with it.
+        message: String,
+    },
+    /// The geometry is unusable (empty, non-finite, ...).
+    #[error("{scene}: {message}")]
+    Geometry {
+        /// The scene's name or file.
+        scene: String,
+        /// What is wrong.
+        message: String,
+    },
+    /// A built-in scene name or parameter is unknown or out of range.
+    #[error("{0}")]
+    Builtin(String),
+}
+
+impl fmt::Display for Normalization {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "centre ({:.6}, {:.6}, {:.6}), radius {:.6}",
+            self.center[0], self.center[1], self.center[2], self.scale
+        )
+    }
+}
+
+/// Loads a scene: a built-in name starting with `@` (see [`builtin`]) or an OBJ file (see [`obj`]).
+pub fn load(spec: &str) -> Result<Scene, SceneError> {
+    if spec.starts_with('@') {
+        builtin::build(spec)
+    } else {
+        obj::load(std::path::Path::new(spec))
+    }
+}

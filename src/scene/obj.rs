@@ -1,0 +1,155 @@
+//! OBJ + MTL scenes, read with `tobj`.
+//!
+//! Each polygon face of the OBJ is one patch (a quad is one patch of two triangles, not two patches).
+//! Materials: `Kd` (mean of RGB) is the reflectance, `Ke` (mean of RGB) the emission; faces without a
+//! material get [`Material::default`]. A missing or unreadable MTL file is a warning, not a failure.
+
+use std::path::Path;
+
+use super::{Material, Scene, SceneBuilder, SceneError};
+
+/// Loads an OBJ file (and its MTL library, if any) as a scene.
+pub fn load(path: &Path) -> Result<Scene, SceneError> {
+    let shown = path.display().to_string();
+    let file_error = |message: String| SceneError::File {
+        path: shown.clone(),
+        message,
+    };
+    if !path.exists() {
+        return Err(file_error("no such file".into()));
+    }
+    let options = tobj::LoadOptions {
+        single_index: false,
+        triangulate: false,
+        ignore_points: true,
+        ignore_lines: true,
+    };
+    let (models, materials) =
+        tobj::load_obj(path, &options).map_err(|e| file_error(describe_tobj_error(&e)))?;
+
+    let mut b = SceneBuilder::new(shown.clone());
+    let material_base = match materials {
+        Ok(mats) => {
+            let base = 0u32;
+            for m in &mats {
+                b.material(convert_material(m));
+            }
+            if mats.is_empty() {
+                None
+            } else {
+                Some(base)
+            }
+        }
+        Err(e) => {
+            b.warn(format!(
+                "{shown}: material library not loaded ({}); every face gets the default material \
+                 (reflectance 0.5, no emission)",
+                describe_tobj_error(&e)
+            ));
+            None
+        }
+    };
+    let default_material = b.material(Material::default());
+
+    for model in &models {
+        let mesh = &model.mesh;
+        if mesh.positions.len() % 3 != 0 {
+            return Err(file_error(format!(
+                "object `{}`: vertex positions are not triples",
+                model.name
+            )));
+        }
+        let ids: Vec<u32> = mesh
+            .positions
+            .chunks_exact(3)
+            .map(|p| b.vertex([p[0] as f64, p[1] as f64, p[2] as f64]))
+            .collect();
+        let material = match (material_base, mesh.material_id) {
+            (Some(base), Some(id)) => base + id as u32,
+            _ => default_material,
+        };
+        let arities: Vec<usize> = if mesh.face_arities.is_empty() {
+            vec![3; mesh.indices.len() / 3]
+        } else {
+            mesh.face_arities.iter().map(|&a| a as usize).collect()
+        };
+        let mut at = 0usize;
+        for (face, &arity) in arities.iter().enumerate() {
+            let Some(corners) = mesh.indices.get(at..at + arity) else {
+                return Err(file_error(format!(
+                    "object `{}`: face {} refers past the end of the index list",
+                    model.name,
+                    face + 1
+                )));
+            };
+            let verts: Result<Vec<u32>, SceneError> = corners
+                .iter()
+                .map(|&i| {
+                    ids.get(i as usize).copied().ok_or_else(|| {
+                        file_error(format!(
+                            "object `{}`: face {} uses vertex {} that does not exist",
+                            model.name,
+                            face + 1,
+                            i + 1
+                        ))
+                    })
+                })
+                .collect();
+            b.polygon(
+                &verts?,
+                material,
+                format!("{shown}: object `{}` face {}", model.name, face + 1),
+            );
+            at += arity;
+        }
+    }
+    b.build()
+}
+
+fn convert_material(m: &tobj::Material) -> Material {
+    let mean = |c: [f32; 3]| (c[0] as f64 + c[1] as f64 + c[2] as f64) / 3.0;
+    let emission = m
+        .unknown_param
+        .get("Ke")
+        .and_then(|s| parse_rgb(s))
+        .map(mean)
+        .unwrap_or(0.0);
+    Material {
+        name: m.name.clone(),
+        emission,
+        reflectance: m.diffuse.map(mean).unwrap_or(Material::default().reflectance),
+    }
+}
+
+fn parse_rgb(s: &str) -> Option<[f32; 3]> {
+    let v: Vec<f32> = s.split_whitespace().filter_map(|x| x.parse().ok()).collect();
+    match v.as_slice() {
+        [r, g, b] => Some([*r, *g, *b]),
+        [g] => Some([*g, *g, *g]),
+        _ => None,
+    }
+}
+
+fn describe_tobj_error(e: &tobj::LoadError) -> String {
+    use tobj::LoadError::*;
+    match e {
+        OpenFileFailed => "cannot open the file".into(),
+        ReadError => "cannot read the file".into(),
+        UnrecognizedCharacter => "unrecognised character".into(),
+        PositionParseError => "malformed vertex position (`v` line)".into(),
+        NormalParseError => "malformed normal (`vn` line)".into(),
+        TexcoordParseError => "malformed texture coordinate (`vt` line)".into(),
+        FaceParseError => "malformed face (`f` line)".into(),
+        MaterialParseError => "malformed material".into(),
+        InvalidObjectName => "invalid object name".into(),
+        FaceVertexOutOfBounds => "a face refers to a vertex that does not exist".into(),
+        FaceTexCoordOutOfBounds => "a face refers to a texture coordinate that does not exist".into(),
+        FaceNormalOutOfBounds => "a face refers to a normal that does not exist".into(),
+        FaceColorOutOfBounds => "a face refers to a colour that does not exist".into(),
+        InvalidLoadOptionConfig => "invalid load options".into(),
+        ScalingByZeroError => "a scale of zero".into(),
+        ColorParseError => "malformed vertex colour".into(),
+        InvalidPolygon => "invalid polygon".into(),
+        GenericFailure => "malformed OBJ".into(),
+    }
+}

@@ -1,0 +1,168 @@
+//! Tracing backends: every intersection along a batch of global lines.
+//!
+//! A backend (`embree`, and later a pure-Rust one) only reports *raw* hits: `(line, t, triangle)` in any
+//! order, possibly with the same crossing reported twice (a line through a shared edge or vertex hits every
+//! triangle that owns it). [`HitRules::canonicalize`] turns them into the canonical form that every
+//! consumer relies on, identically for every backend:
+//!
+//! * hits of a line are sorted by `(t, triangle)`;
+//! * exact repeats of `(t, triangle)` are removed;
+//! * hits within a few f32 ulps of each other whose triangles share a vertex and face the line the same way
+//!   are one crossing, kept once (the first in sort order). Hits at the same place that face the line
+//!   differently are a graze (the line touches a ridge and leaves) and are all kept. So a line through a
+//!   closed mesh always has an even number of hits.
+
+#[cfg(feature = "embree")]
+pub mod embree;
+mod rules;
+
+pub use rules::HitRules;
+
+use std::fmt;
+
+/// A line in tracing space (the scene scaled to its unit bounding sphere), traced in f32.
+///
+/// The segment `origin + t * dir`, `t` in `[0, t_max]`, covers the whole bounding sphere; `dir` is unit.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Line {
+    /// A point outside the bounding sphere, on the line.
+    pub origin: [f32; 3],
+    /// Unit direction.
+    pub dir: [f32; 3],
+    /// The far end of the traced segment.
+    pub t_max: f32,
+}
+
+/// One intersection of a line with a triangle.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Hit {
+    /// Distance from the line's origin, in tracing units.
+    pub t: f32,
+    /// Index of the triangle in [`crate::scene::Scene::triangles`].
+    pub triangle: u32,
+}
+
+/// A raw hit as a backend reports it: which line, where, which triangle.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[repr(C)]
+pub struct RawHit {
+    /// Distance from the line's origin.
+    pub t: f32,
+    /// Triangle index.
+    pub triangle: u32,
+    /// Index of the line within the batch passed to the backend.
+    pub line: u32,
+}
+
+/// The hits of a batch of lines in compressed rows: the hits of line `k` are
+/// `hits[start[k] as usize..start[k + 1] as usize]`.
+#[derive(Clone, Debug, Default)]
+pub struct LineHits {
+    /// All hits, grouped by line.
+    pub hits: Vec<Hit>,
+    /// Row offsets, one more than the number of lines.
+    pub start: Vec<u32>,
+}
+
+impl LineHits {
+    /// The number of lines held.
+    pub fn lines(&self) -> usize {
+        self.start.len().saturating_sub(1)
+    }
+
+    /// The hits of line `k`.
+    pub fn of_line(&self, k: usize) -> &[Hit] {
+        &self.hits[self.start[k] as usize..self.start[k + 1] as usize]
+    }
+
+    /// Groups raw hits by line (a stable counting sort), replacing the current contents.
+    pub fn fill_from_raw(&mut self, n_lines: usize, raw: &[RawHit]) {
+        self.start.clear();
+        self.start.resize(n_lines + 1, 0);
+        for r in raw {
+            self.start[r.line as usize + 1] += 1;
+        }
+        for k in 0..n_lines {
+            self.start[k + 1] += self.start[k];
+        }
+        let mut next: Vec<u32> = self.start[..n_lines].to_vec();
+        self.hits.clear();
+        self.hits.resize(
+            raw.len(),
+            Hit {
+                t: 0.0,
+                triangle: 0,
+            },
+        );
+        for r in raw {
+            let slot = &mut next[r.line as usize];
+            self.hits[*slot as usize] = Hit {
+                t: r.t,
+                triangle: r.triangle,
+            };
+            *slot += 1;
+        }
+    }
+}
+
+/// Which kind of Embree query drives a batch of lines.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Query {
+    /// One line per query (`rtcIntersect1`).
+    Single,
+    /// Packets of 4, 8 or 16 lines per query (`rtcIntersect4/8/16`).
+    Packet(usize),
+}
+
+impl fmt::Display for Query {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Query::Single => write!(f, "single"),
+            Query::Packet(w) => write!(f, "packet{w}"),
+        }
+    }
+}
+
+/// Errors a tracing backend can report.
+#[derive(Debug, thiserror::Error)]
+pub enum TraceError {
+    /// The backend library reported an error (Embree's device error callback, or a failed call).
+    #[error("{backend}: {message}")]
+    Backend {
+        /// Which backend.
+        backend: &'static str,
+        /// What it said.
+        message: String,
+    },
+    /// The requested query is not available on this machine or build.
+    #[error("{0}")]
+    Unsupported(String),
+}
+
+/// A tracing backend: all intersections along a batch of lines.
+///
+/// Implementations must be usable from several threads at once (`&self` queries on a committed scene).
+pub trait Tracer: Send + Sync {
+    /// A short name for reports (`"embree"`, `"rust"`).
+    fn name(&self) -> &'static str;
+
+    /// The canonicalisation rules for this backend's scene.
+    fn rules(&self) -> &HitRules;
+
+    /// Every intersection of every line with the scene's triangles, in any order; replaces `out`'s contents.
+    fn raw_hits(&self, lines: &[Line], out: &mut Vec<RawHit>) -> Result<(), TraceError>;
+
+    /// Every intersection along each line, sorted by `(t, triangle)`, one hit per crossing
+    /// (see the module documentation).
+    fn all_hits(
+        &self,
+        lines: &[Line],
+        scratch: &mut Vec<RawHit>,
+        out: &mut LineHits,
+    ) -> Result<(), TraceError> {
+        self.raw_hits(lines, scratch)?;
+        out.fill_from_raw(lines.len(), scratch);
+        self.rules().canonicalize(lines, out);
+        Ok(())
+    }
+}
