@@ -1,0 +1,464 @@
+//! The Embree backend (Embree 3 or 4, chosen at build time).
+//!
+//! Every intersection along a line comes from *one* traversal: the C shim (`ffi/scx_embree.c`) installs a
+//! filter callback that records each candidate hit (distance, triangle, line) and rejects it, so Embree
+//! carries on to the next candidate instead of stopping at the nearest. Scenes are built with
+//! `RTC_SCENE_FLAG_ROBUST` (watertight triangle test), so a line through a shared edge or vertex is
+//! reported by at least one of the triangles that own it, and often by several: [`HitRules`] merges those.
+//!
+//! Lines are traced one by one (`rtcIntersect1`, [`Query::Single`]) or in packets of 4, 8 or 16 adjacent
+//! lines (`rtcIntersectN`, [`Query::Packet`]), at the widths the machine traces natively.
+//!
+//! All `unsafe` of the crate lives in this module: calls into the shim, each with its reason.
+
+mod ffi;
+
+use std::ffi::{c_char, c_int, CStr};
+use std::fmt;
+use std::mem::{align_of, size_of};
+use std::ptr::{self, NonNull};
+use std::sync::Arc;
+
+use super::{Hit, HitRules, Line, Query, RawHit, TraceError, Tracer};
+use crate::scene::Scene;
+
+/// The name reported by [`Tracer::name`] and in errors.
+const BACKEND: &str = "embree";
+
+/// The shim's "no triangle" / "no line" marker (all ones).
+const NONE: u32 = u32::MAX;
+
+/// The packet widths Embree has kernels for.
+const PACKET_WIDTHS: [usize; 3] = [4, 8, 16];
+
+fn backend_error(message: impl Into<String>) -> TraceError {
+    TraceError::Backend {
+        backend: BACKEND,
+        message: message.into(),
+    }
+}
+
+/// What a status code means, for messages: the shim's own codes, else Embree's `RTCError`.
+fn status_name(code: c_int) -> &'static str {
+    match code {
+        ffi::SCX_ERR_INVALID => "invalid argument",
+        ffi::SCX_ERR_HIT_BUFFER => "hit buffer overflow",
+        ffi::SCX_ERR_RAY_ID => "unexpected ray id",
+        _ => match code as ffi::RTCError {
+            ffi::RTC_ERROR_UNKNOWN => "unknown error",
+            ffi::RTC_ERROR_INVALID_ARGUMENT => "invalid argument",
+            ffi::RTC_ERROR_INVALID_OPERATION => "invalid operation",
+            ffi::RTC_ERROR_OUT_OF_MEMORY => "out of memory",
+            ffi::RTC_ERROR_UNSUPPORTED_CPU => "unsupported CPU",
+            ffi::RTC_ERROR_CANCELLED => "cancelled",
+            _ => "error",
+        },
+    }
+}
+
+/// Turns a shim status into a result, with the message the shim recorded on this thread.
+fn check(code: c_int) -> Result<(), TraceError> {
+    if code == ffi::SCX_OK {
+        return Ok(());
+    }
+    let mut buf = [0u8; 512];
+    // SAFETY: `buf` is writable for `buf.len()` bytes; the shim writes at most that many, NUL included.
+    unsafe { ffi::scx_take_error(buf.as_mut_ptr().cast::<c_char>(), buf.len()) };
+    let message = CStr::from_bytes_until_nul(&buf)
+        .map(|m| m.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    Err(backend_error(format!(
+        "{} (code {code}): {message}",
+        status_name(code)
+    )))
+}
+
+/// An Embree device. Shared through an `Arc` by the tracer and its scene, so whichever is dropped last
+/// releases it.
+struct Device {
+    raw: NonNull<ffi::scx_device>,
+}
+
+// SAFETY: an Embree device is a reference-counted, internally synchronised object (Embree's API may be
+// called from any thread), and the shim's wrapper is immutable after creation: it can move between and be
+// shared by threads.
+unsafe impl Send for Device {}
+// SAFETY: see `Send`; `&Device` only reads immutable properties.
+unsafe impl Sync for Device {}
+
+impl Device {
+    fn new() -> Result<Self, TraceError> {
+        let mut raw = ptr::null_mut();
+        // SAFETY: a null config asks for Embree's defaults; `raw` is a valid place for the result.
+        check(unsafe { ffi::scx_device_new(ptr::null(), &mut raw) })?;
+        NonNull::new(raw)
+            .map(|raw| Device { raw })
+            .ok_or_else(|| backend_error("scx_device_new returned no device"))
+    }
+
+    fn native_widths(&self) -> Vec<usize> {
+        // SAFETY: `self.raw` is a live device (released only in Drop).
+        let bits = unsafe { ffi::scx_device_packet_widths(self.raw.as_ptr()) } as usize;
+        PACKET_WIDTHS.into_iter().filter(|w| bits & w != 0).collect()
+    }
+
+    fn version(&self) -> String {
+        let (mut major, mut minor, mut patch) = (0, 0, 0);
+        // SAFETY: `self.raw` is a live device; the three out-pointers are valid places for ints.
+        unsafe { ffi::scx_device_version(self.raw.as_ptr(), &mut major, &mut minor, &mut patch) };
+        format!("{major}.{minor}.{patch}")
+    }
+}
+
+impl Drop for Device {
+    fn drop(&mut self) {
+        // SAFETY: `self.raw` came from `scx_device_new` and is released exactly once, here. Scenes made from
+        // the device hold an `Arc<Device>`, so none is still in use.
+        unsafe { ffi::scx_device_release(self.raw.as_ptr()) };
+    }
+}
+
+/// A committed Embree scene with the scene's triangles as geometry 0 (primID = triangle index).
+struct CommittedScene {
+    raw: NonNull<ffi::scx_scene>,
+    /// Keeps the device alive for as long as the scene.
+    _device: Arc<Device>,
+}
+
+// SAFETY: after commit an Embree scene is immutable, and Embree documents queries on a committed scene as
+// safe from any number of threads at once; release is reference counted. The shim's per-query state lives
+// on the calling thread's stack and in the caller's own hit buffer.
+unsafe impl Send for CommittedScene {}
+// SAFETY: see `Send`: `&CommittedScene` only runs queries.
+unsafe impl Sync for CommittedScene {}
+
+impl CommittedScene {
+    fn new(device: &Arc<Device>, scene: &Scene) -> Result<Self, TraceError> {
+        let too_big = |what: &str| backend_error(format!("{}: too many {what} for Embree", scene.name));
+        let n_vertices = u32::try_from(scene.positions.len()).map_err(|_| too_big("vertices"))?;
+        let n_triangles = u32::try_from(scene.triangles.len()).map_err(|_| too_big("triangles"))?;
+        let mut raw = ptr::null_mut();
+        // SAFETY: `[f32; 3]` and `[u32; 3]` are laid out as 3 contiguous elements, so the two pointers cover
+        // `3 * n_vertices` floats and `3 * n_triangles` indices; the shim copies them (no pointer is kept)
+        // and checks every index against `n_vertices` before Embree reads any. `raw` is a valid out-pointer.
+        let code = unsafe {
+            ffi::scx_scene_new(
+                device.raw.as_ptr(),
+                scene.positions.as_ptr().cast::<f32>(),
+                n_vertices,
+                scene.triangles.as_ptr().cast::<u32>(),
+                n_triangles,
+                &mut raw,
+            )
+        };
+        check(code).map_err(|e| backend_error(format!("{}: building the scene: {e}", scene.name)))?;
+        let raw = NonNull::new(raw).ok_or_else(|| backend_error("scx_scene_new returned no scene"))?;
+        Ok(CommittedScene {
+            raw,
+            _device: Arc::clone(device),
+        })
+    }
+}
+
+impl Drop for CommittedScene {
+    fn drop(&mut self) {
+        // SAFETY: `self.raw` came from `scx_scene_new` and is released exactly once, here; `&self` queries
+        // cannot outlive `self`.
+        unsafe { ffi::scx_scene_release(self.raw.as_ptr()) };
+    }
+}
+
+/// The shim's growable hit array, freed on drop (also when a query fails half way).
+struct HitBuffer(ffi::scx_hits);
+
+impl HitBuffer {
+    fn new() -> Self {
+        HitBuffer(ffi::scx_hits::default())
+    }
+
+    fn as_slice(&self) -> &[ffi::scx_hit] {
+        if self.0.data.is_null() {
+            return &[];
+        }
+        // SAFETY: the shim keeps `data` pointing at `cap >= len` records of which the first `len` are
+        // written, and it only changes them during a query, which needs `&mut self`.
+        unsafe { std::slice::from_raw_parts(self.0.data, self.0.len) }
+    }
+}
+
+impl Drop for HitBuffer {
+    fn drop(&mut self) {
+        // SAFETY: the buffer was zeroed at creation and since then only managed by the shim, whose
+        // `scx_hits_free` frees exactly what its `realloc` allocated.
+        unsafe { ffi::scx_hits_free(&mut self.0) };
+    }
+}
+
+/// Copies lines into the shim's layout (Rust's [`Line`] has no guaranteed layout), checking that Embree
+/// can trace them: finite numbers, `t_max >= 0`, and fewer lines than the shim's padding id.
+fn to_shim_lines(lines: &[Line]) -> Result<Vec<ffi::scx_line>, TraceError> {
+    if lines.len() >= NONE as usize {
+        return Err(backend_error(format!(
+            "{} lines in one batch; at most {} fit",
+            lines.len(),
+            NONE - 1
+        )));
+    }
+    lines
+        .iter()
+        .enumerate()
+        .map(|(k, l)| {
+            let finite = l.origin.iter().chain(&l.dir).all(|c| c.is_finite()) && l.t_max.is_finite();
+            if !finite || l.t_max < 0.0 {
+                return Err(backend_error(format!(
+                    "line {k} cannot be traced: {l:?} (needs finite values and t_max >= 0)"
+                )));
+            }
+            Ok(ffi::scx_line {
+                org: l.origin,
+                dir: l.dir,
+                t_max: l.t_max,
+            })
+        })
+        .collect()
+}
+
+/// One shared struct's size (or alignment, or a constant) as the C shim's compiler and as the Rust
+/// bindings see it; see [`layout_checks`].
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct LayoutCheck {
+    /// What is measured (`"RTCRayHit16"`, `"align RTCRayHit8"`, `"RTC_VERSION"`).
+    pub name: &'static str,
+    /// The value in C (`sizeof`, `_Alignof`, or the constant).
+    pub c: usize,
+    /// The value in Rust (`size_of`, `align_of` of the bindgen type, or bindgen's constant).
+    pub rust: usize,
+}
+
+impl LayoutCheck {
+    fn new(name: &'static str, c: usize, rust: usize) -> Self {
+        LayoutCheck { name, c, rust }
+    }
+}
+
+fn shim_layout() -> ffi::scx_layout {
+    let mut layout = ffi::scx_layout::default();
+    // SAFETY: `layout` is a valid, writable `scx_layout`, the only thing the shim writes.
+    unsafe { ffi::scx_get_layout(&mut layout) };
+    layout
+}
+
+/// The sizes of every struct Rust shares with the shim or Embree, from both sides. They must agree:
+/// Embree writes whole structs, so a smaller Rust struct would be overrun. [`EmbreeTracer::new`] refuses
+/// to run when they differ.
+pub fn layout_checks() -> Vec<LayoutCheck> {
+    let c = shim_layout();
+    let mut checks = vec![
+        LayoutCheck::new("RTCRay", c.ray, size_of::<ffi::RTCRay>()),
+        LayoutCheck::new("RTCHit", c.hit, size_of::<ffi::RTCHit>()),
+        LayoutCheck::new("RTCRayHit", c.rayhit, size_of::<ffi::RTCRayHit>()),
+        LayoutCheck::new("RTCRayHit4", c.rayhit4, size_of::<ffi::RTCRayHit4>()),
+        LayoutCheck::new("RTCRayHit8", c.rayhit8, size_of::<ffi::RTCRayHit8>()),
+        LayoutCheck::new("RTCRayHit16", c.rayhit16, size_of::<ffi::RTCRayHit16>()),
+        LayoutCheck::new("align RTCRayHit4", c.align_rayhit4, align_of::<ffi::RTCRayHit4>()),
+        LayoutCheck::new("align RTCRayHit8", c.align_rayhit8, align_of::<ffi::RTCRayHit8>()),
+        LayoutCheck::new("align RTCRayHit16", c.align_rayhit16, align_of::<ffi::RTCRayHit16>()),
+        LayoutCheck::new(
+            "RTCFilterFunctionNArguments",
+            c.filter_args,
+            size_of::<ffi::RTCFilterFunctionNArguments>(),
+        ),
+        LayoutCheck::new("scx_line", c.line, size_of::<ffi::scx_line>()),
+        LayoutCheck::new("scx_hit", c.hit_record, size_of::<ffi::scx_hit>()),
+        LayoutCheck::new("scx_hit as RawHit", c.hit_record, size_of::<RawHit>()),
+        LayoutCheck::new("scx_hits", c.hits, size_of::<ffi::scx_hits>()),
+        LayoutCheck::new("scx_first_hit", c.first_hit, size_of::<ffi::scx_first_hit>()),
+        LayoutCheck::new("scx_query", c.query, size_of::<ffi::scx_query>()),
+        LayoutCheck::new("scx_layout", c.layout, size_of::<ffi::scx_layout>()),
+        LayoutCheck::new("RTC_VERSION", c.version as usize, ffi::RTC_VERSION as usize),
+    ];
+    #[cfg(embree_v3)]
+    checks.push(LayoutCheck::new(
+        "RTCIntersectContext",
+        c.context,
+        size_of::<ffi::RTCIntersectContext>(),
+    ));
+    #[cfg(embree_v4)]
+    checks.extend([
+        LayoutCheck::new(
+            "RTCRayQueryContext",
+            c.context,
+            size_of::<ffi::RTCRayQueryContext>(),
+        ),
+        LayoutCheck::new(
+            "RTCIntersectArguments",
+            c.arguments,
+            size_of::<ffi::RTCIntersectArguments>(),
+        ),
+    ]);
+    checks
+}
+
+/// `RTC_VERSION` of the Embree headers the shim was compiled against (e.g. 31305 for 3.13.5).
+pub fn header_version() -> u32 {
+    shim_layout().version as u32
+}
+
+fn check_layout() -> Result<(), TraceError> {
+    let bad: Vec<String> = layout_checks()
+        .into_iter()
+        .filter(|l| l.c != l.rust)
+        .map(|l| format!("{}: C {} vs Rust {}", l.name, l.c, l.rust))
+        .collect();
+    if bad.is_empty() {
+        Ok(())
+    } else {
+        Err(backend_error(format!(
+            "the bindings do not match the compiled shim ({}); rebuild from clean",
+            bad.join(", ")
+        )))
+    }
+}
+
+/// Tracing with Embree: all hits (the [`Tracer`] trait) and first hits, one line or one packet per query.
+///
+/// Queries take `&self` and may run on many threads at once; each call has its own hit buffer.
+pub struct EmbreeTracer {
+    scene: CommittedScene,
+    device: Arc<Device>,
+    query: Query,
+    /// 1 for single lines, else the packet width.
+    width: u32,
+    rules: HitRules,
+}
+
+impl EmbreeTracer {
+    /// Uploads `scene`'s triangles to a new Embree device and commits them (robust mode), to be traced
+    /// with `query`.
+    ///
+    /// Errors: [`TraceError::Unsupported`] when `query` asks for packets of a width that this machine
+    /// does not trace natively (the message names the native widths); [`TraceError::Backend`] when
+    /// Embree fails or the scene cannot be uploaded.
+    pub fn new(scene: &Scene, query: Query) -> Result<Self, TraceError> {
+        check_layout()?;
+        let device = Arc::new(Device::new()?);
+        let width = query_width(&device, query)?;
+        let committed = CommittedScene::new(&device, scene)?;
+        Ok(EmbreeTracer {
+            scene: committed,
+            device,
+            query,
+            width,
+            rules: HitRules::new(scene),
+        })
+    }
+
+    /// The packet widths (among 4, 8, 16) that this machine and Embree build trace natively.
+    pub fn native_packet_widths(&self) -> Vec<usize> {
+        self.device.native_widths()
+    }
+
+    /// The running Embree library's version, e.g. `"3.13.5"`.
+    pub fn version(&self) -> String {
+        self.device.version()
+    }
+
+    /// The query kind this tracer uses.
+    pub fn query(&self) -> Query {
+        self.query
+    }
+
+    /// The nearest hit of each line (`None` for a miss), one entry per line; replaces `out`'s contents.
+    pub fn first_hits(&self, lines: &[Line], out: &mut Vec<Option<Hit>>) -> Result<(), TraceError> {
+        let shim_lines = to_shim_lines(lines)?;
+        let mut first = vec![ffi::scx_first_hit::default(); lines.len()];
+        // SAFETY: the scene is live and committed; `shim_lines` and `first` both hold `lines.len()`
+        // elements (which `to_shim_lines` checked fits in u32); the width was checked against the device
+        // in `new` (and the shim checks it again).
+        let code = unsafe {
+            ffi::scx_first_hits(
+                self.scene.raw.as_ptr(),
+                shim_lines.as_ptr(),
+                shim_lines.len() as u32,
+                self.width,
+                first.as_mut_ptr(),
+            )
+        };
+        check(code)?;
+        out.clear();
+        out.extend(first.iter().map(|f| {
+            (f.prim != NONE).then_some(Hit {
+                t: f.t,
+                triangle: f.prim,
+            })
+        }));
+        Ok(())
+    }
+}
+
+/// The shim's width for a query, or why this machine cannot run it.
+fn query_width(device: &Device, query: Query) -> Result<u32, TraceError> {
+    let width = match query {
+        Query::Single => return Ok(1),
+        Query::Packet(width) => width,
+    };
+    let native = device.native_widths();
+    if native.contains(&width) {
+        return Ok(width as u32);
+    }
+    let list = if native.is_empty() {
+        "none".to_string()
+    } else {
+        native.iter().map(|w| w.to_string()).collect::<Vec<_>>().join(", ")
+    };
+    Err(TraceError::Unsupported(format!(
+        "embree: packets of {width} lines are not native here (Embree {}; native packet widths: {list}); \
+         use one of those or single lines",
+        device.version()
+    )))
+}
+
+impl Tracer for EmbreeTracer {
+    fn name(&self) -> &'static str {
+        BACKEND
+    }
+
+    fn rules(&self) -> &HitRules {
+        &self.rules
+    }
+
+    fn raw_hits(&self, lines: &[Line], out: &mut Vec<RawHit>) -> Result<(), TraceError> {
+        let shim_lines = to_shim_lines(lines)?;
+        let mut hits = HitBuffer::new();
+        // SAFETY: the scene is live and committed; `shim_lines` holds `lines.len()` lines (checked to fit
+        // in u32 below the padding id); `hits` is this call's own buffer, which the shim grows with
+        // realloc; the width was checked against the device in `new` (and the shim checks it again).
+        let code = unsafe {
+            ffi::scx_all_hits(
+                self.scene.raw.as_ptr(),
+                shim_lines.as_ptr(),
+                shim_lines.len() as u32,
+                self.width,
+                &mut hits.0,
+            )
+        };
+        check(code)?;
+        out.clear();
+        out.extend(hits.as_slice().iter().map(|h| RawHit {
+            t: h.t,
+            triangle: h.prim,
+            line: h.line,
+        }));
+        Ok(())
+    }
+}
+
+impl fmt::Debug for EmbreeTracer {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("EmbreeTracer")
+            .field("version", &self.version())
+            .field("query", &self.query)
+            .field("native_packet_widths", &self.native_packet_widths())
+            .finish_non_exhaustive()
+    }
+}
