@@ -21,7 +21,8 @@ mod embree {
 
     const SHIM_HEADER: &str = "ffi/scx_embree.h";
     const SHIM_SOURCE: &str = "ffi/scx_embree.c";
-    const REMEDY: &str = "install it with 'apt-get install libembree-dev libclang-dev', set EMBREE_DIR, \
+    const REMEDY: &str =
+        "install it with 'apt-get install libembree-dev libclang-dev', set EMBREE_DIR, \
                           or build with --no-default-features";
 
     /// The Embree installation the build uses.
@@ -138,13 +139,16 @@ mod embree {
             .allowlist_type("RTCRay|RTCHit|RTCRayHit|RTCRayHit4|RTCRayHit8|RTCRayHit16")
             .allowlist_type("RTCIntersectContext|RTCRayQueryContext|RTCIntersectArguments")
             .allowlist_type("RTCFilterFunctionNArguments|RTCError")
-            .allowlist_var("RTC_VERSION|RTC_VERSION_MAJOR|RTC_VERSION_MINOR|RTC_VERSION_PATCH|SCX_.*")
+            .allowlist_var(
+                "RTC_VERSION|RTC_VERSION_MAJOR|RTC_VERSION_MINOR|RTC_VERSION_PATCH|SCX_.*",
+            )
             .default_macro_constant_type(bindgen::MacroTypeVariation::Signed)
             .derive_default(true)
             .prepend_enum_name(false)
             .parse_callbacks(Box::new(bindgen::CargoCallbacks::new()));
         let bindings = run_bindgen(builder)?;
-        let out = PathBuf::from(env::var("OUT_DIR").expect("cargo sets OUT_DIR")).join("embree_bindings.rs");
+        let out = PathBuf::from(env::var("OUT_DIR").expect("cargo sets OUT_DIR"))
+            .join("embree_bindings.rs");
         bindings
             .write_to_file(&out)
             .map_err(|e| format!("cannot write {}: {e}", out.display()))

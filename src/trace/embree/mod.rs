@@ -99,7 +99,10 @@ impl Device {
     fn native_widths(&self) -> Vec<usize> {
         // SAFETY: `self.raw` is a live device (released only in Drop).
         let bits = unsafe { ffi::scx_device_packet_widths(self.raw.as_ptr()) } as usize;
-        PACKET_WIDTHS.into_iter().filter(|w| bits & w != 0).collect()
+        PACKET_WIDTHS
+            .into_iter()
+            .filter(|w| bits & w != 0)
+            .collect()
     }
 
     fn version(&self) -> String {
@@ -134,7 +137,8 @@ unsafe impl Sync for CommittedScene {}
 
 impl CommittedScene {
     fn new(device: &Arc<Device>, scene: &Scene) -> Result<Self, TraceError> {
-        let too_big = |what: &str| backend_error(format!("{}: too many {what} for Embree", scene.name));
+        let too_big =
+            |what: &str| backend_error(format!("{}: too many {what} for Embree", scene.name));
         let n_vertices = u32::try_from(scene.positions.len()).map_err(|_| too_big("vertices"))?;
         let n_triangles = u32::try_from(scene.triangles.len()).map_err(|_| too_big("triangles"))?;
         let mut raw = ptr::null_mut();
@@ -151,8 +155,10 @@ impl CommittedScene {
                 &mut raw,
             )
         };
-        check(code).map_err(|e| backend_error(format!("{}: building the scene: {e}", scene.name)))?;
-        let raw = NonNull::new(raw).ok_or_else(|| backend_error("scx_scene_new returned no scene"))?;
+        check(code)
+            .map_err(|e| backend_error(format!("{}: building the scene: {e}", scene.name)))?;
+        let raw =
+            NonNull::new(raw).ok_or_else(|| backend_error("scx_scene_new returned no scene"))?;
         Ok(CommittedScene {
             raw,
             _device: Arc::clone(device),
@@ -208,7 +214,8 @@ fn to_shim_lines(lines: &[Line]) -> Result<Vec<ffi::scx_line>, TraceError> {
         .iter()
         .enumerate()
         .map(|(k, l)| {
-            let finite = l.origin.iter().chain(&l.dir).all(|c| c.is_finite()) && l.t_max.is_finite();
+            let finite =
+                l.origin.iter().chain(&l.dir).all(|c| c.is_finite()) && l.t_max.is_finite();
             if !finite || l.t_max < 0.0 {
                 return Err(backend_error(format!(
                     "line {k} cannot be traced: {l:?} (needs finite values and t_max >= 0)"
@@ -260,9 +267,21 @@ pub fn layout_checks() -> Vec<LayoutCheck> {
         LayoutCheck::new("RTCRayHit4", c.rayhit4, size_of::<ffi::RTCRayHit4>()),
         LayoutCheck::new("RTCRayHit8", c.rayhit8, size_of::<ffi::RTCRayHit8>()),
         LayoutCheck::new("RTCRayHit16", c.rayhit16, size_of::<ffi::RTCRayHit16>()),
-        LayoutCheck::new("align RTCRayHit4", c.align_rayhit4, align_of::<ffi::RTCRayHit4>()),
-        LayoutCheck::new("align RTCRayHit8", c.align_rayhit8, align_of::<ffi::RTCRayHit8>()),
-        LayoutCheck::new("align RTCRayHit16", c.align_rayhit16, align_of::<ffi::RTCRayHit16>()),
+        LayoutCheck::new(
+            "align RTCRayHit4",
+            c.align_rayhit4,
+            align_of::<ffi::RTCRayHit4>(),
+        ),
+        LayoutCheck::new(
+            "align RTCRayHit8",
+            c.align_rayhit8,
+            align_of::<ffi::RTCRayHit8>(),
+        ),
+        LayoutCheck::new(
+            "align RTCRayHit16",
+            c.align_rayhit16,
+            align_of::<ffi::RTCRayHit16>(),
+        ),
         LayoutCheck::new(
             "RTCFilterFunctionNArguments",
             c.filter_args,
@@ -272,7 +291,11 @@ pub fn layout_checks() -> Vec<LayoutCheck> {
         LayoutCheck::new("scx_hit", c.hit_record, size_of::<ffi::scx_hit>()),
         LayoutCheck::new("scx_hit as RawHit", c.hit_record, size_of::<RawHit>()),
         LayoutCheck::new("scx_hits", c.hits, size_of::<ffi::scx_hits>()),
-        LayoutCheck::new("scx_first_hit", c.first_hit, size_of::<ffi::scx_first_hit>()),
+        LayoutCheck::new(
+            "scx_first_hit",
+            c.first_hit,
+            size_of::<ffi::scx_first_hit>(),
+        ),
         LayoutCheck::new("scx_query", c.query, size_of::<ffi::scx_query>()),
         LayoutCheck::new("scx_layout", c.layout, size_of::<ffi::scx_layout>()),
         LayoutCheck::new("RTC_VERSION", c.version as usize, ffi::RTC_VERSION as usize),
@@ -409,7 +432,11 @@ fn query_width(device: &Device, query: Query) -> Result<u32, TraceError> {
     let list = if native.is_empty() {
         "none".to_string()
     } else {
-        native.iter().map(|w| w.to_string()).collect::<Vec<_>>().join(", ")
+        native
+            .iter()
+            .map(|w| w.to_string())
+            .collect::<Vec<_>>()
+            .join(", ")
     };
     Err(TraceError::Unsupported(format!(
         "embree: packets of {width} lines are not native here (Embree {}; native packet widths: {list}); \
