@@ -98,6 +98,7 @@ impl SceneBuilder {
             patches: Vec::new(),
             materials: std::mem::take(&mut self.materials),
             normalization,
+            area_scene_units: 0.0,
             warnings: std::mem::take(&mut self.warnings),
         };
         let mut dropped_triangles = 0usize;
@@ -125,12 +126,21 @@ impl SceneBuilder {
             let mut patch_area = 0.0;
             for k in 1..poly.vertices.len() - 1 {
                 let tri = [poly.vertices[0], poly.vertices[k], poly.vertices[k + 1]];
-                let a = triangle_area(traced[tri[0] as usize], traced[tri[1] as usize], traced[tri[2] as usize]);
+                let a = triangle_area(
+                    traced[tri[0] as usize],
+                    traced[tri[1] as usize],
+                    traced[tri[2] as usize],
+                );
                 if a <= DEGENERATE_AREA {
                     dropped_triangles += 1;
                     continue;
                 }
                 patch_area += a;
+                scene.area_scene_units += triangle_area(
+                    self.vertices[tri[0] as usize],
+                    self.vertices[tri[1] as usize],
+                    self.vertices[tri[2] as usize],
+                );
                 scene.triangles.push(tri);
                 scene.triangle_patch.push(patch_index);
             }

@@ -41,7 +41,12 @@ pub fn build(spec: &str) -> Result<Scene, SceneError> {
 }
 
 /// Parses an optional whole-number parameter within `[1, max]`.
-fn parse_count(spec: &str, param: Option<&str>, default: usize, max: usize) -> Result<usize, SceneError> {
+fn parse_count(
+    spec: &str,
+    param: Option<&str>,
+    default: usize,
+    max: usize,
+) -> Result<usize, SceneError> {
     let Some(p) = param else {
         return Ok(default);
     };

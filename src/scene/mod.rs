@@ -5,8 +5,8 @@
 //! positions for the tracers, and f64 patch planes, normals and areas for the measures, computed from the
 //! original f64 coordinates.
 
-pub mod builtin;
 mod build;
+pub mod builtin;
 pub mod obj;
 
 pub use build::SceneBuilder;
@@ -79,6 +79,8 @@ pub struct Scene {
     pub materials: Vec<Material>,
     /// Mapping back to the scene's own units.
     pub normalization: Normalization,
+    /// Total area in the scene's own units, from the original f64 coordinates.
+    pub area_scene_units: f64,
     /// Non-fatal problems found while loading (missing MTL, dropped degenerate triangles, ...).
     pub warnings: Vec<String>,
 }
@@ -94,9 +96,9 @@ impl Scene {
         self.patches.iter().map(|p| p.area).sum()
     }
 
-    /// Total area in the scene's own units.
+    /// Total area in the scene's own units (computed from the original coordinates).
     pub fn total_area_scene_units(&self) -> f64 {
-        self.total_area() * self.normalization.scale * self.normalization.scale
+        self.area_scene_units
     }
 
     /// Radius of the bounding sphere in tracing space (1 by construction).

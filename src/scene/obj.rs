@@ -62,7 +62,7 @@ pub fn load(path: &Path) -> Result<Scene, SceneError> {
         let ids: Vec<u32> = mesh
             .positions
             .chunks_exact(3)
-            .map(|p| b.vertex([p[0] as f64, p[1] as f64, p[2] as f64]))
+            .map(|p| b.vertex([p[0], p[1], p[2]]))
             .collect();
         let material = match (material_base, mesh.material_id) {
             (Some(base), Some(id)) => base + id as u32,
@@ -107,7 +107,7 @@ pub fn load(path: &Path) -> Result<Scene, SceneError> {
 }
 
 fn convert_material(m: &tobj::Material) -> Material {
-    let mean = |c: [f32; 3]| (c[0] as f64 + c[1] as f64 + c[2] as f64) / 3.0;
+    let mean = |c: [f64; 3]| (c[0] + c[1] + c[2]) / 3.0;
     let emission = m
         .unknown_param
         .get("Ke")
@@ -117,12 +117,18 @@ fn convert_material(m: &tobj::Material) -> Material {
     Material {
         name: m.name.clone(),
         emission,
-        reflectance: m.diffuse.map(mean).unwrap_or(Material::default().reflectance),
+        reflectance: m
+            .diffuse
+            .map(mean)
+            .unwrap_or(Material::default().reflectance),
     }
 }
 
-fn parse_rgb(s: &str) -> Option<[f32; 3]> {
-    let v: Vec<f32> = s.split_whitespace().filter_map(|x| x.parse().ok()).collect();
+fn parse_rgb(s: &str) -> Option<[f64; 3]> {
+    let v: Vec<f64> = s
+        .split_whitespace()
+        .filter_map(|x| x.parse().ok())
+        .collect();
     match v.as_slice() {
         [r, g, b] => Some([*r, *g, *b]),
         [g] => Some([*g, *g, *g]),
@@ -143,7 +149,9 @@ fn describe_tobj_error(e: &tobj::LoadError) -> String {
         MaterialParseError => "malformed material".into(),
         InvalidObjectName => "invalid object name".into(),
         FaceVertexOutOfBounds => "a face refers to a vertex that does not exist".into(),
-        FaceTexCoordOutOfBounds => "a face refers to a texture coordinate that does not exist".into(),
+        FaceTexCoordOutOfBounds => {
+            "a face refers to a texture coordinate that does not exist".into()
+        }
         FaceNormalOutOfBounds => "a face refers to a normal that does not exist".into(),
         FaceColorOutOfBounds => "a face refers to a colour that does not exist".into(),
         InvalidLoadOptionConfig => "invalid load options".into(),
