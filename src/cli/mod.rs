@@ -25,6 +25,17 @@ enum Command {
     Analyze(AnalyzeArgs),
     /// List the built-in scenes and their parameters.
     Scenes,
+    /// Write a scene (built-in or file) as OBJ + MTL.
+    Export(ExportArgs),
+}
+
+#[derive(clap::Args, Debug)]
+struct ExportArgs {
+    /// An OBJ file, or a built-in scene such as `@cube:10`.
+    scene: String,
+    /// The OBJ file to write; the MTL library goes beside it.
+    #[arg(short, long)]
+    output: std::path::PathBuf,
 }
 
 #[derive(clap::Args, Debug)]
@@ -114,8 +125,41 @@ pub fn main() -> ExitCode {
             }
             ExitCode::SUCCESS
         }
-        Command::Analyze(args) => run_analyze(args),
+        Command::Analyze(args) => finish(try_analyze(&args)),
+        Command::Export(args) => finish(try_export(&args)),
     }
+}
+
+fn finish(result: Result<(), Failure>) -> ExitCode {
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(f) => {
+            eprintln!("scx: error: {}", f.message);
+            ExitCode::from(f.code)
+        }
+    }
+}
+
+fn load_scene(spec: &str) -> Result<scene::Scene, Failure> {
+    let scene = scene::load(spec).map_err(bad_input)?;
+    for w in &scene.warnings {
+        eprintln!("scx: warning: {w}");
+    }
+    Ok(scene)
+}
+
+fn try_export(args: &ExportArgs) -> Result<(), Failure> {
+    let scene = load_scene(&args.scene)?;
+    scene::obj::write(&scene, &args.output).map_err(|e| Failure {
+        code: 1,
+        message: e.to_string(),
+    })?;
+    eprintln!(
+        "scx: wrote {} ({} patches) and its MTL library",
+        args.output.display(),
+        scene.patch_count()
+    );
+    Ok(())
 }
 
 /// A failure with its exit code.
@@ -131,21 +175,8 @@ fn bad_input(message: impl ToString) -> Failure {
     }
 }
 
-fn run_analyze(args: AnalyzeArgs) -> ExitCode {
-    match try_analyze(&args) {
-        Ok(()) => ExitCode::SUCCESS,
-        Err(f) => {
-            eprintln!("scx: error: {}", f.message);
-            ExitCode::from(f.code)
-        }
-    }
-}
-
 fn try_analyze(args: &AnalyzeArgs) -> Result<(), Failure> {
-    let scene = scene::load(&args.scene).map_err(bad_input)?;
-    for w in &scene.warnings {
-        eprintln!("scx: warning: {w}");
-    }
+    let scene = load_scene(&args.scene)?;
     let backend = match args.tracer {
         Some(TracerArg::Embree) => Backend::Embree,
         Some(TracerArg::Rust) => Backend::Rust,

@@ -51,6 +51,8 @@ pub struct Patch {
     pub first_triangle: u32,
     /// How many triangles the patch has.
     pub triangle_count: u32,
+    /// The polygon's vertices (indices into [`Scene::vertices`]), in order, front side counter-clockwise.
+    pub polygon: Vec<u32>,
 }
 
 /// How tracing space relates to the scene's own units: `original = center + scale * traced`.
@@ -69,6 +71,8 @@ pub struct Scene {
     pub name: String,
     /// Vertex positions in tracing space (f32, for the tracers).
     pub positions: Vec<[f32; 3]>,
+    /// The same vertices in the scene's own units (f64, as loaded).
+    pub vertices: Vec<[f64; 3]>,
     /// Triangles as vertex indices, ordered so that each patch's triangles are contiguous.
     pub triangles: Vec<[u32; 3]>,
     /// The patch of each triangle.
