@@ -212,3 +212,28 @@ fn scaling_the_scene_changes_nothing() {
     assert!((results[0].1 / base_area - 1e-6).abs() < 1e-12);
     assert!((results[2].1 / base_area - 1e6).abs() < 1e-3);
 }
+
+/// The sphere is the independent channel (sec. 3.1.2): I_s^c = 0 for the true sphere, so on icospheres it
+/// tends to 0 as the subdivision grows, and the discrete I_s stays below it (Proposition 2).
+#[test]
+fn sphere_mutual_information_tends_to_zero() {
+    let mut previous_cmi = f64::INFINITY;
+    let mut previous_is = f64::INFINITY;
+    for level in 0..=3usize {
+        let scene = scene::load(&format!("@sphere:{level}")).unwrap();
+        let tracer = all_tracers(&scene).pop().unwrap();
+        let a = run(&scene, tracer.as_ref(), 400_000, 21);
+        let cmi = a.visibility.continuous_mutual_information.unwrap();
+        assert!(cmi.value > 0.0 && cmi.value < 0.45 * previous_cmi, "level {level}: I_s^c {cmi:?} after {previous_cmi}");
+        previous_cmi = cmi.value;
+        if level <= 1 {
+            // Rows are well sampled here (>= 2500 segments per patch), so the plug-in I_s is close to
+            // its limit: below I_s^c, and falling with the subdivision.
+            let is = a.visibility.mutual_information.unwrap();
+            assert!(is.value < cmi.value + 4.0 * cmi.stderr.unwrap(), "level {level}: {is:?} vs {cmi:?}");
+            assert!(is.value < previous_is, "level {level}: {is:?}");
+            previous_is = is.value;
+        }
+    }
+    assert!(previous_cmi < 0.02);
+}
