@@ -6,5 +6,8 @@
 
 #![forbid(unsafe_op_in_unsafe_fn)]
 
+pub mod analysis;
+pub mod measure;
+pub mod sample;
 pub mod scene;
 pub mod trace;

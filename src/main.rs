@@ -1,1 +1,7 @@
-fn main() {}
+//! `scx`: the command-line front end of the scene complexity analyser.
+
+mod cli;
+
+fn main() -> std::process::ExitCode {
+    cli::main()
+}

@@ -90,14 +90,22 @@ impl SceneBuilder {
             .map(|p| to_tracing_space(*p, &normalization))
             .collect();
 
+        // Vertices that round to the same f32 point are one vertex for the tracers: weld them, so that
+        // triangles meeting there share the index (the hit rules merge a crossing of a shared vertex).
+        let remap = weld_f32(&traced, &mut self.polygons);
+        let vertices: Vec<[f64; 3]> = remap.iter().map(|&v| self.vertices[v as usize]).collect();
+        let traced: Vec<[f64; 3]> = remap.iter().map(|&v| traced[v as usize]).collect();
+
         let mut scene = Scene {
             name: self.name.clone(),
             positions: traced.iter().map(|p| p.map(|c| c as f32)).collect(),
+            vertices,
             triangles: Vec::new(),
             triangle_patch: Vec::new(),
             patches: Vec::new(),
             materials: std::mem::take(&mut self.materials),
             normalization,
+            area_scene_units: 0.0,
             warnings: std::mem::take(&mut self.warnings),
         };
         let mut dropped_triangles = 0usize;
@@ -125,12 +133,21 @@ impl SceneBuilder {
             let mut patch_area = 0.0;
             for k in 1..poly.vertices.len() - 1 {
                 let tri = [poly.vertices[0], poly.vertices[k], poly.vertices[k + 1]];
-                let a = triangle_area(traced[tri[0] as usize], traced[tri[1] as usize], traced[tri[2] as usize]);
+                let a = triangle_area(
+                    traced[tri[0] as usize],
+                    traced[tri[1] as usize],
+                    traced[tri[2] as usize],
+                );
                 if a <= DEGENERATE_AREA {
                     dropped_triangles += 1;
                     continue;
                 }
                 patch_area += a;
+                scene.area_scene_units += triangle_area(
+                    scene.vertices[tri[0] as usize],
+                    scene.vertices[tri[1] as usize],
+                    scene.vertices[tri[2] as usize],
+                );
                 scene.triangles.push(tri);
                 scene.triangle_patch.push(patch_index);
             }
@@ -147,6 +164,7 @@ impl SceneBuilder {
                 material: poly.material,
                 first_triangle: first,
                 triangle_count: count,
+                polygon: poly.vertices.clone(),
             });
         }
         if dropped_triangles > 0 {
@@ -230,6 +248,28 @@ impl SceneBuilder {
             scale: radius,
         })
     }
+}
+
+/// Renumbers vertices so that those with equal f32 tracing positions become one, rewriting the polygons;
+/// returns, for each new vertex, the old vertex it stands for (unused vertices are dropped).
+fn weld_f32(traced: &[[f64; 3]], polygons: &mut [Polygon]) -> Vec<u32> {
+    let mut by_position: HashMap<[u32; 3], u32> = HashMap::new();
+    let mut new_of_old: Vec<Option<u32>> = vec![None; traced.len()];
+    let mut old_of_new: Vec<u32> = Vec::new();
+    for poly in polygons.iter_mut() {
+        for v in poly.vertices.iter_mut() {
+            let old = *v as usize;
+            let new = *new_of_old[old].get_or_insert_with(|| {
+                let key = traced[old].map(|c| ((c as f32) + 0.0).to_bits());
+                *by_position.entry(key).or_insert_with(|| {
+                    old_of_new.push(old as u32);
+                    (old_of_new.len() - 1) as u32
+                })
+            });
+            *v = new;
+        }
+    }
+    old_of_new
 }
 
 fn to_tracing_space(p: [f64; 3], n: &Normalization) -> [f64; 3] {

@@ -1,8 +1,15 @@
-//! Built-in scenes, named `@name` or `@name:param`.
+//! Built-in scenes, named `@name` or `@name:param`; every one is an enclosure seen from inside (normals
+//! point inwards), so every line segment inside it joins two patches.
 //!
-//! * `@cube:N`: the interior of the unit cube (area 6), each face cut into N x N square patches, normals
-//!   pointing inwards. `@cube` is `@cube:1`.
+//! * `@cube:N`: the interior of the unit cube (area 6), each face cut into N x N square patches.
+//!   `@cube` is `@cube:1`.
+//! * `@sphere:L`: an icosphere after L subdivisions of the icosahedron (20 * 4^L triangles, each a patch),
+//!   vertices on the unit sphere.
+//! * `@tetrahedron`, `@octahedron`, `@icosahedron` (`:N` cuts each triangular face into N^2 equal
+//!   triangles) and `@dodecahedron` (one pentagon patch per face; `:N` cuts each pentagon into 5 triangles
+//!   from its centre, then each into N^2): the interiors of the regular solids, circumradius 1.
 
+use super::build::{cross, dot, norm, sub};
 use super::{Material, Scene, SceneBuilder, SceneError};
 
 /// A built-in scene's name, parameter and description, for `scx scenes`.
@@ -15,10 +22,32 @@ pub struct BuiltinInfo {
 }
 
 /// Every built-in scene.
-pub const BUILTINS: &[BuiltinInfo] = &[BuiltinInfo {
-    usage: "@cube[:N]",
-    description: "unit cube enclosure, inward normals, each face cut into N x N square patches (N >= 1, default 1)",
-}];
+pub const BUILTINS: &[BuiltinInfo] = &[
+    BuiltinInfo {
+        usage: "@cube[:N]",
+        description: "unit cube enclosure, each face cut into N x N square patches (N >= 1, default 1)",
+    },
+    BuiltinInfo {
+        usage: "@sphere[:L]",
+        description: "icosphere enclosure after L subdivisions (0..=7, default 3): 20*4^L triangle patches",
+    },
+    BuiltinInfo {
+        usage: "@tetrahedron[:N]",
+        description: "regular tetrahedron interior, each face cut into N^2 triangles (default 1: 4 patches)",
+    },
+    BuiltinInfo {
+        usage: "@octahedron[:N]",
+        description: "regular octahedron interior, each face cut into N^2 triangles (default 1: 8 patches)",
+    },
+    BuiltinInfo {
+        usage: "@icosahedron[:N]",
+        description: "regular icosahedron interior, each face cut into N^2 triangles (default 1: 20 patches)",
+    },
+    BuiltinInfo {
+        usage: "@dodecahedron[:N]",
+        description: "regular dodecahedron interior, one pentagon per face; N > 1 cuts each into 5 N^2 triangles",
+    },
+];
 
 /// Builds a built-in scene from its name (`@cube:10`).
 pub fn build(spec: &str) -> Result<Scene, SceneError> {
@@ -29,6 +58,11 @@ pub fn build(spec: &str) -> Result<Scene, SceneError> {
     };
     match name {
         "cube" => cube(spec, parse_count(spec, param, 1, 2000)?),
+        "sphere" => sphere(spec, parse_count(spec, param.or(Some("3")), 0, 7)?),
+        "tetrahedron" => solid(spec, &tetrahedron(), parse_count(spec, param, 1, 1000)?),
+        "octahedron" => solid(spec, &octahedron(), parse_count(spec, param, 1, 1000)?),
+        "icosahedron" => solid(spec, &icosahedron(), parse_count(spec, param, 1, 1000)?),
+        "dodecahedron" => solid(spec, &dodecahedron(), parse_count(spec, param, 1, 1000)?),
         _ => Err(SceneError::Builtin(format!(
             "{spec}: unknown built-in scene; `scx scenes` lists them ({})",
             BUILTINS
@@ -40,15 +74,20 @@ pub fn build(spec: &str) -> Result<Scene, SceneError> {
     }
 }
 
-/// Parses an optional whole-number parameter within `[1, max]`.
-fn parse_count(spec: &str, param: Option<&str>, default: usize, max: usize) -> Result<usize, SceneError> {
+/// Parses an optional whole-number parameter within `[min, max]` (absent: `min`).
+fn parse_count(
+    spec: &str,
+    param: Option<&str>,
+    min: usize,
+    max: usize,
+) -> Result<usize, SceneError> {
     let Some(p) = param else {
-        return Ok(default);
+        return Ok(min);
     };
     match p.parse::<usize>() {
-        Ok(n) if (1..=max).contains(&n) => Ok(n),
+        Ok(n) if (min..=max).contains(&n) => Ok(n),
         _ => Err(SceneError::Builtin(format!(
-            "{spec}: the parameter must be a whole number from 1 to {max}, not `{p}`"
+            "{spec}: the parameter must be a whole number from {min} to {max}, not `{p}`"
         ))),
     }
 }
@@ -89,4 +128,235 @@ pub fn cube(spec: &str, n: usize) -> Result<Scene, SceneError> {
         }
     }
     b.build()
+}
+
+/// A convex polyhedron centred at the origin: vertices and faces (vertex lists, any winding).
+struct Polyhedron {
+    vertices: Vec<[f64; 3]>,
+    faces: Vec<Vec<usize>>,
+}
+
+fn wall_material(b: &mut SceneBuilder) -> u32 {
+    b.material(Material {
+        name: "wall".into(),
+        emission: 0.0,
+        reflectance: 0.5,
+    })
+}
+
+/// The interior of a convex polyhedron: each face one patch (N = 1) or cut into triangles.
+fn solid(spec: &str, poly: &Polyhedron, n: usize) -> Result<Scene, SceneError> {
+    let mut b = SceneBuilder::new(spec);
+    let m = wall_material(&mut b);
+    for (f, face) in poly.faces.iter().enumerate() {
+        let pts = facing_inwards(face.iter().map(|&v| poly.vertices[v]).collect());
+        if n == 1 {
+            let idx: Vec<u32> = pts.iter().map(|&p| b.vertex(p)).collect();
+            b.polygon(&idx, m, format!("face {f}"));
+        } else if pts.len() == 3 {
+            split_triangle(&mut b, [pts[0], pts[1], pts[2]], n, m, &format!("face {f}"));
+        } else {
+            let c = centroid(&pts);
+            for k in 0..pts.len() {
+                let tri = [c, pts[k], pts[(k + 1) % pts.len()]];
+                split_triangle(&mut b, tri, n, m, &format!("face {f} sector {k}"));
+            }
+        }
+    }
+    b.build()
+}
+
+/// Reorders a convex face so that it is counter-clockwise seen from the origin (its normal points in).
+fn facing_inwards(mut pts: Vec<[f64; 3]>) -> Vec<[f64; 3]> {
+    let c = centroid(&pts);
+    let n = cross(sub(pts[1], pts[0]), sub(pts[2], pts[0]));
+    if dot(n, c) > 0.0 {
+        pts.reverse();
+    }
+    pts
+}
+
+/// Cuts a triangle into n^2 equal triangles on a barycentric grid (same winding).
+fn split_triangle(b: &mut SceneBuilder, t: [[f64; 3]; 3], n: usize, m: u32, origin: &str) {
+    let point = |i: usize, j: usize| {
+        let (u, v) = (i as f64 / n as f64, j as f64 / n as f64);
+        [0, 1, 2].map(|a| t[0][a] + u * (t[1][a] - t[0][a]) + v * (t[2][a] - t[0][a]))
+    };
+    for i in 0..n {
+        for j in 0..n - i {
+            let (p, q, r) = (
+                b.vertex(point(i, j)),
+                b.vertex(point(i + 1, j)),
+                b.vertex(point(i, j + 1)),
+            );
+            b.polygon(&[p, q, r], m, format!("{origin} cell ({i}, {j})"));
+            if i + j + 1 < n {
+                let s = b.vertex(point(i + 1, j + 1));
+                b.polygon(&[q, s, r], m, format!("{origin} cell ({i}, {j})'"));
+            }
+        }
+    }
+}
+
+/// `@sphere:L`: icosphere enclosure, inward normals, every triangle a patch.
+pub fn sphere(spec: &str, levels: usize) -> Result<Scene, SceneError> {
+    let ico = icosahedron();
+    let mut tris: Vec<[[f64; 3]; 3]> = ico
+        .faces
+        .iter()
+        .map(|f| {
+            let p = facing_inwards(f.iter().map(|&v| normalize(ico.vertices[v])).collect());
+            [p[0], p[1], p[2]]
+        })
+        .collect();
+    for _ in 0..levels {
+        tris = tris
+            .iter()
+            .flat_map(|&[a, b, c]| {
+                // (x + y) is symmetric, so neighbouring triangles get the bit-identical midpoint.
+                let mid =
+                    |x: [f64; 3], y: [f64; 3]| normalize([x[0] + y[0], x[1] + y[1], x[2] + y[2]]);
+                let (ab, bc, ca) = (mid(a, b), mid(b, c), mid(c, a));
+                [[a, ab, ca], [ab, b, bc], [ca, bc, c], [ab, bc, ca]]
+            })
+            .collect();
+    }
+    let mut b = SceneBuilder::new(spec);
+    let m = wall_material(&mut b);
+    for (k, t) in tris.iter().enumerate() {
+        let idx = t.map(|p| b.vertex(p));
+        b.polygon(&idx, m, format!("triangle {k}"));
+    }
+    b.build()
+}
+
+fn tetrahedron() -> Polyhedron {
+    let vertices = vec![
+        [1.0, 1.0, 1.0],
+        [1.0, -1.0, -1.0],
+        [-1.0, 1.0, -1.0],
+        [-1.0, -1.0, 1.0],
+    ];
+    Polyhedron {
+        faces: triangles_with_edge(&vertices, 8f64.sqrt()),
+        vertices,
+    }
+}
+
+fn octahedron() -> Polyhedron {
+    let mut vertices = Vec::new();
+    for a in 0..3 {
+        for s in [1.0, -1.0] {
+            let mut v = [0.0; 3];
+            v[a] = s;
+            vertices.push(v);
+        }
+    }
+    Polyhedron {
+        faces: triangles_with_edge(&vertices, 2f64.sqrt()),
+        vertices,
+    }
+}
+
+fn icosahedron() -> Polyhedron {
+    let phi = (1.0 + 5f64.sqrt()) / 2.0;
+    let mut vertices = Vec::new();
+    for s1 in [1.0, -1.0] {
+        for s2 in [phi, -phi] {
+            vertices.push([0.0, s1, s2]);
+            vertices.push([s1, s2, 0.0]);
+            vertices.push([s2, 0.0, s1]);
+        }
+    }
+    Polyhedron {
+        faces: triangles_with_edge(&vertices, 2.0),
+        vertices,
+    }
+}
+
+/// The dodecahedron as the dual of the icosahedron: a vertex per icosahedron face (its centroid), a
+/// pentagon per icosahedron vertex (the centroids of the five faces around it, in angular order).
+fn dodecahedron() -> Polyhedron {
+    let ico = icosahedron();
+    let vertices: Vec<[f64; 3]> = ico
+        .faces
+        .iter()
+        .map(|f| centroid(&f.iter().map(|&v| ico.vertices[v]).collect::<Vec<_>>()))
+        .collect();
+    let faces = (0..ico.vertices.len())
+        .map(|v| {
+            let axis = normalize(ico.vertices[v]);
+            let (e1, e2) = crate::sample::lines::orthonormal_basis(axis);
+            let mut around: Vec<usize> = (0..ico.faces.len())
+                .filter(|&f| ico.faces[f].contains(&v))
+                .collect();
+            around.sort_by(|&a, &b| {
+                let angle = |f: usize| dot(vertices[f], e2).atan2(dot(vertices[f], e1));
+                angle(a).total_cmp(&angle(b))
+            });
+            around
+        })
+        .collect();
+    Polyhedron { vertices, faces }
+}
+
+/// All vertex triples whose three sides have length `edge`: the faces of a deltahedron.
+fn triangles_with_edge(v: &[[f64; 3]], edge: f64) -> Vec<Vec<usize>> {
+    let is_edge = |a: usize, b: usize| (norm(sub(v[a], v[b])) - edge).abs() < 1e-9 * edge;
+    let mut faces = Vec::new();
+    for a in 0..v.len() {
+        for b in a + 1..v.len() {
+            for c in b + 1..v.len() {
+                if is_edge(a, b) && is_edge(b, c) && is_edge(a, c) {
+                    faces.push(vec![a, b, c]);
+                }
+            }
+        }
+    }
+    faces
+}
+
+fn centroid(pts: &[[f64; 3]]) -> [f64; 3] {
+    let n = pts.len() as f64;
+    [0, 1, 2].map(|a| pts.iter().map(|p| p[a]).sum::<f64>() / n)
+}
+
+fn normalize(p: [f64; 3]) -> [f64; 3] {
+    let l = norm(p);
+    p.map(|c| c / l)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn solids_have_the_right_face_counts_and_inward_normals() {
+        for (spec, faces) in [
+            ("@tetrahedron", 4),
+            ("@octahedron", 8),
+            ("@cube", 6),
+            ("@icosahedron", 20),
+            ("@dodecahedron", 12),
+            ("@sphere:0", 20),
+            ("@sphere:2", 320),
+            ("@tetrahedron:3", 36),
+            ("@dodecahedron:2", 240),
+        ] {
+            let s = build(spec).unwrap();
+            assert_eq!(s.patch_count(), faces, "{spec}");
+            for p in &s.patches {
+                // Inward: the plane offset n . x is negative for a face around the origin.
+                assert!(p.offset < 0.0, "{spec}: a patch faces outwards");
+            }
+        }
+    }
+
+    #[test]
+    fn bad_names_and_parameters_are_clear_errors() {
+        for bad in ["@cub", "@cube:0", "@cube:x", "@sphere:9", "@tetrahedron:-1"] {
+            let e = build(bad).unwrap_err().to_string();
+            assert!(e.starts_with(bad), "{e}");
+        }
+    }
 }

@@ -5,8 +5,8 @@
 //! positions for the tracers, and f64 patch planes, normals and areas for the measures, computed from the
 //! original f64 coordinates.
 
-pub mod builtin;
 mod build;
+pub mod builtin;
 pub mod obj;
 
 pub use build::SceneBuilder;
@@ -51,6 +51,8 @@ pub struct Patch {
     pub first_triangle: u32,
     /// How many triangles the patch has.
     pub triangle_count: u32,
+    /// The polygon's vertices (indices into [`Scene::vertices`]), in order, front side counter-clockwise.
+    pub polygon: Vec<u32>,
 }
 
 /// How tracing space relates to the scene's own units: `original = center + scale * traced`.
@@ -69,6 +71,8 @@ pub struct Scene {
     pub name: String,
     /// Vertex positions in tracing space (f32, for the tracers).
     pub positions: Vec<[f32; 3]>,
+    /// The same vertices in the scene's own units (f64, as loaded).
+    pub vertices: Vec<[f64; 3]>,
     /// Triangles as vertex indices, ordered so that each patch's triangles are contiguous.
     pub triangles: Vec<[u32; 3]>,
     /// The patch of each triangle.
@@ -79,6 +83,8 @@ pub struct Scene {
     pub materials: Vec<Material>,
     /// Mapping back to the scene's own units.
     pub normalization: Normalization,
+    /// Total area in the scene's own units, from the original f64 coordinates.
+    pub area_scene_units: f64,
     /// Non-fatal problems found while loading (missing MTL, dropped degenerate triangles, ...).
     pub warnings: Vec<String>,
 }
@@ -94,9 +100,9 @@ impl Scene {
         self.patches.iter().map(|p| p.area).sum()
     }
 
-    /// Total area in the scene's own units.
+    /// Total area in the scene's own units (computed from the original coordinates).
     pub fn total_area_scene_units(&self) -> f64 {
-        self.total_area() * self.normalization.scale * self.normalization.scale
+        self.area_scene_units
     }
 
     /// Radius of the bounding sphere in tracing space (1 by construction).

@@ -62,7 +62,7 @@ pub fn load(path: &Path) -> Result<Scene, SceneError> {
         let ids: Vec<u32> = mesh
             .positions
             .chunks_exact(3)
-            .map(|p| b.vertex([p[0] as f64, p[1] as f64, p[2] as f64]))
+            .map(|p| b.vertex([p[0], p[1], p[2]]))
             .collect();
         let material = match (material_base, mesh.material_id) {
             (Some(base), Some(id)) => base + id as u32,
@@ -107,7 +107,7 @@ pub fn load(path: &Path) -> Result<Scene, SceneError> {
 }
 
 fn convert_material(m: &tobj::Material) -> Material {
-    let mean = |c: [f32; 3]| (c[0] as f64 + c[1] as f64 + c[2] as f64) / 3.0;
+    let mean = |c: [f64; 3]| (c[0] + c[1] + c[2]) / 3.0;
     let emission = m
         .unknown_param
         .get("Ke")
@@ -117,12 +117,18 @@ fn convert_material(m: &tobj::Material) -> Material {
     Material {
         name: m.name.clone(),
         emission,
-        reflectance: m.diffuse.map(mean).unwrap_or(Material::default().reflectance),
+        reflectance: m
+            .diffuse
+            .map(mean)
+            .unwrap_or(Material::default().reflectance),
     }
 }
 
-fn parse_rgb(s: &str) -> Option<[f32; 3]> {
-    let v: Vec<f32> = s.split_whitespace().filter_map(|x| x.parse().ok()).collect();
+fn parse_rgb(s: &str) -> Option<[f64; 3]> {
+    let v: Vec<f64> = s
+        .split_whitespace()
+        .filter_map(|x| x.parse().ok())
+        .collect();
     match v.as_slice() {
         [r, g, b] => Some([*r, *g, *b]),
         [g] => Some([*g, *g, *g]),
@@ -143,7 +149,9 @@ fn describe_tobj_error(e: &tobj::LoadError) -> String {
         MaterialParseError => "malformed material".into(),
         InvalidObjectName => "invalid object name".into(),
         FaceVertexOutOfBounds => "a face refers to a vertex that does not exist".into(),
-        FaceTexCoordOutOfBounds => "a face refers to a texture coordinate that does not exist".into(),
+        FaceTexCoordOutOfBounds => {
+            "a face refers to a texture coordinate that does not exist".into()
+        }
         FaceNormalOutOfBounds => "a face refers to a normal that does not exist".into(),
         FaceColorOutOfBounds => "a face refers to a colour that does not exist".into(),
         InvalidLoadOptionConfig => "invalid load options".into(),
@@ -152,4 +160,67 @@ fn describe_tobj_error(e: &tobj::LoadError) -> String {
         InvalidPolygon => "invalid polygon".into(),
         GenericFailure => "malformed OBJ".into(),
     }
+}
+
+/// Writes a scene as OBJ (scene units, one polygon face per patch) plus an MTL library beside it
+/// (`Kd` = reflectance, `Ke` = emission, grey), so that [`load`] reads back the same patches and materials.
+pub fn write(scene: &Scene, path: &Path) -> Result<(), SceneError> {
+    use std::fmt::Write as _;
+    let io_error = |p: &Path, e: std::io::Error| SceneError::File {
+        path: p.display().to_string(),
+        message: format!("cannot write: {e}"),
+    };
+    let mtl_path = path.with_extension("mtl");
+    let mtl_name = mtl_path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "scene.mtl".into());
+
+    let mut mtl = String::from("# written by scx\n");
+    for (k, m) in scene.materials.iter().enumerate() {
+        let (r, e) = (m.reflectance, m.emission);
+        let _ = writeln!(
+            mtl,
+            "newmtl {}\nKd {r} {r} {r}\nKe {e} {e} {e}\n",
+            material_label(k, m)
+        );
+    }
+    let mut obj = format!(
+        "# {} written by scx {}: {} patches\nmtllib {mtl_name}\n",
+        scene.name,
+        env!("CARGO_PKG_VERSION"),
+        scene.patch_count()
+    );
+    for v in &scene.vertices {
+        let _ = writeln!(obj, "v {:?} {:?} {:?}", v[0], v[1], v[2]);
+    }
+    let mut current = None;
+    for p in &scene.patches {
+        if current != Some(p.material) {
+            let k = p.material as usize;
+            let _ = writeln!(obj, "usemtl {}", material_label(k, &scene.materials[k]));
+            current = Some(p.material);
+        }
+        let idx: Vec<String> = p.polygon.iter().map(|v| (v + 1).to_string()).collect();
+        let _ = writeln!(obj, "f {}", idx.join(" "));
+    }
+    std::fs::write(&mtl_path, mtl).map_err(|e| io_error(&mtl_path, e))?;
+    std::fs::write(path, obj).map_err(|e| io_error(path, e))?;
+    Ok(())
+}
+
+/// A material name safe for MTL (no spaces), unique by index.
+fn material_label(k: usize, m: &Material) -> String {
+    let clean: String = m
+        .name
+        .chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '_' || c == '-' {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect();
+    format!("m{k}_{clean}")
 }

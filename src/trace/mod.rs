@@ -15,6 +15,7 @@
 #[cfg(feature = "embree")]
 pub mod embree;
 mod rules;
+pub mod rust;
 
 pub use rules::HitRules;
 
@@ -164,5 +165,51 @@ pub trait Tracer: Send + Sync {
         out.fill_from_raw(lines.len(), scratch);
         self.rules().canonicalize(lines, out);
         Ok(())
+    }
+}
+
+/// The tracing backends a user can choose.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Backend {
+    /// Embree (needs the `embree` feature).
+    Embree,
+    /// The pure-Rust tracer.
+    Rust,
+}
+
+impl Backend {
+    /// The backend used when none is named: Embree when built in, else the pure-Rust tracer.
+    pub fn default_available() -> Self {
+        if cfg!(feature = "embree") {
+            Backend::Embree
+        } else {
+            Backend::Rust
+        }
+    }
+}
+
+/// Builds the tracer for `scene` with the chosen backend and query kind.
+pub fn make_tracer(
+    backend: Backend,
+    scene: &crate::scene::Scene,
+    query: Query,
+) -> Result<Box<dyn Tracer>, TraceError> {
+    match backend {
+        #[cfg(feature = "embree")]
+        Backend::Embree => Ok(Box::new(embree::EmbreeTracer::new(scene, query)?)),
+        #[cfg(not(feature = "embree"))]
+        Backend::Embree => {
+            let _ = query;
+            Err(TraceError::Unsupported(
+                "this scx was built without Embree (cargo feature `embree`); use --tracer rust"
+                    .into(),
+            ))
+        }
+        Backend::Rust => match query {
+            Query::Single => Ok(Box::new(rust::BruteForceTracer::new(scene))),
+            Query::Packet(_) => Err(TraceError::Unsupported(
+                "the pure-Rust tracer traces single lines only".into(),
+            )),
+        },
     }
 }

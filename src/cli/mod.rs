@@ -1,0 +1,233 @@
+//! Command-line arguments and dispatch. Knows the library's public API only (never a backend's types).
+
+mod report;
+
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand, ValueEnum};
+use scene_complexity::analysis::{analyze, AnalysisConfig, DEFAULT_GROUPS};
+use scene_complexity::sample::tally::Wanted;
+use scene_complexity::scene::{self, builtin};
+use scene_complexity::trace::{make_tracer, Backend, Query};
+
+/// scx: how hard is a 3D scene to light and to mesh? Information-theoretic scene complexity
+/// (Feixas, del Acebo, Bekaert, Sbert, Eurographics 1999) from global lines.
+#[derive(Parser, Debug)]
+#[command(name = "scx", version, about, long_about = None)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// Cast global lines through a scene and report its complexity measures.
+    Analyze(AnalyzeArgs),
+    /// List the built-in scenes and their parameters.
+    Scenes,
+    /// Write a scene (built-in or file) as OBJ + MTL.
+    Export(ExportArgs),
+}
+
+#[derive(clap::Args, Debug)]
+struct ExportArgs {
+    /// An OBJ file, or a built-in scene such as `@cube:10`.
+    scene: String,
+    /// The OBJ file to write; the MTL library goes beside it.
+    #[arg(short, long)]
+    output: std::path::PathBuf,
+}
+
+#[derive(clap::Args, Debug)]
+struct AnalyzeArgs {
+    /// An OBJ file, or a built-in scene such as `@cube:10` (see `scx scenes`).
+    scene: String,
+    /// Number of global lines (accepts `1e7`).
+    #[arg(long, default_value = "1e6", value_parser = parse_count)]
+    lines: u64,
+    /// Seed of the random line streams.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Worker threads (default: all cores). Results do not depend on it.
+    #[arg(long)]
+    threads: Option<usize>,
+    /// Tracing backend.
+    #[arg(long, value_enum)]
+    tracer: Option<TracerArg>,
+    /// Ray query: `single`, or `packet4`/`packet8`/`packet16` (Embree, native widths only).
+    #[arg(long, default_value = "single", value_parser = parse_query)]
+    query: Query,
+    /// Which measures to compute (comma separated): discrete, continuous. Default: all.
+    #[arg(long, value_delimiter = ',', value_enum)]
+    measures: Option<Vec<MeasureArg>>,
+    /// Independent groups of lines behind each standard error.
+    #[arg(long, default_value_t = DEFAULT_GROUPS as u16, value_parser = clap::value_parser!(u16).range(2..=1024))]
+    groups: u16,
+    /// Output format.
+    #[arg(long, value_enum, default_value_t = Format::Table)]
+    format: Format,
+}
+
+#[derive(Clone, Copy, Debug, ValueEnum)]
+enum TracerArg {
+    Embree,
+    Rust,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+enum MeasureArg {
+    Discrete,
+    Continuous,
+}
+
+/// Output formats of `analyze`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum Format {
+    /// A readable table.
+    Table,
+    /// One JSON document.
+    Json,
+    /// `measure,value,stderr` rows.
+    Csv,
+}
+
+/// Parses a positive whole count written as `1000000`, `1e6` or `2.5e6`.
+fn parse_count(s: &str) -> Result<u64, String> {
+    let v: f64 = s
+        .trim()
+        .parse()
+        .map_err(|_| format!("`{s}` is not a number"))?;
+    if !(v.is_finite() && v >= 1.0 && v.fract() == 0.0 && v <= 1e15) {
+        return Err(format!("`{s}`: need a whole number from 1 to 1e15"));
+    }
+    Ok(v as u64)
+}
+
+fn parse_query(s: &str) -> Result<Query, String> {
+    match s {
+        "single" => Ok(Query::Single),
+        "packet4" => Ok(Query::Packet(4)),
+        "packet8" => Ok(Query::Packet(8)),
+        "packet16" => Ok(Query::Packet(16)),
+        _ => Err(format!(
+            "`{s}`: expected single, packet4, packet8 or packet16"
+        )),
+    }
+}
+
+/// Runs the command line; exit code 2 for bad input, 1 for failures while running.
+pub fn main() -> ExitCode {
+    let cli = Cli::parse();
+    match cli.command {
+        Command::Scenes => {
+            for b in builtin::BUILTINS {
+                println!("{:<18} {}", b.usage, b.description);
+            }
+            ExitCode::SUCCESS
+        }
+        Command::Analyze(args) => finish(try_analyze(&args)),
+        Command::Export(args) => finish(try_export(&args)),
+    }
+}
+
+fn finish(result: Result<(), Failure>) -> ExitCode {
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(f) => {
+            eprintln!("scx: error: {}", f.message);
+            ExitCode::from(f.code)
+        }
+    }
+}
+
+fn load_scene(spec: &str) -> Result<scene::Scene, Failure> {
+    let scene = scene::load(spec).map_err(bad_input)?;
+    for w in &scene.warnings {
+        eprintln!("scx: warning: {w}");
+    }
+    Ok(scene)
+}
+
+fn try_export(args: &ExportArgs) -> Result<(), Failure> {
+    let scene = load_scene(&args.scene)?;
+    scene::obj::write(&scene, &args.output).map_err(|e| Failure {
+        code: 1,
+        message: e.to_string(),
+    })?;
+    eprintln!(
+        "scx: wrote {} ({} patches) and its MTL library",
+        args.output.display(),
+        scene.patch_count()
+    );
+    Ok(())
+}
+
+/// A failure with its exit code.
+struct Failure {
+    code: u8,
+    message: String,
+}
+
+fn bad_input(message: impl ToString) -> Failure {
+    Failure {
+        code: 2,
+        message: message.to_string(),
+    }
+}
+
+fn try_analyze(args: &AnalyzeArgs) -> Result<(), Failure> {
+    let scene = load_scene(&args.scene)?;
+    let backend = match args.tracer {
+        Some(TracerArg::Embree) => Backend::Embree,
+        Some(TracerArg::Rust) => Backend::Rust,
+        None => Backend::default_available(),
+    };
+    let tracer = make_tracer(backend, &scene, args.query).map_err(bad_input)?;
+    let wanted = match &args.measures {
+        None => Wanted {
+            discrete: true,
+            continuous: true,
+        },
+        Some(m) => Wanted {
+            discrete: m.contains(&MeasureArg::Discrete),
+            continuous: m.contains(&MeasureArg::Continuous),
+        },
+    };
+    let threads = args.threads.unwrap_or_else(|| {
+        std::thread::available_parallelism()
+            .map(|n| n.get())
+            .unwrap_or(1)
+    });
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .map_err(|e| bad_input(format!("cannot start {threads} threads: {e}")))?;
+    let cfg = AnalysisConfig {
+        lines: args.lines,
+        seed: args.seed,
+        wanted,
+        groups: usize::from(args.groups),
+    };
+    let analysis = pool
+        .install(|| analyze(&scene, tracer.as_ref(), &cfg))
+        .map_err(|e| Failure {
+            code: 1,
+            message: e.to_string(),
+        })?;
+    let run = report::RunInfo {
+        scene: &scene,
+        tracer: tracer.name(),
+        query: args.query,
+        threads,
+    };
+    for w in report::warnings(&scene, &analysis) {
+        eprintln!("scx: warning: {w}");
+    }
+    let text = match args.format {
+        Format::Table => report::table(&run, &analysis),
+        Format::Json => report::json(&run, &analysis),
+        Format::Csv => report::csv(&run, &analysis),
+    };
+    print!("{text}");
+    Ok(())
+}

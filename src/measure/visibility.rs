@@ -1,0 +1,163 @@
+//! Scene visibility complexity (paper sec. 3): entropies and mutual information of the form-factor channel.
+//!
+//! The channel's input and output are patches, with the area distribution `a_i = A_i / A_T` and the
+//! form factors as transition matrix. Form factors are estimated from global-line pair counts as
+//! `F_ij = N_ij / N_i`, where `N_i` counts the segments leaving patch i's front side (to another patch, or
+//! escaping an open scene), so a row sums to 1 in a closed scene and reciprocity `A_i F_ij = A_j F_ji`
+//! holds up to sampling error.
+
+use ndarray::Array1;
+
+use super::entropy::xlog2x;
+use crate::sample::counts::PairCounts;
+
+/// The discrete measures of one set of counts (paper sec. 3.1).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DiscreteValues {
+    /// Eq. (19): H_p = -sum a_i log a_i, exact from the areas.
+    pub positional_entropy: f64,
+    /// Eq. (17): H_s = -sum_i a_i sum_j F_ij log F_ij.
+    pub entropy: f64,
+    /// H(X, Y) = -sum_ij a_i F_ij log(a_i F_ij) (= H_p + H_s in a closed scene).
+    pub joint_entropy: f64,
+    /// Eq. (21): I_s = sum_ij a_i F_ij log(F_ij / a_j) (= H_p - H_s, eq. (20), in a closed scene).
+    pub mutual_information: f64,
+    /// Eq. (22) times N: n_p - sum_ij F_ij^2, the expected form-factor MSE of a single line.
+    pub mse_per_line: f64,
+    /// Patches no line left from (their rows are empty and contribute nothing).
+    pub unsampled_patches: usize,
+    /// Their share of the total area.
+    pub unsampled_area_fraction: f64,
+}
+
+/// The continuous measure of one set of pairs (paper sec. 3.2).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ContinuousValues {
+    /// Eq. (27): I_s^c, the mean over pairs of log2(A_T cos_x cos_y / (pi d^2)).
+    pub mutual_information: f64,
+}
+
+impl ContinuousValues {
+    /// Eq. (27) from the sum of its terms over `pairs` pairs; `None` without pairs.
+    pub fn from_sum(sum: f64, pairs: u64) -> Option<Self> {
+        (pairs > 0).then(|| ContinuousValues {
+            mutual_information: sum / pairs as f64,
+        })
+    }
+}
+
+/// Area distribution `a_i = A_i / A_T`.
+pub fn area_distribution(areas: &[f64]) -> Array1<f64> {
+    let a = Array1::from(areas.to_vec());
+    let total = a.sum();
+    a / total
+}
+
+/// `N_i`: segments leaving each patch's front side (pair counts in both directions plus escapes).
+pub fn row_totals(patches: usize, counts: &PairCounts, escapes: &[u64]) -> Array1<f64> {
+    let mut n = Array1::<f64>::zeros(patches);
+    counts.for_each(|i, j, c| {
+        n[i as usize] += c as f64;
+        n[j as usize] += c as f64;
+    });
+    for (t, &e) in n.iter_mut().zip(escapes) {
+        *t += e as f64;
+    }
+    n
+}
+
+/// Visits every estimated form factor `(i, j, F_ij)` with `F_ij > 0` (both directions of each pair).
+pub fn for_each_form_factor(
+    counts: &PairCounts,
+    row_totals: &Array1<f64>,
+    mut f: impl FnMut(usize, usize, f64),
+) {
+    counts.for_each(|i, j, c| {
+        let (i, j) = (i as usize, j as usize);
+        let c = c as f64;
+        if i == j {
+            // One segment from a patch back to itself enters N_ii twice (i -> j and j -> i).
+            f(i, i, 2.0 * c / row_totals[i]);
+        } else {
+            f(i, j, c / row_totals[i]);
+            f(j, i, c / row_totals[j]);
+        }
+    });
+}
+
+/// The discrete measures from the patch areas, the pair counts and the escapes per patch.
+pub fn discrete(areas: &[f64], counts: &PairCounts, escapes: &[u64]) -> DiscreteValues {
+    let a = area_distribution(areas);
+    let n = row_totals(areas.len(), counts, escapes);
+    let positional_entropy = -a.iter().map(|&x| xlog2x(x)).sum::<f64>();
+
+    let (mut entropy, mut joint, mut mi, mut sum_f2) = (0.0, 0.0, 0.0, 0.0);
+    for_each_form_factor(counts, &n, |i, j, f| {
+        entropy -= a[i] * xlog2x(f);
+        joint -= xlog2x(a[i] * f);
+        mi += a[i] * f * (f / a[j]).log2();
+        sum_f2 += f * f;
+    });
+
+    let unsampled: Vec<usize> = (0..areas.len()).filter(|&i| n[i] == 0.0).collect();
+    DiscreteValues {
+        positional_entropy,
+        entropy,
+        joint_entropy: joint,
+        mutual_information: mi,
+        mse_per_line: areas.len() as f64 - sum_f2,
+        unsampled_patches: unsampled.len(),
+        unsampled_area_fraction: unsampled.iter().fold(0.0, |acc, &i| acc + a[i]),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sample::counts::pair_key;
+
+    /// Two facing patches of equal area that only see each other: F_01 = F_10 = 1, so H_s = 0 and
+    /// I_s = H_p = 1 bit.
+    #[test]
+    fn two_patches_seeing_only_each_other() {
+        let counts = PairCounts::from_keys(2, &mut vec![pair_key(0, 1); 10]);
+        let v = discrete(&[1.0, 1.0], &counts, &[0, 0]);
+        assert!((v.positional_entropy - 1.0).abs() < 1e-15);
+        assert!(v.entropy.abs() < 1e-15);
+        assert!((v.mutual_information - 1.0).abs() < 1e-15);
+        assert!((v.joint_entropy - 1.0).abs() < 1e-15);
+        assert!((v.mse_per_line - 0.0).abs() < 1e-15);
+        assert_eq!(v.unsampled_patches, 0);
+    }
+
+    /// Independence: F_ij = a_j gives I_s = 0 and H_s = H_p (the sphere of sec. 3.1.2).
+    #[test]
+    fn independent_channel_has_zero_mutual_information() {
+        // Three equal patches with rows (1/3, 1/3, 1/3): a self pair enters N_ii twice and an
+        // off-diagonal pair once per direction, so off-diagonal pairs are drawn twice as often.
+        let mut keys = Vec::new();
+        for (i, j, c) in [
+            (0, 0, 1),
+            (1, 1, 1),
+            (2, 2, 1),
+            (0, 1, 2),
+            (0, 2, 2),
+            (1, 2, 2),
+        ] {
+            keys.extend(std::iter::repeat_n(pair_key(i, j), c));
+        }
+        let counts = PairCounts::from_keys(3, &mut keys);
+        let v = discrete(&[1.0, 1.0, 1.0], &counts, &[0, 0, 0]);
+        assert!(v.mutual_information.abs() < 1e-12, "{v:?}");
+        assert!((v.entropy - 3f64.log2()).abs() < 1e-12);
+    }
+
+    #[test]
+    fn unsampled_patches_are_reported_not_nan() {
+        let counts = PairCounts::from_keys(3, &mut vec![pair_key(0, 1)]);
+        let v = discrete(&[1.0, 1.0, 2.0], &counts, &[0, 0, 0]);
+        assert_eq!(v.unsampled_patches, 1);
+        assert!((v.unsampled_area_fraction - 0.5).abs() < 1e-15);
+        assert!(v.entropy.is_finite() && v.mutual_information.is_finite());
+    }
+}
