@@ -123,6 +123,8 @@ mod embree {
             .include(&embree.include)
             .define("SCX_EMBREE_MAJOR", embree.major.to_string().as_str())
             .flag_if_supported("-std=c11")
+            // The watertight test needs each product rounded on its own: no fused multiply-adds.
+            .flag_if_supported("-ffp-contract=off")
             .warnings(true)
             .extra_warnings(true)
             .compile("scx_embree");

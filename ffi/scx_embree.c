@@ -2,6 +2,7 @@
 
 #include "scx_embree.h"
 
+#include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -29,8 +30,16 @@ struct scx_device {
 
 struct scx_scene {
   RTCScene rtc;
-  uint32_t widths; /* copied from the device: checked on every query */
+  uint32_t widths;    /* copied from the device: checked on every query */
+  float* triangles;   /* the original triangles, 9 floats each, for the watertight test */
+  uint32_t n_triangles;
 };
+
+/* How far each triangle's edges are pushed out for Embree, relative to the scene's extent. Embree's
+ * robust test errs by a few ulps of the distances involved (~1e-7 for a unit scene seen from a few units
+ * away; measured: misses stop beyond ~1e-6): the margin must exceed that by far, and costs only
+ * candidates the watertight test then rejects (about margin x perimeter / area more of them). */
+#define SCX_MARGIN (1.0 / 65536.0)
 
 /* ---------------------------------------------------------------------------------------------------- */
 /* Errors. Embree calls the error callback on the thread whose API call failed, so a thread-local record
@@ -111,6 +120,7 @@ void scx_get_layout(scx_layout* out) {
   out->hits = sizeof(scx_hits);
   out->first_hit = sizeof(scx_first_hit);
   out->query = sizeof(scx_query);
+  out->sheared = sizeof(scx_sheared);
   out->layout = sizeof(scx_layout);
   out->version = RTC_VERSION;
 }
@@ -174,30 +184,80 @@ static int check_indices(const uint32_t* indices, uint32_t n_triangles, uint32_t
   return SCX_OK;
 }
 
-/* Copies the mesh into Embree-owned buffers and attaches it as geometry 0 (primID = triangle index). */
-static int attach_triangles(RTCDevice device, RTCScene scene, const float* positions, uint32_t n_vertices,
-                            const uint32_t* indices, uint32_t n_triangles) {
+/* The triangle pushed out by `margin` on every side: scaled about its incenter by 1 + margin / inradius,
+ * which moves each edge outwards by exactly `margin`. Degenerate triangles are left as they are (the
+ * watertight test never hits them). */
+static void inflate(const float* tri, double margin, float* out) {
+  double v[3][3], len[3], center[3] = {0.0, 0.0, 0.0};
+  for (int k = 0; k < 3; ++k)
+    for (int a = 0; a < 3; ++a) v[k][a] = tri[3 * k + a];
+  for (int k = 0; k < 3; ++k) {
+    /* len[k]: the side opposite vertex k */
+    const double* p = v[(k + 1) % 3];
+    const double* q = v[(k + 2) % 3];
+    len[k] = sqrt((p[0] - q[0]) * (p[0] - q[0]) + (p[1] - q[1]) * (p[1] - q[1]) + (p[2] - q[2]) * (p[2] - q[2]));
+  }
+  const double perimeter = len[0] + len[1] + len[2];
+  double e1[3], e2[3];
+  for (int a = 0; a < 3; ++a) {
+    e1[a] = v[1][a] - v[0][a];
+    e2[a] = v[2][a] - v[0][a];
+  }
+  const double cx = e1[1] * e2[2] - e1[2] * e2[1];
+  const double cy = e1[2] * e2[0] - e1[0] * e2[2];
+  const double cz = e1[0] * e2[1] - e1[1] * e2[0];
+  const double inradius = sqrt(cx * cx + cy * cy + cz * cz) / perimeter; /* 2 area / perimeter */
+  if (!(inradius > 0.0) || !isfinite(inradius)) {
+    memcpy(out, tri, 9 * sizeof(float));
+    return;
+  }
+  for (int k = 0; k < 3; ++k)
+    for (int a = 0; a < 3; ++a) center[a] += v[k][a] * len[k] / perimeter;
+  const double scale = 1.0 + margin / inradius;
+  for (int k = 0; k < 3; ++k)
+    for (int a = 0; a < 3; ++a) out[3 * k + a] = (float)(center[a] + (v[k][a] - center[a]) * scale);
+}
+
+/* Attaches the scene's triangles, inflated, as geometry 0 (primID = triangle index). Inflation is per
+ * triangle, so the vertex buffer holds three vertices per triangle. */
+static int attach_triangles(RTCDevice device, scx_scene* scene, double margin) {
+  const size_t n = scene->n_triangles;
   RTCGeometry geometry = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
   if (!geometry) return fail(RTC_ERROR_UNKNOWN, "rtcNewGeometry failed");
   /* Embree reads the last vertex with a 16-byte load, so the buffer needs 4 bytes past the last float3.
    * Some Embree 3 releases get the over-allocation of rtcSetNewGeometryBuffer wrong for a 12-byte stride,
    * so ask for one spare (zeroed, never indexed) vertex instead of relying on it. */
   float* vertices = rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
-                                            3 * sizeof(float), (size_t)n_vertices + 1);
-  uint32_t* triangles = rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
-                                                3 * sizeof(uint32_t), n_triangles);
-  if (!vertices || !triangles) {
+                                            3 * sizeof(float), 3 * n + 1);
+  uint32_t* indices = rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                              3 * sizeof(uint32_t), n);
+  if (!vertices || !indices) {
     rtcReleaseGeometry(geometry);
     return fail(RTC_ERROR_OUT_OF_MEMORY, "rtcSetNewGeometryBuffer failed");
   }
-  memcpy(vertices, positions, (size_t)n_vertices * 3 * sizeof(float));
-  memset(vertices + (size_t)n_vertices * 3, 0, 3 * sizeof(float));
-  memcpy(triangles, indices, (size_t)n_triangles * 3 * sizeof(uint32_t));
+  for (size_t i = 0; i < n; ++i) {
+    inflate(scene->triangles + 9 * i, margin, vertices + 9 * i);
+    for (uint32_t k = 0; k < 3; ++k) indices[3 * i + k] = (uint32_t)(3 * i + k);
+  }
+  memset(vertices + 9 * n, 0, 3 * sizeof(float));
   rtcCommitGeometry(geometry);
-  rtcAttachGeometry(scene, geometry);
+  rtcAttachGeometry(scene->rtc, geometry);
   /* The scene holds its own reference now. */
   rtcReleaseGeometry(geometry);
   return last_code;
+}
+
+/* Copies the triangles' corners out of the indexed mesh; returns the largest coordinate magnitude. */
+static double gather_triangles(float* out, const float* positions, const uint32_t* indices, uint32_t n) {
+  double extent = 0.0;
+  for (size_t i = 0; i < (size_t)n * 3; ++i) {
+    for (int a = 0; a < 3; ++a) {
+      const float c = positions[3 * (size_t)indices[i] + a];
+      out[3 * i + a] = c;
+      if (fabs(c) > extent) extent = fabs(c);
+    }
+  }
+  return extent;
 }
 
 int scx_scene_new(scx_device* device, const float* positions, uint32_t n_vertices, const uint32_t* indices,
@@ -210,9 +270,17 @@ int scx_scene_new(scx_device* device, const float* positions, uint32_t n_vertice
   if (n_vertices == UINT32_MAX) return fail(SCX_ERR_INVALID, "scx_scene_new: too many vertices");
   if (check_indices(indices, n_triangles, n_vertices) != SCX_OK) return last_code;
 
+  if (n_triangles > UINT32_MAX / 3) return fail(SCX_ERR_INVALID, "scx_scene_new: too many triangles");
   scx_scene* scene = calloc(1, sizeof *scene);
   if (!scene) return fail(RTC_ERROR_OUT_OF_MEMORY, "scx_scene_new: out of memory");
   scene->widths = device->widths;
+  scene->n_triangles = n_triangles;
+  scene->triangles = malloc(((size_t)n_triangles * 9 + 1) * sizeof(float));
+  if (!scene->triangles) {
+    free(scene);
+    return fail(RTC_ERROR_OUT_OF_MEMORY, "scx_scene_new: out of memory");
+  }
+  const double extent = gather_triangles(scene->triangles, positions, indices, n_triangles);
   scene->rtc = rtcNewScene(device->rtc);
   if (!scene->rtc) {
     free(scene);
@@ -221,7 +289,7 @@ int scx_scene_new(scx_device* device, const float* positions, uint32_t n_vertice
   rtcSetSceneFlags(scene->rtc, (enum RTCSceneFlags)SCX_SCENE_FLAGS);
   /* An empty scene is valid: it has no geometry and every query misses. */
   if (n_triangles > 0) {
-    attach_triangles(device->rtc, scene->rtc, positions, n_vertices, indices, n_triangles);
+    attach_triangles(device->rtc, scene, SCX_MARGIN * (extent > 0.0 ? extent : 1.0));
   }
   if (last_code == SCX_OK) rtcCommitScene(scene->rtc);
   if (last_code != SCX_OK) {
@@ -235,6 +303,7 @@ int scx_scene_new(scx_device* device, const float* positions, uint32_t n_vertice
 void scx_scene_release(scx_scene* scene) {
   if (!scene) return;
   if (scene->rtc) rtcReleaseScene(scene->rtc);
+  free(scene->triangles);
   free(scene);
 }
 
@@ -270,49 +339,136 @@ void scx_hits_free(scx_hits* hits) {
 }
 
 /* ---------------------------------------------------------------------------------------------------- */
-/* The all-hits filter: record the candidate and reject it, so that one traversal visits every hit. */
+/* The watertight ray/triangle test of Woop, Benthin and Wald (JCGT 2(1), 2013), with the same operations
+ * in the same order as the pure-Rust tracer (src/trace/rust/watertight.rs), so both give bit-identical
+ * hits. Needs IEEE single precision without FMA contraction (the build passes -ffp-contract=off): the
+ * edge functions of a shared edge must come out exactly opposite in its two triangles. */
 
+static void shear_line(scx_sheared* r, const scx_line* line) {
+  const float* d = line->dir;
+  const float ax = fabsf(d[0]), ay = fabsf(d[1]), az = fabsf(d[2]);
+  int kz = ax > ay ? (ax > az ? 0 : 2) : (ay > az ? 1 : 2);
+  int kx = (kz + 1) % 3;
+  int ky = (kx + 1) % 3;
+  /* Keep the winding: swap when the dominant component is negative. */
+  if (d[kz] < 0.0f) {
+    const int swap = kx;
+    kx = ky;
+    ky = swap;
+  }
+  memcpy(r->org, line->org, sizeof r->org);
+  r->kx = kx;
+  r->ky = ky;
+  r->kz = kz;
+  r->sx = d[kx] / d[kz];
+  r->sy = d[ky] / d[kz];
+  r->sz = 1.0f / d[kz];
+}
+
+/* Whether the line hits triangle tri (9 floats) at t in [t_min, t_max]; t in *t_out. */
+static int watertight_hit(const scx_sheared* r, const float* tri, float t_min, float t_max, float* t_out) {
+  float rel[3][3], sx[3], sy[3];
+  for (int k = 0; k < 3; ++k) {
+    for (int a = 0; a < 3; ++a) rel[k][a] = tri[3 * k + a] - r->org[a];
+    sx[k] = rel[k][r->kx] - r->sx * rel[k][r->kz];
+    sy[k] = rel[k][r->ky] - r->sy * rel[k][r->kz];
+  }
+  const float ax = sx[0], ay = sy[0], bx = sx[1], by = sy[1], cx = sx[2], cy = sy[2];
+  float u = cx * by - cy * bx;
+  float v = ax * cy - ay * cx;
+  float w = bx * ay - by * ax;
+  /* On an edge in f32: decide it exactly (enough) in f64 so both neighbours agree. */
+  if (u == 0.0f || v == 0.0f || w == 0.0f) {
+    u = (float)((double)cx * (double)by - (double)cy * (double)bx);
+    v = (float)((double)ax * (double)cy - (double)ay * (double)cx);
+    w = (float)((double)bx * (double)ay - (double)by * (double)ax);
+  }
+  if ((u < 0.0f || v < 0.0f || w < 0.0f) && (u > 0.0f || v > 0.0f || w > 0.0f)) return 0;
+  const float det = u + v + w;
+  if (det == 0.0f) return 0;
+  const float az = r->sz * rel[0][r->kz];
+  const float bz = r->sz * rel[1][r->kz];
+  const float cz = r->sz * rel[2][r->kz];
+  const float t = (u * az + v * bz + w * cz) / det;
+  if (!(t >= t_min && t <= t_max)) return 0;
+  *t_out = t;
+  return 1;
+}
+
+/* The candidate in lane i, decided by the watertight test: 1 and *t for a hit. Candidates of foreign rays
+ * or primitives are flagged (never expected). */
+static int decide(scx_query* q, const struct RTCFilterFunctionNArguments* args, unsigned int i,
+                  uint32_t* line, uint32_t* prim, float* t) {
+  const unsigned int n = args->N;
+  /* Lanes are found by ray id, never by position: Embree may repack rays. */
+  *line = ((const unsigned int*)args->ray)[10 * n + i];
+  *prim = ((const unsigned int*)args->hit)[5 * n + i];
+  if (*line >= q->n_lines || *prim >= q->n_triangles) {
+    q->bad_ray_id = 1;
+    return 0;
+  }
+  return watertight_hit(&q->sheared[*line], q->triangles + 9 * (size_t)*prim, 0.0f, q->lines[*line].t_max, t);
+}
+
+/* All hits: record the candidate if it is a hit, and reject it either way, so that one traversal visits
+ * every candidate. */
 static void collect_hits(const struct RTCFilterFunctionNArguments* args) {
   /* args->context points at q->rtc, the first member of q. */
   scx_query* q = (scx_query*)args->context;
-  const unsigned int n = args->N;
-  const float* ray = (const float*)args->ray;
-  const unsigned int* ray_u = (const unsigned int*)args->ray;
-  const unsigned int* hit_u = (const unsigned int*)args->hit;
-  for (unsigned int i = 0; i < n; ++i) {
+  for (unsigned int i = 0; i < args->N; ++i) {
     if (args->valid[i] != -1) continue;
-    /* Lanes are found by ray id, never by position: Embree may repack rays. */
-    unsigned int line = ray_u[10 * n + i];
-    if (line < q->n_lines) {
-      /* During the callback the candidate's distance sits in the ray's tfar slot. */
-      hits_push(q->hits, ray[8 * n + i], hit_u[5 * n + i], line);
-    } else {
-      q->bad_ray_id = 1;
-    }
+    uint32_t line, prim;
+    float t;
+    if (decide(q, args, i, &line, &prim, &t)) hits_push(q->hits, t, prim, line);
     args->valid[i] = 0;
+  }
+}
+
+/* First hit: accept true hits (so Embree narrows the search to nearer ones) and keep the nearest by the
+ * watertight t, ties to the lower triangle index; reject false candidates of the inflated triangles. */
+static void nearest_hit(const struct RTCFilterFunctionNArguments* args) {
+  scx_query* q = (scx_query*)args->context;
+  for (unsigned int i = 0; i < args->N; ++i) {
+    if (args->valid[i] != -1) continue;
+    uint32_t line, prim;
+    float t;
+    if (!decide(q, args, i, &line, &prim, &t)) {
+      args->valid[i] = 0;
+      continue;
+    }
+    scx_first_hit* best = &q->first[line];
+    if (best->prim == SCX_NO_LINE || t < best->t || (t == best->t && prim < best->prim)) {
+      best->t = t;
+      best->prim = prim;
+    }
   }
 }
 
 /* ---------------------------------------------------------------------------------------------------- */
 /* Queries, with the v3/v4 differences kept in these few functions. */
 
-static void query_init(scx_query* q, scx_hits* hits, uint32_t n_lines) {
+/* Prepares a query over a batch: all hits into `hits`, or first hits into `first`. */
+static void query_init(scx_query* q, const scx_scene* scene, const scx_line* lines, const scx_sheared* sheared,
+                       uint32_t n_lines, scx_hits* hits, scx_first_hit* first) {
   memset(q, 0, sizeof *q);
-  RTCFilterFunctionN filter = hits ? collect_hits : NULL;
+  RTCFilterFunctionN filter = hits ? collect_hits : nearest_hit;
 #if SCX_EMBREE_V4
   rtcInitRayQueryContext(&q->rtc);
   rtcInitIntersectArguments(&q->args);
   q->args.context = &q->rtc;
-  if (filter) {
-    q->args.filter = filter;
-    q->args.flags = (enum RTCRayQueryFlags)(q->args.flags | RTC_RAY_QUERY_FLAG_INVOKE_ARGUMENT_FILTER);
-  }
+  q->args.filter = filter;
+  q->args.flags = (enum RTCRayQueryFlags)(q->args.flags | RTC_RAY_QUERY_FLAG_INVOKE_ARGUMENT_FILTER);
 #else
   rtcInitIntersectContext(&q->rtc);
   q->rtc.filter = filter;
 #endif
-  q->hits = hits;
+  q->triangles = scene->triangles;
+  q->n_triangles = scene->n_triangles;
+  q->lines = lines;
+  q->sheared = sheared;
   q->n_lines = n_lines;
+  q->hits = hits;
+  q->first = first;
 }
 
 static void intersect1(RTCScene scene, scx_query* q, struct RTCRayHit* rayhit) {
@@ -393,38 +549,22 @@ static void packet_fill(scx_packet* p, int* valid, uint32_t n, const scx_line* l
   }
 }
 
-static void store_first(scx_first_hit* out, float tfar, uint32_t geom, uint32_t prim) {
-  const int hit = geom != RTC_INVALID_GEOMETRY_ID;
-  out->t = hit ? tfar : 0.0f;
-  out->prim = hit ? prim : SCX_NO_LINE;
-}
-
-static void packet_store_first(const scx_packet* p, uint32_t n, uint32_t count, scx_first_hit* out) {
-  const float* ray = (const float*)p;
-  const unsigned int* hit_u = (const unsigned int*)p + SCX_RAY_FIELDS * n;
-  for (uint32_t i = 0; i < count; ++i) {
-    store_first(&out[i], ray[8 * n + i], hit_u[6 * n + i], hit_u[5 * n + i]);
-  }
-}
-
-static void trace_single(RTCScene scene, scx_query* q, const scx_line* lines, uint32_t n, scx_first_hit* first) {
+/* Results arrive through the filter (in q), not in the ray structs. */
+static void trace_single(RTCScene scene, scx_query* q, const scx_line* lines, uint32_t n) {
   for (uint32_t k = 0; k < n; ++k) {
     struct RTCRayHit rh;
     ray_init(&rh, &lines[k], k);
     intersect1(scene, q, &rh);
-    if (first) store_first(&first[k], rh.ray.tfar, rh.hit.geomID, rh.hit.primID);
   }
 }
 
-static void trace_packets(RTCScene scene, scx_query* q, const scx_line* lines, uint32_t n, uint32_t width,
-                          scx_first_hit* first) {
+static void trace_packets(RTCScene scene, scx_query* q, const scx_line* lines, uint32_t n, uint32_t width) {
   scx_packet packet; /* the union carries the 16/32/64-byte alignment of Embree's packet types */
   SCX_ALIGN(64) int valid[16];
   for (uint64_t base = 0; base < n; base += width) {
     const uint32_t count = (uint32_t)(n - base < width ? n - base : width);
     packet_fill(&packet, valid, width, lines + base, (uint32_t)base, count);
     intersect_packet(scene, q, valid, &packet, width);
-    if (first) packet_store_first(&packet, width, count, first + base);
   }
 }
 
@@ -439,13 +579,22 @@ static int check_query(const scx_scene* scene, const scx_line* lines, uint32_t n
   return SCX_OK;
 }
 
-static void trace(const scx_scene* scene, scx_query* q, const scx_line* lines, uint32_t n, uint32_t width,
-                  scx_first_hit* first) {
+/* Prepares the batch for the watertight test and traces it; the filter delivers the results into q. */
+static int trace(const scx_scene* scene, const scx_line* lines, uint32_t n, uint32_t width, scx_hits* hits,
+                 scx_first_hit* first) {
+  scx_sheared* sheared = malloc((n > 0 ? n : 1) * sizeof(scx_sheared));
+  if (!sheared) return fail(RTC_ERROR_OUT_OF_MEMORY, "out of memory preparing %u lines", n);
+  for (uint32_t k = 0; k < n; ++k) shear_line(&sheared[k], &lines[k]);
+  scx_query q;
+  query_init(&q, scene, lines, sheared, n, hits, first);
   if (width == 1) {
-    trace_single(scene->rtc, q, lines, n, first);
+    trace_single(scene->rtc, &q, lines, n);
   } else {
-    trace_packets(scene->rtc, q, lines, n, width, first);
+    trace_packets(scene->rtc, &q, lines, n, width);
   }
+  free(sheared);
+  if (q.bad_ray_id) return fail(SCX_ERR_RAY_ID, "Embree reported a hit for a ray or primitive outside the batch");
+  return last_code;
 }
 
 int scx_all_hits(const scx_scene* scene, const scx_line* lines, uint32_t n, uint32_t width, scx_hits* out) {
@@ -454,10 +603,7 @@ int scx_all_hits(const scx_scene* scene, const scx_line* lines, uint32_t n, uint
   if (check_query(scene, lines, n, width) != SCX_OK) return last_code;
   /* Most lines of a closed scene cross it a few times: start with room for two hits a line. */
   if (!hits_reserve(out, out->len + (size_t)n * 2 + 16)) out->overflow = 1;
-  scx_query q;
-  query_init(&q, out, n);
-  if (!out->overflow) trace(scene, &q, lines, n, width, NULL);
-  if (q.bad_ray_id) return fail(SCX_ERR_RAY_ID, "Embree reported a hit for a ray id outside the batch");
+  if (!out->overflow) trace(scene, lines, n, width, out, NULL);
   if (out->overflow) return fail(SCX_ERR_HIT_BUFFER, "out of memory growing the hit buffer (%zu hits)", out->len);
   return last_code;
 }
@@ -467,8 +613,9 @@ int scx_first_hits(const scx_scene* scene, const scx_line* lines, uint32_t n, ui
   clear_error();
   if (n > 0 && !out) return fail(SCX_ERR_INVALID, "null output array");
   if (check_query(scene, lines, n, width) != SCX_OK) return last_code;
-  scx_query q;
-  query_init(&q, NULL, n);
-  trace(scene, &q, lines, n, width, out);
-  return last_code;
+  for (uint32_t k = 0; k < n; ++k) {
+    out[k].t = 0.0f;
+    out[k].prim = SCX_NO_LINE;
+  }
+  return trace(scene, lines, n, width, NULL, out);
 }

@@ -87,6 +87,14 @@ typedef struct scx_first_hit {
   uint32_t prim;
 } scx_first_hit;
 
+/* A line prepared for the watertight triangle test (Woop, Benthin, Wald, JCGT 2013): the axis permutation
+ * and shear that map its direction onto +z. Internal; in the header for the size check. */
+typedef struct scx_sheared {
+  float org[3];
+  int kx, ky, kz;
+  float sx, sy, sz;
+} scx_sheared;
+
 /* The per-query state. The Embree context must be the first member: Embree passes a pointer to it to the
  * filter callback, which casts it back to the whole struct. Internal; in the header only so the bindings'
  * size can be checked. */
@@ -95,9 +103,14 @@ typedef struct scx_query {
 #if SCX_EMBREE_V4
   struct RTCIntersectArguments args;
 #endif
-  scx_hits* hits;    /* where the filter appends hits (NULL for first-hit queries) */
-  uint32_t n_lines;  /* ray ids at or above this are not lines of the batch */
-  int bad_ray_id;    /* set by the filter on a foreign ray id */
+  const float* triangles;    /* the scene's original triangles, 9 floats each */
+  uint32_t n_triangles;
+  const scx_line* lines;     /* the batch, indexed by ray id */
+  const scx_sheared* sheared; /* the batch prepared for the watertight test, indexed by ray id */
+  uint32_t n_lines;          /* ray ids at or above this are not lines of the batch */
+  scx_hits* hits;            /* all-hits queries: where hits are appended */
+  scx_first_hit* first;      /* first-hit queries: the nearest hit so far of each line */
+  int bad_ray_id;            /* set by the filter on a foreign ray id or primitive */
 } scx_query;
 
 /* sizeof/_Alignof of every struct shared with Rust, as this C compiler sees them, and RTC_VERSION. Rust
@@ -121,6 +134,7 @@ typedef struct scx_layout {
   size_t hits;            /* scx_hits */
   size_t first_hit;       /* scx_first_hit */
   size_t query;           /* scx_query */
+  size_t sheared;         /* scx_sheared */
   size_t layout;          /* scx_layout */
   int32_t version;        /* RTC_VERSION of the headers compiled against, e.g. 31305 */
 } scx_layout;
@@ -142,19 +156,28 @@ uint32_t scx_device_packet_widths(const scx_device* device);
 void scx_device_version(const scx_device* device, int* major, int* minor, int* patch);
 
 /* Builds and commits a robust scene with one triangle mesh: n_vertices float3 positions and n_triangles
- * uint3 vertex indices (copied). Every index must be below n_vertices. */
+ * uint3 vertex indices (copied). Every index must be below n_vertices.
+ *
+ * Embree's own triangle test (robust mode) is watertight for lines that cross an edge into the surface,
+ * but can miss every triangle around a vertex, or one face of a convex edge, when a line passes within
+ * rounding distance of it. So Embree gets each triangle inflated by a small margin (every edge pushed out
+ * by ~1.5e-5 of the scene's size), which makes its candidates a superset of the true hits, and every
+ * candidate is then decided, and its distance computed, by the watertight test on the original triangle:
+ * the hits are exactly those of that test, which is watertight at edges and vertices alike. */
 int scx_scene_new(scx_device* device, const float* positions, uint32_t n_vertices, const uint32_t* indices,
                   uint32_t n_triangles, scx_scene** out);
 /* Releases a scene. */
 void scx_scene_release(scx_scene* scene);
 
-/* Every intersection of n lines with the scene, appended to out as {t, prim, line}, in traversal order.
+/* Every intersection of n lines with the scene, appended to out as {t, prim, line}, in traversal order;
+ * t and the hit decision come from the watertight test, identical for single lines and packets.
  * width 1 traces line by line (rtcIntersect1); 4, 8 or 16 traces packets of that many adjacent lines
  * (rtcIntersect4/8/16, native widths only), the last packet padded with inactive lanes. n must be below
  * SCX_NO_LINE. Safe to call from several threads at once with different out buffers. */
 int scx_all_hits(const scx_scene* scene, const scx_line* lines, uint32_t n, uint32_t width, scx_hits* out);
 
-/* The nearest hit of each of n lines, written to out[0..n]; width as for scx_all_hits. */
+/* The nearest hit of each of n lines (by the watertight test), written to out[0..n]; width as for
+ * scx_all_hits. */
 int scx_first_hits(const scx_scene* scene, const scx_line* lines, uint32_t n, uint32_t width,
                    scx_first_hit* out);
 
