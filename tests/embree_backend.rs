@@ -424,9 +424,9 @@ fn lines_grazing_vertices_and_convex_edges_keep_even_parity() {
     for query in all_queries(&scene) {
         let tracer = EmbreeTracer::new(&scene, query).unwrap();
         let hits = trace_all(&tracer, &lines);
-        for k in 0..lines.len() {
+        for (k, line) in lines.iter().enumerate() {
             let row = hits.of_line(k);
-            assert!(row.len() % 2 == 0, "{query}: {:?}: {row:?}", lines[k]);
+            assert!(row.len() % 2 == 0, "{query}: {line:?}: {row:?}");
         }
     }
 }
