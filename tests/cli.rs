@@ -3,13 +3,31 @@
 use std::process::Command;
 
 fn scx(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_scx")).args(args).output().expect("scx runs")
+    Command::new(env!("CARGO_BIN_EXE_scx"))
+        .args(args)
+        .output()
+        .expect("scx runs")
 }
 
 #[test]
 fn json_report_parses_and_carries_the_documented_fields() {
-    let out = scx(&["analyze", "@cube:3", "--lines", "2e4", "--tracer", "rust", "--format", "json", "--threads", "2"]);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let out = scx(&[
+        "analyze",
+        "@cube:3",
+        "--lines",
+        "2e4",
+        "--tracer",
+        "rust",
+        "--format",
+        "json",
+        "--threads",
+        "2",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let doc: serde_json::Value = serde_json::from_slice(&out.stdout).expect("valid JSON");
     assert_eq!(doc["schema_version"], 1);
     assert_eq!(doc["scene"], "@cube:3");
@@ -37,17 +55,32 @@ fn json_report_parses_and_carries_the_documented_fields() {
         assert!(m["value"].as_f64().unwrap().is_finite(), "{key}: {m}");
         assert!(m["stderr"].as_f64().unwrap() >= 0.0, "{key}: {m}");
     }
-    let hp = doc["visibility"]["positional_entropy"]["value"].as_f64().unwrap();
+    let hp = doc["visibility"]["positional_entropy"]["value"]
+        .as_f64()
+        .unwrap();
     assert!((hp - 54f64.log2()).abs() < 1e-12);
 }
 
 #[test]
 fn continuous_only_leaves_the_discrete_measures_out() {
-    let out = scx(&["analyze", "@cube:2", "--lines", "1e4", "--tracer", "rust", "--format", "json", "--measures", "continuous"]);
+    let out = scx(&[
+        "analyze",
+        "@cube:2",
+        "--lines",
+        "1e4",
+        "--tracer",
+        "rust",
+        "--format",
+        "json",
+        "--measures",
+        "continuous",
+    ]);
     assert!(out.status.success());
     let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert!(doc["visibility"]["mutual_information"].is_null());
-    assert!(doc["visibility"]["continuous_mutual_information"]["value"].as_f64().is_some());
+    assert!(doc["visibility"]["continuous_mutual_information"]["value"]
+        .as_f64()
+        .is_some());
     assert!(doc["distinct_pairs"].is_null(), "no count matrix was built");
 }
 
@@ -57,10 +90,24 @@ fn bad_input_is_one_clear_error_with_exit_code_2() {
     let nan = dir.path().join("nan.obj");
     std::fs::write(&nan, "v 0 0 0\nv 1 0 0\nv 0 nan 0\nf 1 2 3\n").unwrap();
     let cases: Vec<(Vec<String>, &str)> = vec![
-        (vec!["analyze".into(), "@nosuch".into()], "unknown built-in scene"),
+        (
+            vec!["analyze".into(), "@nosuch".into()],
+            "unknown built-in scene",
+        ),
         (vec!["analyze".into(), "@cube:0".into()], "whole number"),
-        (vec!["analyze".into(), "/no/such/file.obj".into()], "no such file"),
-        (vec!["analyze".into(), nan.display().to_string(), "--tracer".into(), "rust".into()], "non-finite"),
+        (
+            vec!["analyze".into(), "/no/such/file.obj".into()],
+            "no such file",
+        ),
+        (
+            vec![
+                "analyze".into(),
+                nan.display().to_string(),
+                "--tracer".into(),
+                "rust".into(),
+            ],
+            "non-finite",
+        ),
     ];
     for (args, expect) in cases {
         let args: Vec<&str> = args.iter().map(String::as_str).collect();

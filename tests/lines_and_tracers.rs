@@ -151,14 +151,14 @@ fn lines_through_edges_and_vertices_have_even_parity() {
             hits.hits.len()
         );
         let mut through_interior = 0;
-        for k in 0..lines.len() {
+        for (k, line) in lines.iter().enumerate() {
             let n = hits.of_line(k).len();
             assert_eq!(
                 n % 2,
                 0,
                 "{}: line {k} {:?} has {n} hits: {:?}",
                 tracer.name(),
-                lines[k],
+                line,
                 hits.of_line(k)
             );
             through_interior += usize::from(n == 2);

@@ -224,13 +224,19 @@ fn sphere_mutual_information_tends_to_zero() {
         let tracer = all_tracers(&scene).pop().unwrap();
         let a = run(&scene, tracer.as_ref(), 400_000, 21);
         let cmi = a.visibility.continuous_mutual_information.unwrap();
-        assert!(cmi.value > 0.0 && cmi.value < 0.45 * previous_cmi, "level {level}: I_s^c {cmi:?} after {previous_cmi}");
+        assert!(
+            cmi.value > 0.0 && cmi.value < 0.45 * previous_cmi,
+            "level {level}: I_s^c {cmi:?} after {previous_cmi}"
+        );
         previous_cmi = cmi.value;
         if level <= 1 {
             // Rows are well sampled here (>= 2500 segments per patch), so the plug-in I_s is close to
             // its limit: below I_s^c, and falling with the subdivision.
             let is = a.visibility.mutual_information.unwrap();
-            assert!(is.value < cmi.value + 4.0 * cmi.stderr.unwrap(), "level {level}: {is:?} vs {cmi:?}");
+            assert!(
+                is.value < cmi.value + 4.0 * cmi.stderr.unwrap(),
+                "level {level}: {is:?} vs {cmi:?}"
+            );
             assert!(is.value < previous_is, "level {level}: {is:?}");
             previous_is = is.value;
         }

@@ -188,11 +188,7 @@ pub fn table(run: &RunInfo, a: &Analysis) -> String {
             .unwrap_or_default()
     );
     let _ = writeln!(s);
-    let _ = writeln!(
-        s,
-        "{:<38} {:>12} {:>12}  {}",
-        "measure", "value", "stderr", ""
-    );
+    let _ = writeln!(s, "{:<38} {:>12} {:>12}", "measure", "value", "stderr");
     for (_, label, reference, e) in measures(a) {
         if let Some(e) = e {
             let se = e

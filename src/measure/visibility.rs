@@ -120,7 +120,7 @@ mod tests {
     /// I_s = H_p = 1 bit.
     #[test]
     fn two_patches_seeing_only_each_other() {
-        let counts = PairCounts::from_keys(2, &mut vec![pair_key(0, 1); 10]);
+        let counts = PairCounts::from_keys(2, &mut [pair_key(0, 1); 10]);
         let v = discrete(&[1.0, 1.0], &counts, &[0, 0]);
         assert!((v.positional_entropy - 1.0).abs() < 1e-15);
         assert!(v.entropy.abs() < 1e-15);
@@ -154,7 +154,7 @@ mod tests {
 
     #[test]
     fn unsampled_patches_are_reported_not_nan() {
-        let counts = PairCounts::from_keys(3, &mut vec![pair_key(0, 1)]);
+        let counts = PairCounts::from_keys(3, &mut [pair_key(0, 1)]);
         let v = discrete(&[1.0, 1.0, 2.0], &counts, &[0, 0, 0]);
         assert_eq!(v.unsampled_patches, 1);
         assert!((v.unsampled_area_fraction - 0.5).abs() < 1e-15);

@@ -94,7 +94,7 @@ mod tests {
             [0.6, 0.0, -0.8],
             [1e-9, 0.0, -1.0],
         ] {
-            let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]) as f64;
+            let len: f64 = n[0] * n[0] + n[1] * n[1] + n[2] * n[2];
             let n = n.map(|c: f64| c / len.sqrt());
             let (a, b) = orthonormal_basis(n);
             let d = |x: [f64; 3], y: [f64; 3]| x[0] * y[0] + x[1] * y[1] + x[2] * y[2];

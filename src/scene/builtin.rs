@@ -104,7 +104,7 @@ const CUBE_FACES: [([f64; 3], [f64; 3], [f64; 3]); 6] = [
 
 /// `@cube:N`: the unit cube enclosure, N x N patches per face, inward normals.
 ///
-/// Patches are numbered face by face in the order of [`CUBE_FACES`], and within a face by `(i, j)` with
+/// Patches are numbered face by face in the order x = 0, x = 1, y = 0, y = 1, z = 0, z = 1, and within a face by `(i, j)` with
 /// `patch = face * N^2 + i * N + j`, `i` along u and `j` along v.
 pub fn cube(spec: &str, n: usize) -> Result<Scene, SceneError> {
     let mut b = SceneBuilder::new(spec);
