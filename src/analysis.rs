@@ -114,14 +114,17 @@ pub fn analyze(
     let groups = (cfg.groups.max(1) as u64).min(batches.max(1));
     let areas: Vec<f64> = scene.patches.iter().map(|p| p.area).collect();
 
-    let mut total = Tally::empty(scene, cfg.wanted);
+    let mut merged = MergeStack::default();
     let mut per_group = Vec::with_capacity(groups as usize);
     for g in 0..groups {
         let range = g * batches / groups..(g + 1) * batches / groups;
         let tally = tally_batches(scene, tracer, &plan, cfg.seed, range, cfg.wanted)?;
         per_group.push(GroupValues::of(scene, &areas, &tally));
-        total.merge(&tally);
+        merged.push(tally);
     }
+    let total = merged
+        .finish()
+        .unwrap_or_else(|| Tally::empty(scene, cfg.wanted));
     let all = GroupValues::of(scene, &areas, &total);
     let visibility = estimates(&areas, &all, &per_group, cfg.wanted);
 
@@ -142,6 +145,40 @@ pub fn analyze(
         visibility,
         tally: total,
     })
+}
+
+/// Merges group tallies like a binary counter: two tallies of equal weight merge into one of the next, so
+/// every count is merged O(log G) times (merging each group into one running total would touch all
+/// distinct pairs G times) and at most log2(G) tallies are alive.
+#[derive(Default)]
+struct MergeStack {
+    /// (weight, tally), weights strictly decreasing from bottom to top.
+    stack: Vec<(u32, Tally)>,
+}
+
+impl MergeStack {
+    fn push(&mut self, tally: Tally) {
+        let mut item = (0u32, tally);
+        while let Some(top) = self.stack.last() {
+            if top.0 != item.0 {
+                break;
+            }
+            let (weight, mut below) = self.stack.pop().expect("checked non-empty");
+            // Merge in group order so that f64 sums are added in a fixed order.
+            below.merge(&item.1);
+            item = (weight + 1, below);
+        }
+        self.stack.push(item);
+    }
+
+    fn finish(mut self) -> Option<Tally> {
+        let mut acc = self.stack.pop()?.1;
+        while let Some((_, mut below)) = self.stack.pop() {
+            below.merge(&acc);
+            acc = below;
+        }
+        Some(acc)
+    }
 }
 
 fn estimates(

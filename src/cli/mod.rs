@@ -120,10 +120,11 @@ pub fn main() -> ExitCode {
     let cli = Cli::parse();
     match cli.command {
         Command::Scenes => {
-            for b in builtin::BUILTINS {
-                println!("{:<18} {}", b.usage, b.description);
-            }
-            ExitCode::SUCCESS
+            let list: String = builtin::BUILTINS
+                .iter()
+                .map(|b| format!("{:<18} {}\n", b.usage, b.description))
+                .collect();
+            finish(write_stdout(&list))
         }
         Command::Analyze(args) => finish(try_analyze(&args)),
         Command::Export(args) => finish(try_export(&args)),
@@ -228,6 +229,19 @@ fn try_analyze(args: &AnalyzeArgs) -> Result<(), Failure> {
         Format::Json => report::json(&run, &analysis),
         Format::Csv => report::csv(&run, &analysis),
     };
-    print!("{text}");
-    Ok(())
+    write_stdout(&text)
+}
+
+/// Writes a report to stdout; a reader that went away (`scx ... | head`) is not an error worth a panic.
+fn write_stdout(text: &str) -> Result<(), Failure> {
+    use std::io::Write;
+    let mut out = std::io::stdout().lock();
+    match out.write_all(text.as_bytes()).and_then(|()| out.flush()) {
+        Ok(()) => Ok(()),
+        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(()),
+        Err(e) => Err(Failure {
+            code: 1,
+            message: format!("cannot write the report to stdout: {e}"),
+        }),
+    }
 }

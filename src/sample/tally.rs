@@ -248,7 +248,7 @@ fn add_continuous_term(
     cos_product: f64,
 ) {
     if distance > 0.0 && cos_product > 0.0 {
-        let term = log2_area_over_pi + cos_product.log2() - 2.0 * distance.log2();
+        let term = log2_area_over_pi + (cos_product / (distance * distance)).log2();
         if term.is_finite() {
             t.cmi_sum += term;
             t.cmi_pairs += 1;
