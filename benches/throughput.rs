@@ -52,13 +52,11 @@ fn main() -> anyhow::Result<()> {
             let raw = pool.install(|| best(|| raw_pass(tracer.as_ref(), &lines)));
             let all = pool.install(|| best(|| all_hits_pass(tracer.as_ref(), &lines)));
             let cfg = AnalysisConfig {
-                lines: count,
-                seed: 1,
                 wanted: Wanted {
                     discrete: true,
                     continuous: true,
                 },
-                groups: DEFAULT_GROUPS,
+                ..AnalysisConfig::new(count, 1)
             };
             let end_to_end = pool.install(|| {
                 best(|| {

@@ -78,13 +78,11 @@ fn bench_analysis(c: &mut Criterion) {
     g.sample_size(10);
     for (name, t) in tracers(&scene) {
         let cfg = AnalysisConfig {
-            lines: LINES as u64,
-            seed: 1,
             wanted: Wanted {
                 discrete: true,
                 continuous: true,
             },
-            groups: 16,
+            ..AnalysisConfig::new(LINES as u64, 1)
         };
         g.bench_function(BenchmarkId::from_parameter(&name), |b| {
             b.iter(|| analyze(&scene, t.as_ref(), &cfg).unwrap())

@@ -1,20 +1,38 @@
 //! One analysis run: lines -> hits -> pairs -> counts -> measures, with standard errors from groups.
+//!
+//! Lines come in batches (each with its own random stream, see [`crate::sample::lines`]). Batch `b`
+//! belongs to group `b mod G`; every measure is computed on each group alone as well as on all lines, and
+//! the spread of the group values gives the standard error ([`crate::measure::estimate`]). Because
+//! membership depends on the batch index only, the groups fill up evenly however long a run lasts, so a
+//! run can stop at any batch (a time budget, a precision target, Ctrl-C) and still has G comparable groups.
+//!
+//! A stopped run keeps the longest prefix of finished batches, so its lines are always batches `0..k`: the
+//! same seed gives the same numbers for the same number of lines, whatever the thread count.
 
-use std::time::Instant;
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::time::{Duration, Instant};
 
+use crate::measure::bias::{self, CorrectedValues, EntropyEstimator};
 use crate::measure::visibility::{self, ContinuousValues, DiscreteValues};
 use crate::measure::Estimate;
-use crate::sample::tally::{tally_batches, BatchPlan, Tally, Wanted};
+use crate::sample::tally::{trace_batches, BatchPlan, BatchTally, Tally, Wanted};
 use crate::scene::Scene;
 use crate::trace::{TraceError, Tracer};
+
+/// The most lines traced in one round (their pair keys are held until the round is counted).
+const MAX_ROUND_LINES: u64 = 1 << 25;
 
 /// Default number of independent groups of lines behind every standard error.
 pub const DEFAULT_GROUPS: usize = 16;
 
+/// The entropy estimator behind the bias-corrected H_s and I_s, chosen by measurement against the exact
+/// I_s of `@cube:N` (README, "Error against run time").
+pub const DEFAULT_ESTIMATOR: EntropyEstimator = EntropyEstimator::ChaoWangJost;
+
 /// What to run.
 #[derive(Clone, Copy, Debug)]
 pub struct AnalysisConfig {
-    /// Global lines to cast.
+    /// Global lines to cast (a cap when a budget is set).
     pub lines: u64,
     /// Seed of the line streams.
     pub seed: u64,
@@ -22,6 +40,136 @@ pub struct AnalysisConfig {
     pub wanted: Wanted,
     /// Groups for the standard errors (see [`crate::measure::estimate`]).
     pub groups: usize,
+    /// The estimator of the bias-corrected H_s and I_s.
+    pub estimator: EntropyEstimator,
+    /// When to stop before `lines`.
+    pub budget: Budget,
+}
+
+impl AnalysisConfig {
+    /// `lines` lines from `seed`, every measure, default groups and estimator, no budget.
+    pub fn new(lines: u64, seed: u64) -> Self {
+        AnalysisConfig {
+            lines,
+            seed,
+            wanted: Wanted {
+                discrete: true,
+                continuous: true,
+            },
+            groups: DEFAULT_GROUPS,
+            estimator: DEFAULT_ESTIMATOR,
+            budget: Budget::default(),
+        }
+    }
+}
+
+/// Limits that end a run before its line count.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Budget {
+    /// Stop when this much wall-clock time is spent.
+    pub seconds: Option<f64>,
+    /// Stop when a measure's standard error is this small.
+    pub target: Option<Target>,
+}
+
+/// A precision target: run until `measure`'s standard error is at most `stderr`.
+#[derive(Clone, Copy, Debug)]
+pub struct Target {
+    /// The measure watched.
+    pub measure: TargetMeasure,
+    /// The standard error to reach.
+    pub stderr: f64,
+}
+
+/// A measure a precision target can watch (named as in the JSON report).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TargetMeasure {
+    /// H_s, eq. (17).
+    Entropy,
+    /// I_s, eq. (21).
+    MutualInformation,
+    /// I_s^c, eq. (27).
+    ContinuousMutualInformation,
+    /// I_s / I_s^c.
+    Accuracy,
+}
+
+impl TargetMeasure {
+    /// Every target measure with its name.
+    pub const NAMES: [(&'static str, TargetMeasure); 4] = [
+        ("entropy", TargetMeasure::Entropy),
+        ("mutual_information", TargetMeasure::MutualInformation),
+        (
+            "continuous_mutual_information",
+            TargetMeasure::ContinuousMutualInformation,
+        ),
+        ("accuracy", TargetMeasure::Accuracy),
+    ];
+
+    /// Parses a name as in the JSON report (`mutual_information`).
+    pub fn from_name(name: &str) -> Option<Self> {
+        Self::NAMES
+            .iter()
+            .find(|(n, _)| *n == name)
+            .map(|&(_, m)| m)
+    }
+
+    fn of(self, v: &VisibilityEstimates) -> Option<Estimate> {
+        match self {
+            TargetMeasure::Entropy => v.entropy,
+            TargetMeasure::MutualInformation => v.mutual_information,
+            TargetMeasure::ContinuousMutualInformation => v.continuous_mutual_information,
+            TargetMeasure::Accuracy => v.accuracy,
+        }
+    }
+}
+
+/// Shared between a run and whoever watches it: a stop request (Ctrl-C) and a progress counter.
+#[derive(Debug, Default)]
+pub struct RunControl {
+    stop: AtomicBool,
+    lines_started: AtomicU64,
+}
+
+impl RunControl {
+    /// Asks the run to stop; it finishes the batches under way and reports what it gathered.
+    pub fn request_stop(&self) {
+        self.stop.store(true, Ordering::Relaxed);
+    }
+
+    /// Lines whose tracing has started so far (for a progress display).
+    pub fn lines_started(&self) -> u64 {
+        self.lines_started.load(Ordering::Relaxed)
+    }
+
+    fn stop_requested(&self) -> bool {
+        self.stop.load(Ordering::Relaxed)
+    }
+}
+
+/// Why a run ended.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum StopReason {
+    /// All the requested lines were cast.
+    Lines,
+    /// The time budget was spent.
+    Seconds,
+    /// The precision target was reached.
+    Target,
+    /// A stop was requested (Ctrl-C).
+    Interrupted,
+}
+
+impl StopReason {
+    /// A short name for reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            StopReason::Lines => "lines",
+            StopReason::Seconds => "seconds",
+            StopReason::Target => "target_stderr",
+            StopReason::Interrupted => "interrupted",
+        }
+    }
 }
 
 /// The visibility measures of a run, each with its standard error; `None` when not computed.
@@ -29,16 +177,22 @@ pub struct AnalysisConfig {
 pub struct VisibilityEstimates {
     /// Eq. (19), exact.
     pub positional_entropy: Option<Estimate>,
-    /// Eq. (17).
+    /// Eq. (17), plug-in.
     pub entropy: Option<Estimate>,
+    /// Eq. (17) with bias-corrected row entropies ([`crate::measure::bias`]).
+    pub entropy_corrected: Option<Estimate>,
     /// H(X, Y).
     pub joint_entropy: Option<Estimate>,
-    /// Eq. (21).
+    /// Eq. (21), plug-in.
     pub mutual_information: Option<Estimate>,
+    /// Eq. (20) with the bias-corrected H_s.
+    pub mutual_information_corrected: Option<Estimate>,
     /// Eq. (27).
     pub continuous_mutual_information: Option<Estimate>,
-    /// Sec. 3.3: discretisation accuracy I_s / I_s^c.
+    /// Sec. 3.3: discretisation accuracy I_s / I_s^c (plug-in I_s).
     pub accuracy: Option<Estimate>,
+    /// Sec. 3.3 with the bias-corrected I_s.
+    pub accuracy_corrected: Option<Estimate>,
     /// Sec. 3.3: discretisation relative error (I_s^c - I_s) / I_s^c.
     pub relative_error: Option<Estimate>,
     /// Eq. (22), per line.
@@ -54,8 +208,12 @@ pub struct Analysis {
     pub seed: u64,
     /// Wall-clock seconds of tracing, counting and measuring.
     pub seconds: f64,
+    /// Why the run ended.
+    pub stop_reason: StopReason,
     /// Groups behind the standard errors.
     pub groups: usize,
+    /// The estimator of the corrected measures.
+    pub estimator: EntropyEstimator,
     /// Canonical hits.
     pub hits: u64,
     /// Visible pairs.
@@ -80,59 +238,141 @@ pub struct Analysis {
 #[derive(Clone, Copy, Debug)]
 struct GroupValues {
     discrete: Option<DiscreteValues>,
+    corrected: Option<CorrectedValues>,
     continuous: Option<ContinuousValues>,
 }
 
 impl GroupValues {
-    fn of(scene: &Scene, areas: &[f64], t: &Tally) -> Self {
+    fn of(areas: &[f64], t: &Tally, estimator: EntropyEstimator) -> Self {
+        let counted = t.counts.as_ref().filter(|_| t.lines > 0);
         GroupValues {
-            discrete: t
-                .counts
-                .as_ref()
-                .map(|c| visibility::discrete(areas, c, &t.escapes_by_patch)),
-            continuous: ContinuousValues::from_sum(t.cmi_sum, t.cmi_pairs)
-                .filter(|_| scene.patch_count() > 0),
+            discrete: counted.map(|c| visibility::discrete(areas, c, &t.escapes_by_patch)),
+            corrected: counted.map(|c| bias::corrected(areas, c, &t.escapes_by_patch, estimator)),
+            continuous: ContinuousValues::from_sum(t.cmi_sum, t.cmi_pairs),
         }
     }
 
     fn accuracy(&self) -> Option<f64> {
         Some(self.discrete?.mutual_information / self.continuous?.mutual_information)
     }
+
+    fn accuracy_corrected(&self) -> Option<f64> {
+        Some(self.corrected?.mutual_information / self.continuous?.mutual_information)
+    }
 }
 
-/// Runs an analysis: casts `cfg.lines` global lines through `scene` with `tracer`.
-///
-/// Uses the current rayon thread pool; results do not depend on its size.
+/// Runs an analysis with no one watching: casts `cfg.lines` global lines (or fewer, by the budget).
 pub fn analyze(
     scene: &Scene,
     tracer: &dyn Tracer,
     cfg: &AnalysisConfig,
 ) -> Result<Analysis, TraceError> {
+    analyze_with(scene, tracer, cfg, &RunControl::default())
+}
+
+/// Runs an analysis that `control` can watch and stop.
+///
+/// Uses the current rayon thread pool; results do not depend on its size.
+pub fn analyze_with(
+    scene: &Scene,
+    tracer: &dyn Tracer,
+    cfg: &AnalysisConfig,
+    control: &RunControl,
+) -> Result<Analysis, TraceError> {
     let start = Instant::now();
-    let plan = BatchPlan::new(cfg.lines);
-    let batches = plan.batches();
-    let groups = (cfg.groups.max(1) as u64).min(batches.max(1));
+    let open_ended = cfg.budget.seconds.is_some() || cfg.budget.target.is_some();
+    let plan = if open_ended {
+        BatchPlan::open_ended(cfg.lines)
+    } else {
+        BatchPlan::new(cfg.lines)
+    };
+    let deadline = cfg
+        .budget
+        .seconds
+        .map(|s| start + Duration::from_secs_f64(s.max(0.0)));
     let areas: Vec<f64> = scene.patches.iter().map(|p| p.area).collect();
+    let mut run = GroupedRun::new(scene, cfg, plan);
 
-    let mut merged = MergeStack::default();
-    let mut per_group = Vec::with_capacity(groups as usize);
-    for g in 0..groups {
-        let range = g * batches / groups..(g + 1) * batches / groups;
-        let tally = tally_batches(scene, tracer, &plan, cfg.seed, range, cfg.wanted)?;
-        per_group.push(GroupValues::of(scene, &areas, &tally));
-        merged.push(tally);
-    }
-    let total = merged
-        .finish()
-        .unwrap_or_else(|| Tally::empty(scene, cfg.wanted));
-    let all = GroupValues::of(scene, &areas, &total);
-    let visibility = estimates(&areas, &all, &per_group, cfg.wanted);
+    let stop = |b: u64| {
+        let late = deadline.is_some_and(|d| Instant::now() >= d);
+        if control.stop_requested() || late {
+            return true;
+        }
+        control
+            .lines_started
+            .fetch_add(plan.batch_len(b) as u64, Ordering::Relaxed);
+        false
+    };
+    // Rounds bound the memory held in pair keys and let a budget run check itself; for a fixed run
+    // their sizes depend on the line count only, so the numbers do too.
+    let max_round = (MAX_ROUND_LINES / plan.batch_size).max(1);
+    let mut round = if open_ended {
+        (4 * run.groups()).max(64)
+    } else {
+        max_round
+    };
+    let stop_reason = loop {
+        let first = run.batches_done;
+        let last = (first + round).min(plan.batches());
+        let traced = trace_batches(
+            scene,
+            tracer,
+            &plan,
+            cfg.seed,
+            first..last,
+            cfg.wanted,
+            &stop,
+        )?;
+        let complete = run.add_prefix(traced);
+        if !complete {
+            break if control.stop_requested() {
+                StopReason::Interrupted
+            } else {
+                StopReason::Seconds
+            };
+        }
+        if run.batches_done >= plan.batches() {
+            break StopReason::Lines;
+        }
+        if deadline.is_some_and(|d| Instant::now() >= d) {
+            break StopReason::Seconds;
+        }
+        if let Some(target) = cfg.budget.target {
+            let se = run.current_stderr(&areas, cfg, target.measure);
+            match se {
+                Some(se) if se <= target.stderr => break StopReason::Target,
+                // stderr ~ 1/sqrt(lines): aim 10% past the predicted need, at most doubling per round.
+                Some(se) => {
+                    let need = run.batches_done as f64 * (se / target.stderr).powi(2) * 1.1;
+                    round = ((need as u64).saturating_sub(run.batches_done))
+                        .clamp(1, run.batches_done.max(1));
+                }
+                None => round = run.batches_done.max(1),
+            }
+        } else {
+            // Doubling: few rounds, and a time budget is checked before every batch anyway.
+            round = run.batches_done.max(64);
+        }
+        round = round.min(max_round);
+    };
 
+    let (total, per_group) = run.finish(&areas, cfg.estimator);
+    let all = GroupValues::of(&areas, &total, cfg.estimator);
+    let visibility = if total.lines == 0 {
+        VisibilityEstimates {
+            positional_entropy: Some(Estimate::exact(positional_entropy(&areas))),
+            ..VisibilityEstimates::default()
+        }
+    } else {
+        estimates(&areas, &all, &per_group, cfg.wanted)
+    };
     Ok(Analysis {
         lines: total.lines,
         seed: cfg.seed,
         seconds: start.elapsed().as_secs_f64(),
-        groups: groups as usize,
+        stop_reason,
+        groups: per_group.len(),
+        estimator: cfg.estimator,
         hits: total.hits,
         pairs: total.pairs,
         escapes: total.escapes,
@@ -145,6 +385,91 @@ pub fn analyze(
         visibility,
         tally: total,
     })
+}
+
+/// The groups of a run as they fill up.
+struct GroupedRun<'a> {
+    scene: &'a Scene,
+    wanted: Wanted,
+    groups: Vec<Option<Tally>>,
+    batches_done: u64,
+}
+
+impl<'a> GroupedRun<'a> {
+    fn new(scene: &'a Scene, cfg: &AnalysisConfig, plan: BatchPlan) -> Self {
+        // A short fixed run has fewer batches than groups: one group per batch then.
+        let groups = (cfg.groups.max(2) as u64).min(plan.batches().max(2)) as usize;
+        GroupedRun {
+            scene,
+            wanted: cfg.wanted,
+            groups: vec![None; groups],
+            batches_done: 0,
+        }
+    }
+
+    fn groups(&self) -> u64 {
+        self.groups.len() as u64
+    }
+
+    /// Adds the longest prefix of finished batches to their groups; true when every batch finished.
+    fn add_prefix(&mut self, traced: Vec<Option<BatchTally>>) -> bool {
+        let finished = traced.iter().take_while(|b| b.is_some()).count();
+        let first = self.batches_done;
+        let g_count = self.groups();
+        for (g, slot) in self.groups.iter_mut().enumerate() {
+            let members = traced[..finished]
+                .iter()
+                .enumerate()
+                .filter(|(k, _)| (first + *k as u64) % g_count == g as u64)
+                .map(|(_, b)| b.as_ref().expect("within the finished prefix"));
+            if members.clone().next().is_none() {
+                continue;
+            }
+            let tally = Tally::from_batches(self.scene, self.wanted, members);
+            match slot {
+                Some(t) => t.merge(&tally),
+                None => *slot = Some(tally),
+            }
+        }
+        self.batches_done += finished as u64;
+        finished == traced.len()
+    }
+
+    /// The standard error of `measure` from the groups so far.
+    fn current_stderr(
+        &self,
+        areas: &[f64],
+        cfg: &AnalysisConfig,
+        measure: TargetMeasure,
+    ) -> Option<f64> {
+        let filled: Vec<&Tally> = self.groups.iter().flatten().collect();
+        let values: Vec<GroupValues> = filled
+            .iter()
+            .map(|t| GroupValues::of(areas, t, cfg.estimator))
+            .collect();
+        // The total's value does not change the spread of the groups; any stand-in does.
+        let stand_in = values.first()?;
+        measure
+            .of(&estimates(areas, stand_in, &values, cfg.wanted))?
+            .stderr
+    }
+
+    /// The merged total and every non-empty group's values.
+    fn finish(self, areas: &[f64], estimator: EntropyEstimator) -> (Tally, Vec<GroupValues>) {
+        let filled: Vec<Tally> = self.groups.into_iter().flatten().collect();
+        let per_group = filled
+            .iter()
+            .map(|t| GroupValues::of(areas, t, estimator))
+            .collect();
+        let mut merged = MergeStack::default();
+        for t in filled {
+            merged.push(t);
+        }
+        let total = merged
+            .finish()
+            .unwrap_or_else(|| Tally::empty(self.scene, self.wanted));
+        (total, per_group)
+    }
 }
 
 /// Merges group tallies like a binary counter: two tallies of equal weight merge into one of the next, so
@@ -181,6 +506,13 @@ impl MergeStack {
     }
 }
 
+fn positional_entropy(areas: &[f64]) -> f64 {
+    -visibility::area_distribution(areas)
+        .iter()
+        .map(|&x| crate::measure::entropy::xlog2x(x))
+        .sum::<f64>()
+}
+
 fn estimates(
     areas: &[f64],
     all: &GroupValues,
@@ -199,22 +531,22 @@ fn estimates(
             }
         })
     };
-    let hp = -visibility::area_distribution(areas)
-        .iter()
-        .map(|&x| crate::measure::entropy::xlog2x(x))
-        .sum::<f64>();
+    let both = wanted.discrete && wanted.continuous;
     VisibilityEstimates {
-        positional_entropy: Some(Estimate::exact(hp)),
+        positional_entropy: Some(Estimate::exact(positional_entropy(areas))),
         entropy: est(&|g| Some(g.discrete?.entropy)),
+        entropy_corrected: est(&|g| Some(g.corrected?.entropy)),
         joint_entropy: est(&|g| Some(g.discrete?.joint_entropy)),
         mutual_information: est(&|g| Some(g.discrete?.mutual_information)),
+        mutual_information_corrected: est(&|g| Some(g.corrected?.mutual_information)),
         continuous_mutual_information: est(&|g| Some(g.continuous?.mutual_information)),
-        accuracy: if wanted.discrete && wanted.continuous {
-            est(&|g| g.accuracy())
+        accuracy: if both { est(&|g| g.accuracy()) } else { None },
+        accuracy_corrected: if both {
+            est(&|g| g.accuracy_corrected())
         } else {
             None
         },
-        relative_error: if wanted.discrete && wanted.continuous {
+        relative_error: if both {
             est(&|g| Some(1.0 - g.accuracy()?))
         } else {
             None

@@ -17,10 +17,8 @@ const ALL: Wanted = Wanted {
 
 fn run(scene: &Scene, tracer: &dyn Tracer, lines: u64, seed: u64) -> Analysis {
     let cfg = AnalysisConfig {
-        lines,
-        seed,
         wanted: ALL,
-        groups: 16,
+        ..AnalysisConfig::new(lines, seed)
     };
     analyze(scene, tracer, &cfg).expect("analysis runs")
 }
@@ -242,4 +240,29 @@ fn sphere_mutual_information_tends_to_zero() {
         }
     }
     assert!(previous_cmi < 0.02);
+}
+
+/// The closed-form form factors of `@cube:N` (used as truth for the bias corrections) are right: rows sum
+/// to 1, reciprocity is exact, and N = 1 reproduces the unit-square values.
+#[test]
+fn closed_form_cube_form_factors_are_consistent() {
+    let scene = scene::load("@cube:4").unwrap();
+    let rects: Vec<AxisRect> = (0..scene.patch_count())
+        .map(|p| AxisRect::of_patch(&scene, p))
+        .collect();
+    let rows: Vec<Vec<f64>> = (0..scene.patch_count())
+        .map(|i| cube_form_factor_row(&scene, &rects, i))
+        .collect();
+    for (i, row) in rows.iter().enumerate() {
+        assert!((row.iter().sum::<f64>() - 1.0).abs() < 1e-10, "row {i}");
+        for (j, f) in row.iter().enumerate() {
+            assert!((f - rows[j][i]).abs() < 1e-12, "equal areas: F_ij = F_ji");
+        }
+    }
+    let (_, is1) = cube_exact_measures(1);
+    let (fp, fq) = (
+        ff_parallel_rectangles(1.0, 1.0, 1.0),
+        ff_perpendicular_rectangles(1.0, 1.0, 1.0),
+    );
+    assert!((is1 - (fp * (6.0 * fp).log2() + 4.0 * fq * (6.0 * fq).log2())).abs() < 1e-12);
 }

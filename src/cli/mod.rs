@@ -1,11 +1,18 @@
 //! Command-line arguments and dispatch. Knows the library's public API only (never a backend's types).
 
+mod progress;
 mod report;
+
+use std::sync::Arc;
 
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand, ValueEnum};
-use scene_complexity::analysis::{analyze, AnalysisConfig, DEFAULT_GROUPS};
+use scene_complexity::analysis::{
+    analyze_with, AnalysisConfig, Budget, RunControl, Target, TargetMeasure, DEFAULT_ESTIMATOR,
+    DEFAULT_GROUPS,
+};
+use scene_complexity::measure::bias::EntropyEstimator;
 use scene_complexity::sample::tally::Wanted;
 use scene_complexity::scene::{self, builtin};
 use scene_complexity::trace::{make_tracer, Backend, Query};
@@ -43,8 +50,8 @@ struct AnalyzeArgs {
     /// An OBJ file, or a built-in scene such as `@cube:10` (see `scx scenes`).
     scene: String,
     /// Number of global lines (accepts `1e7`).
-    #[arg(long, default_value = "1e6", value_parser = parse_count)]
-    lines: u64,
+    #[arg(long, value_parser = parse_count)]
+    lines: Option<u64>,
     /// Seed of the random line streams.
     #[arg(long, default_value_t = 1)]
     seed: u64,
@@ -63,6 +70,20 @@ struct AnalyzeArgs {
     /// Independent groups of lines behind each standard error.
     #[arg(long, default_value_t = DEFAULT_GROUPS as u16, value_parser = clap::value_parser!(u16).range(2..=1024))]
     groups: u16,
+    /// Estimator of the bias-corrected H_s and I_s: plug-in, miller-madow, grassberger, chao-shen,
+    /// chao-wang-jost.
+    #[arg(long, default_value = DEFAULT_ESTIMATOR.name(), value_parser = parse_estimator)]
+    estimator: EntropyEstimator,
+    /// Stop after this many seconds (then --lines is only a cap).
+    #[arg(long, value_parser = parse_positive)]
+    seconds: Option<f64>,
+    /// Stop when the standard error of --target-measure is at most this (then --lines is only a cap).
+    #[arg(long, value_parser = parse_positive)]
+    target_stderr: Option<f64>,
+    /// The measure --target-stderr watches: mutual_information, entropy, continuous_mutual_information,
+    /// accuracy.
+    #[arg(long, default_value = "mutual_information", value_parser = parse_target_measure)]
+    target_measure: TargetMeasure,
     /// Output format.
     #[arg(long, value_enum, default_value_t = Format::Table)]
     format: Format,
@@ -101,6 +122,27 @@ fn parse_count(s: &str) -> Result<u64, String> {
         return Err(format!("`{s}`: need a whole number from 1 to 1e15"));
     }
     Ok(v as u64)
+}
+
+fn parse_positive(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
+        _ => Err(format!("`{s}`: need a positive number")),
+    }
+}
+
+fn parse_estimator(s: &str) -> Result<EntropyEstimator, String> {
+    EntropyEstimator::from_name(s).ok_or_else(|| {
+        let names: Vec<&str> = EntropyEstimator::ALL.iter().map(|e| e.name()).collect();
+        format!("`{s}`: expected one of {}", names.join(", "))
+    })
+}
+
+fn parse_target_measure(s: &str) -> Result<TargetMeasure, String> {
+    TargetMeasure::from_name(s).ok_or_else(|| {
+        let names: Vec<&str> = TargetMeasure::NAMES.iter().map(|(n, _)| *n).collect();
+        format!("`{s}`: expected one of {}", names.join(", "))
+    })
 }
 
 fn parse_query(s: &str) -> Result<Query, String> {
@@ -203,18 +245,35 @@ fn try_analyze(args: &AnalyzeArgs) -> Result<(), Failure> {
         .num_threads(threads)
         .build()
         .map_err(|e| bad_input(format!("cannot start {threads} threads: {e}")))?;
+    let budget = Budget {
+        seconds: args.seconds,
+        target: args.target_stderr.map(|stderr| Target {
+            measure: args.target_measure,
+            stderr,
+        }),
+    };
+    let open_ended = budget.seconds.is_some() || budget.target.is_some();
+    let lines = args.lines.unwrap_or(if open_ended {
+        1_000_000_000_000
+    } else {
+        1_000_000
+    });
     let cfg = AnalysisConfig {
-        lines: args.lines,
-        seed: args.seed,
         wanted,
         groups: usize::from(args.groups),
+        estimator: args.estimator,
+        budget,
+        ..AnalysisConfig::new(lines, args.seed)
     };
-    let analysis = pool
-        .install(|| analyze(&scene, tracer.as_ref(), &cfg))
-        .map_err(|e| Failure {
-            code: 1,
-            message: e.to_string(),
-        })?;
+    let control = Arc::new(RunControl::default());
+    watch_ctrl_c(&control);
+    let analysis = progress::while_running(&control, (!open_ended).then_some(lines), || {
+        pool.install(|| analyze_with(&scene, tracer.as_ref(), &cfg, &control))
+    })
+    .map_err(|e| Failure {
+        code: 1,
+        message: e.to_string(),
+    })?;
     let run = report::RunInfo {
         scene: &scene,
         tracer: tracer.name(),
@@ -230,6 +289,20 @@ fn try_analyze(args: &AnalyzeArgs) -> Result<(), Failure> {
         Format::Csv => report::csv(&run, &analysis),
     };
     write_stdout(&text)
+}
+
+/// The first Ctrl-C asks the run to stop and report what it gathered; a second one ends the program.
+fn watch_ctrl_c(control: &Arc<RunControl>) {
+    let control = Arc::clone(control);
+    let presses = std::sync::atomic::AtomicU32::new(0);
+    // Failing to install the handler only loses the clean stop: Ctrl-C then ends the program as usual.
+    let _ = ctrlc::set_handler(move || {
+        if presses.fetch_add(1, std::sync::atomic::Ordering::SeqCst) > 0 {
+            std::process::exit(130);
+        }
+        eprintln!("\nscx: stopping after the batches under way (Ctrl-C again to quit now)");
+        control.request_stop();
+    });
 }
 
 /// Writes a report to stdout; a reader that went away (`scx ... | head`) is not an error worth a panic.

@@ -2,7 +2,7 @@
 
 use std::fmt::Write;
 
-use scene_complexity::analysis::Analysis;
+use scene_complexity::analysis::{Analysis, StopReason};
 use scene_complexity::measure::Estimate;
 use scene_complexity::scene::Scene;
 use scene_complexity::trace::Query;
@@ -19,47 +19,81 @@ pub struct RunInfo<'a> {
     pub threads: usize,
 }
 
-/// The visibility measures in report order: (JSON key, table label, paper reference, estimate).
-fn measures(a: &Analysis) -> Vec<(&'static str, &'static str, &'static str, Option<Estimate>)> {
+/// One row of the report: JSON key, table label, paper reference, plug-in and bias-corrected estimates.
+struct Row {
+    key: &'static str,
+    label: &'static str,
+    reference: &'static str,
+    estimate: Option<Estimate>,
+    corrected: Option<Estimate>,
+}
+
+/// The visibility measures in report order.
+fn measures(a: &Analysis) -> Vec<Row> {
     let v = &a.visibility;
+    let row = |key, label, reference, estimate, corrected| Row {
+        key,
+        label,
+        reference,
+        estimate,
+        corrected,
+    };
     vec![
-        (
+        row(
             "positional_entropy",
             "positional entropy H_p",
             "eq. 19",
             v.positional_entropy,
+            None,
         ),
-        ("entropy", "visibility entropy H_s", "eq. 17", v.entropy),
-        ("joint_entropy", "joint entropy H(X,Y)", "", v.joint_entropy),
-        (
+        row(
+            "entropy",
+            "visibility entropy H_s",
+            "eq. 17",
+            v.entropy,
+            v.entropy_corrected,
+        ),
+        row(
+            "joint_entropy",
+            "joint entropy H(X,Y)",
+            "eq. 7",
+            v.joint_entropy,
+            None,
+        ),
+        row(
             "mutual_information",
             "mutual information I_s",
             "eq. 21",
             v.mutual_information,
+            v.mutual_information_corrected,
         ),
-        (
+        row(
             "continuous_mutual_information",
             "continuous mutual information I_s^c",
             "eq. 27",
             v.continuous_mutual_information,
+            None,
         ),
-        (
+        row(
             "accuracy",
             "discretisation accuracy I_s/I_s^c",
             "sec. 3.3",
             v.accuracy,
+            v.accuracy_corrected,
         ),
-        (
+        row(
             "relative_error",
             "discretisation relative error",
             "sec. 3.3",
             v.relative_error,
+            None,
         ),
-        (
+        row(
             "mse_per_line",
             "form-factor E(MSE) per line",
             "eq. 22",
             v.mse_per_line,
+            None,
         ),
     ]
 }
@@ -101,6 +135,14 @@ fn estimate_json(e: Option<Estimate>) -> Value {
     }
 }
 
+fn row_json(r: &Row) -> Value {
+    let mut v = estimate_json(r.estimate);
+    if let (Value::Object(map), Some(c)) = (&mut v, r.corrected) {
+        map.insert("corrected".into(), estimate_json(Some(c)));
+    }
+    v
+}
+
 fn finite(x: f64) -> Option<f64> {
     x.is_finite().then_some(x)
 }
@@ -108,8 +150,8 @@ fn finite(x: f64) -> Option<f64> {
 /// The JSON document of `analyze --format json`.
 pub fn json(run: &RunInfo, a: &Analysis) -> String {
     let mut visibility = serde_json::Map::new();
-    for (key, _, _, e) in measures(a) {
-        visibility.insert(key.into(), estimate_json(e));
+    for r in measures(a) {
+        visibility.insert(r.key.into(), row_json(&r));
     }
     let doc = json!({
         "schema_version": SCHEMA_VERSION,
@@ -125,6 +167,9 @@ pub fn json(run: &RunInfo, a: &Analysis) -> String {
         "threads": run.threads,
         "groups": a.groups,
         "seconds": a.seconds,
+        "stop_reason": a.stop_reason.name(),
+        "interrupted": a.stop_reason == StopReason::Interrupted,
+        "estimator": a.estimator.name(),
         "hits": a.hits,
         "pairs": a.pairs,
         "escapes": a.escapes,
@@ -143,11 +188,19 @@ pub fn json(run: &RunInfo, a: &Analysis) -> String {
 
 /// `measure,value,stderr` rows with a header.
 pub fn csv(_run: &RunInfo, a: &Analysis) -> String {
-    let mut s = String::from("measure,value,stderr\n");
-    for (key, _, _, e) in measures(a) {
-        if let Some(e) = e {
-            let se = e.stderr.map(|x| x.to_string()).unwrap_or_default();
-            let _ = writeln!(s, "{key},{},{se}", e.value);
+    let mut s = String::from("measure,value,stderr,corrected,corrected_stderr\n");
+    let field = |e: Option<Estimate>| {
+        (
+            e.map(|e| e.value.to_string()).unwrap_or_default(),
+            e.and_then(|e| e.stderr)
+                .map(|x| x.to_string())
+                .unwrap_or_default(),
+        )
+    };
+    for r in measures(a) {
+        if r.estimate.is_some() {
+            let ((v, se), (c, cse)) = (field(r.estimate), field(r.corrected));
+            let _ = writeln!(s, "{},{v},{se},{c},{cse}", r.key);
         }
     }
     s
@@ -188,21 +241,55 @@ pub fn table(run: &RunInfo, a: &Analysis) -> String {
             .unwrap_or_default()
     );
     let _ = writeln!(s);
-    let _ = writeln!(s, "{:<38} {:>12} {:>12}", "measure", "value", "stderr");
-    for (_, label, reference, e) in measures(a) {
-        if let Some(e) = e {
-            let se = e
-                .stderr
-                .map(|x| format!("{x:.6}"))
-                .unwrap_or_else(|| "n/a".into());
-            let _ = writeln!(s, "{label:<38} {:>12.6} {se:>12}  {reference}", e.value);
+    let _ = writeln!(
+        s,
+        "{:<36} {:>12} {:>10}  {:>12} {:>10}",
+        "measure", "plug-in", "stderr", "corrected", "stderr"
+    );
+    for r in measures(a) {
+        if let Some(e) = r.estimate {
+            let corrected = r
+                .corrected
+                .map(|c| format!("{:>12.6} {:>10}", c.value, stderr_text(c)))
+                .unwrap_or_else(|| format!("{:>23}", ""));
+            let _ = writeln!(
+                s,
+                "{:<36} {:>12.6} {:>10}  {corrected}  {}",
+                r.label,
+                e.value,
+                stderr_text(e),
+                r.reference
+            );
         }
     }
     let _ = writeln!(
         s,
-        "\nstandard errors: spread of {} independent groups of lines / sqrt({}); statistical only (the plug-in \
-         H_s and I_s are biased at few lines)",
-        a.groups, a.groups
+        "\nstandard errors: spread of {} independent groups of lines / sqrt({}) (statistical error only).\n\
+         corrected: row entropies by the {} estimator; the plug-in H_s and I_s are biased when rows are \
+         undersampled.",
+        a.groups,
+        a.groups,
+        a.estimator.name()
     );
+    if a.stop_reason != StopReason::Lines {
+        let _ = writeln!(s, "stopped by: {}", stop_text(a.stop_reason));
+    }
     s
+}
+
+fn stderr_text(e: Estimate) -> String {
+    e.stderr
+        .map(|x| format!("{x:.6}"))
+        .unwrap_or_else(|| "n/a".into())
+}
+
+fn stop_text(r: StopReason) -> &'static str {
+    match r {
+        StopReason::Lines => "all lines cast",
+        StopReason::Seconds => "the time budget (--seconds)",
+        StopReason::Target => "the precision target (--target-stderr) was reached",
+        StopReason::Interrupted => {
+            "interrupted (Ctrl-C): the report covers the lines gathered so far"
+        }
+    }
 }

@@ -2,6 +2,7 @@
 //!
 //! Logarithms are base 2 (bits). `0 log 0 = 0` everywhere ([`entropy::xlog2x`]).
 
+pub mod bias;
 pub mod entropy;
 pub mod estimate;
 pub mod visibility;

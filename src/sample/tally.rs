@@ -40,6 +40,16 @@ impl BatchPlan {
         BatchPlan { lines, batch_size }
     }
 
+    /// A plan for a run whose length is not known in advance (a time or precision budget, with `lines`
+    /// only a cap): always full batches of 4096 lines, so a run's first batches are the same whatever
+    /// the budget.
+    pub fn open_ended(lines: u64) -> Self {
+        BatchPlan {
+            lines,
+            batch_size: 4096,
+        }
+    }
+
     /// Number of batches.
     pub fn batches(&self) -> u64 {
         self.lines.div_ceil(self.batch_size)
@@ -125,7 +135,7 @@ impl Tally {
 
 /// One batch's findings, before its pair keys become counts.
 #[derive(Debug, Default)]
-struct BatchTally {
+pub struct BatchTally {
     lines: u64,
     hits: u64,
     pairs: u64,
@@ -155,34 +165,66 @@ pub fn tally_batches(
     batches: Range<u64>,
     wanted: Wanted,
 ) -> Result<Tally, TraceError> {
-    let per_batch: Vec<BatchTally> = batches
+    let per_batch = trace_batches(scene, tracer, plan, seed, batches, wanted, &|_| false)?;
+    Ok(Tally::from_batches(
+        scene,
+        wanted,
+        per_batch.iter().map(|b| b.as_ref().expect("never stopped")),
+    ))
+}
+
+/// Traces the batches `batches` of `plan` in parallel, each into its own [`BatchTally`], in batch order.
+///
+/// `stop(b)` is asked before batch `b` starts; a batch skipped because it said yes is `None`. Batches
+/// that already started always finish, so what was traced is whole batches.
+pub fn trace_batches(
+    scene: &Scene,
+    tracer: &dyn Tracer,
+    plan: &BatchPlan,
+    seed: u64,
+    batches: Range<u64>,
+    wanted: Wanted,
+    stop: &(dyn Fn(u64) -> bool + Sync),
+) -> Result<Vec<Option<BatchTally>>, TraceError> {
+    batches
         .into_par_iter()
         .map_init(Scratch::default, |scratch, b| {
-            tally_batch(scene, tracer, seed, b, plan.batch_len(b), wanted, scratch)
+            if stop(b) {
+                return Ok(None);
+            }
+            tally_batch(scene, tracer, seed, b, plan.batch_len(b), wanted, scratch).map(Some)
         })
-        .collect::<Result<_, _>>()?;
+        .collect()
+}
 
-    let mut tally = Tally::empty(scene, wanted);
-    let mut keys = Vec::with_capacity(per_batch.iter().map(|b| b.pair_keys.len()).sum());
-    for b in &per_batch {
-        tally.lines += b.lines;
-        tally.hits += b.hits;
-        tally.pairs += b.pairs;
-        tally.escapes += b.escapes;
-        tally.unpaired += b.unpaired;
-        tally.degenerate_pairs += b.degenerate_pairs;
-        tally.cmi_sum += b.cmi_sum;
-        tally.cmi_pairs += b.cmi_pairs;
-        keys.extend_from_slice(&b.pair_keys);
-        for &p in &b.escape_patches {
-            tally.escapes_by_patch[p as usize] += 1;
+impl Tally {
+    /// The tally of a set of batches, added in the order given (which fixes the f64 sums).
+    pub fn from_batches<'a>(
+        scene: &Scene,
+        wanted: Wanted,
+        batches: impl Iterator<Item = &'a BatchTally> + Clone,
+    ) -> Tally {
+        let mut tally = Tally::empty(scene, wanted);
+        let mut keys = Vec::with_capacity(batches.clone().map(|b| b.pair_keys.len()).sum());
+        for b in batches {
+            tally.lines += b.lines;
+            tally.hits += b.hits;
+            tally.pairs += b.pairs;
+            tally.escapes += b.escapes;
+            tally.unpaired += b.unpaired;
+            tally.degenerate_pairs += b.degenerate_pairs;
+            tally.cmi_sum += b.cmi_sum;
+            tally.cmi_pairs += b.cmi_pairs;
+            keys.extend_from_slice(&b.pair_keys);
+            for &p in &b.escape_patches {
+                tally.escapes_by_patch[p as usize] += 1;
+            }
         }
+        if wanted.discrete {
+            tally.counts = Some(PairCounts::from_keys(scene.patch_count(), &mut keys));
+        }
+        tally
     }
-    drop(per_batch);
-    if wanted.discrete {
-        tally.counts = Some(PairCounts::from_keys(scene.patch_count(), &mut keys));
-    }
-    Ok(tally)
 }
 
 fn tally_batch(

@@ -5,6 +5,7 @@
 use std::f64::consts::PI;
 
 use scene_complexity::scene::Scene;
+
 use scene_complexity::trace::{make_tracer, Backend, Query, Tracer};
 
 /// Form factor between two identical, directly opposed parallel rectangles `a x b` at distance `c`.
@@ -90,4 +91,155 @@ pub fn room_with_box_obj(scale: f64) -> String {
         s.push_str(&format!("f {}\n", idx.join(" ")));
     }
     s
+}
+
+/// An axis-aligned rectangle: `coord[fixed] = level`, spanning `lo..hi` on the two other axes.
+#[derive(Clone, Copy, Debug)]
+pub struct AxisRect {
+    pub fixed: usize,
+    pub level: f64,
+    pub lo: [f64; 3],
+    pub hi: [f64; 3],
+}
+
+impl AxisRect {
+    /// The rectangle of a patch whose polygon is axis-aligned (the patches of `@cube:N`).
+    pub fn of_patch(scene: &Scene, p: usize) -> AxisRect {
+        let pts: Vec<[f64; 3]> = scene.patches[p]
+            .polygon
+            .iter()
+            .map(|&v| scene.vertices[v as usize])
+            .collect();
+        let lo = [0, 1, 2].map(|a| pts.iter().map(|q| q[a]).fold(f64::INFINITY, f64::min));
+        let hi = [0, 1, 2].map(|a| pts.iter().map(|q| q[a]).fold(f64::NEG_INFINITY, f64::max));
+        let fixed = (0..3)
+            .find(|&a| hi[a] - lo[a] == 0.0)
+            .expect("an axis-aligned patch");
+        AxisRect {
+            fixed,
+            level: lo[fixed],
+            lo,
+            hi,
+        }
+    }
+
+    fn area(&self) -> f64 {
+        (0..3)
+            .filter(|&a| a != self.fixed)
+            .map(|a| self.hi[a] - self.lo[a])
+            .product()
+    }
+}
+
+/// `A_1 F_12` between two axis-aligned rectangles that see each other over no obstacle (parallel planes,
+/// or perpendicular planes on the same side of each other), by the superposition of corner terms
+/// (Howell's catalogue, C-16 and C-17). Zero for coplanar rectangles.
+pub fn area_form_factor(r1: &AxisRect, r2: &AxisRect) -> f64 {
+    if r1.fixed == r2.fixed {
+        let c = (r1.level - r2.level).abs();
+        if c == 0.0 {
+            return 0.0;
+        }
+        let (u, v) = other_axes(r1.fixed);
+        let g = |x: f64, y: f64| {
+            let (sy, sx) = ((y * y + c * c).sqrt(), (x * x + c * c).sqrt());
+            (x * sy * (x / sy).atan() + y * sx * (y / sx).atan()
+                - 0.5 * c * c * (x * x + y * y + c * c).ln())
+                / (2.0 * PI)
+        };
+        corner_sum(|i, j, k, l| {
+            g(
+                corner(r1, u, i) - corner(r2, u, k),
+                corner(r1, v, j) - corner(r2, v, l),
+            )
+        })
+    } else {
+        // Common axis b; x: distance of r1's points from r2's plane, xi: of r2's points from r1's plane.
+        let b = 3 - r1.fixed - r2.fixed;
+        let g = |x: f64, y: f64, xi: f64, eta: f64| {
+            let r2 = x * x + xi * xi;
+            let d = y - eta;
+            let t1 = if r2 > 0.0 {
+                d * r2.sqrt() * (d / r2.sqrt()).atan()
+            } else {
+                0.0
+            };
+            let q = r2 + d * d;
+            let t2 = if q > 0.0 {
+                0.25 * (r2 - d * d) * q.ln()
+            } else {
+                0.0
+            };
+            (t1 - t2) / (2.0 * PI)
+        };
+        // Distances from the common line, in increasing order so the alternating sum keeps its sign.
+        let dist = |r: &AxisRect, axis: usize, level: f64| {
+            let (p, q) = ((r.lo[axis] - level).abs(), (r.hi[axis] - level).abs());
+            [p.min(q), p.max(q)]
+        };
+        let (x, xi) = (dist(r1, r2.fixed, r2.level), dist(r2, r1.fixed, r1.level));
+        corner_sum(|i, j, k, l| g(x[i], corner(r1, b, j), xi[k], corner(r2, b, l)))
+    }
+}
+
+fn other_axes(a: usize) -> (usize, usize) {
+    ((a + 1) % 3, (a + 2) % 3)
+}
+
+fn corner(r: &AxisRect, axis: usize, which: usize) -> f64 {
+    if which == 0 {
+        r.lo[axis]
+    } else {
+        r.hi[axis]
+    }
+}
+
+fn corner_sum(f: impl Fn(usize, usize, usize, usize) -> f64) -> f64 {
+    let mut s = 0.0;
+    for i in 0..2 {
+        for j in 0..2 {
+            for k in 0..2 {
+                for l in 0..2 {
+                    let sign = if (i + j + k + l) % 2 == 0 { 1.0 } else { -1.0 };
+                    s += sign * f(i, j, k, l);
+                }
+            }
+        }
+    }
+    s
+}
+
+/// The exact form factors of `@cube:N` from patch `i` (one row), in the scene's patch order.
+pub fn cube_form_factor_row(scene: &Scene, rects: &[AxisRect], i: usize) -> Vec<f64> {
+    let a = rects[i].area();
+    let _ = scene;
+    rects
+        .iter()
+        .map(|r| area_form_factor(&rects[i], r) / a)
+        .collect()
+}
+
+/// Exact H_s (eq. 17) and I_s (eq. 21) of `@cube:N`: every patch has the same area, and the cube's
+/// symmetry maps every face onto face 0, so the rows of face 0's patches suffice.
+pub fn cube_exact_measures(n: usize) -> (f64, f64) {
+    use rayon::prelude::*;
+    let scene = scene_complexity::scene::load(&format!("@cube:{n}")).unwrap();
+    let rects: Vec<AxisRect> = (0..scene.patch_count())
+        .map(|p| AxisRect::of_patch(&scene, p))
+        .collect();
+    let n_p = scene.patch_count() as f64;
+    let face0: Vec<usize> = (0..scene.patch_count())
+        .filter(|&p| rects[p].fixed == rects[0].fixed && rects[p].level == rects[0].level)
+        .collect();
+    let entropy_sum: f64 = face0
+        .par_iter()
+        .map(|&i| {
+            cube_form_factor_row(&scene, &rects, i)
+                .iter()
+                .map(|&f| if f > 0.0 { -f * f.log2() } else { 0.0 })
+                .sum::<f64>()
+        })
+        .sum();
+    let h_s = entropy_sum / face0.len() as f64;
+    (h_s, n_p.log2() - h_s)
 }

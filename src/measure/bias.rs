@@ -1,0 +1,349 @@
+//! Bias-corrected H_s and I_s for undersampled form-factor rows.
+//!
+//! The plug-in H_s (eq. 17) puts the estimated `F_ij = N_ij / N_i` into `-F log F`. Row i is a multinomial
+//! sample of its `N_i` segments over the patches it sees, and the plug-in entropy of an undersampled
+//! multinomial is biased low (unseen patches count as impossible), so H_s reads low and I_s = H_p - H_s
+//! high: on the 30 x 30 cube at 10^7 lines each row holds ~2400 segments spread over ~1800 effectively
+//! visible patches, and the plug-in I_s is 70% too high (paper Table 2 shows the same).
+//!
+//! Each estimator here replaces the plug-in entropy of every row by a less biased one; H_s is their
+//! area-weighted sum, and `I_s = X - H_s` where `X = -sum_i a_i sum_j F_ij log a_j` is linear in F (so its
+//! ratio estimate is nearly unbiased; `X = H_p` in a closed scene). Escapes of an open scene are one more
+//! outcome of the row, whose own plug-in term is removed again, since eq. (17) sums over patches only.
+//!
+//! * Miller–Madow (1955): plug-in + (m - 1) / (2N) nats, m the outcomes seen. First order only.
+//! * Grassberger (2003): ln N - (1/N) sum_k n_k G(n_k), G(n) = psi(n) + (-1)^n / 2 (psi((n+1)/2) - psi(n/2)).
+//! * Chao–Shen (2003): coverage-adjusted Horvitz–Thompson, C = 1 - f1/N, p = C n/N,
+//!   H = -sum p ln p / (1 - (1 - p)^N).
+//! * Chao–Wang–Jost (2013): sum over seen outcomes of (n_k/N)(psi(N) - psi(n_k)) plus a term for the
+//!   unseen ones from the singletons f1 and doubletons f2; nearly unbiased even when most outcomes are
+//!   unseen.
+
+use ndarray::Array1;
+
+use super::visibility::{area_distribution, row_totals};
+use crate::sample::counts::PairCounts;
+
+/// An entropy estimator for the form-factor rows.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum EntropyEstimator {
+    /// The plug-in estimate of eq. (17), uncorrected.
+    PlugIn,
+    /// Miller–Madow's first-order correction.
+    MillerMadow,
+    /// Grassberger's 2003 estimator.
+    Grassberger,
+    /// Chao and Shen's coverage-adjusted estimator.
+    ChaoShen,
+    /// Chao, Wang and Jost's 2013 estimator.
+    ChaoWangJost,
+}
+
+impl EntropyEstimator {
+    /// Every estimator, for comparisons.
+    pub const ALL: [EntropyEstimator; 5] = [
+        EntropyEstimator::PlugIn,
+        EntropyEstimator::MillerMadow,
+        EntropyEstimator::Grassberger,
+        EntropyEstimator::ChaoShen,
+        EntropyEstimator::ChaoWangJost,
+    ];
+
+    /// A short name (`chao-wang-jost`).
+    pub fn name(self) -> &'static str {
+        match self {
+            EntropyEstimator::PlugIn => "plug-in",
+            EntropyEstimator::MillerMadow => "miller-madow",
+            EntropyEstimator::Grassberger => "grassberger",
+            EntropyEstimator::ChaoShen => "chao-shen",
+            EntropyEstimator::ChaoWangJost => "chao-wang-jost",
+        }
+    }
+
+    /// Parses a name as printed by [`EntropyEstimator::name`].
+    pub fn from_name(name: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|e| e.name() == name)
+    }
+}
+
+/// Bias-corrected discrete measures (bits).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CorrectedValues {
+    /// Eq. (17) with every row's entropy estimated by the chosen estimator.
+    pub entropy: f64,
+    /// `X - H_s` (eq. 20 in a closed scene).
+    pub mutual_information: f64,
+}
+
+/// Per-row statistics gathered in a first pass over the counts.
+struct RowStats {
+    total: Array1<f64>,
+    singletons: Array1<f64>,
+    doubletons: Array1<f64>,
+    seen: Array1<f64>,
+}
+
+/// Visits every outcome count of every row: `(row, count)` for each patch pair in both directions, and
+/// each row's escapes as one more outcome.
+fn for_each_outcome(counts: &PairCounts, escapes: &[u64], mut f: impl FnMut(usize, f64)) {
+    counts.for_each(|i, j, c| {
+        if i == j {
+            f(i as usize, 2.0 * c as f64);
+        } else {
+            f(i as usize, c as f64);
+            f(j as usize, c as f64);
+        }
+    });
+    for (i, &e) in escapes.iter().enumerate() {
+        if e > 0 {
+            f(i, e as f64);
+        }
+    }
+}
+
+fn row_stats(patches: usize, counts: &PairCounts, escapes: &[u64]) -> RowStats {
+    let mut s = RowStats {
+        total: row_totals(patches, counts, escapes),
+        singletons: Array1::zeros(patches),
+        doubletons: Array1::zeros(patches),
+        seen: Array1::zeros(patches),
+    };
+    for_each_outcome(counts, escapes, |i, x| {
+        s.seen[i] += 1.0;
+        if x == 1.0 {
+            s.singletons[i] += 1.0;
+        } else if x == 2.0 {
+            s.doubletons[i] += 1.0;
+        }
+    });
+    s
+}
+
+/// The bias-corrected H_s and I_s from the patch areas, pair counts and escapes.
+pub fn corrected(
+    areas: &[f64],
+    counts: &PairCounts,
+    escapes: &[u64],
+    estimator: EntropyEstimator,
+) -> CorrectedValues {
+    let n_p = areas.len();
+    let a = area_distribution(areas);
+    let stats = row_stats(n_p, counts, escapes);
+    let log2_a: Array1<f64> = a.mapv(|x| if x > 0.0 { x.log2() } else { 0.0 });
+
+    // Per-outcome part of each row's estimate (nats), then the per-row part.
+    let mut row_h = Array1::<f64>::zeros(n_p);
+    let mut cross = 0.0;
+    let coverage = stats_coverage(&stats);
+    for_each_outcome(counts, escapes, |i, x| {
+        row_h[i] += outcome_term(estimator, x, stats.total[i], coverage[i]);
+    });
+    counts.for_each(|i, j, c| {
+        let (i, j, c) = (i as usize, j as usize, c as f64);
+        if i == j {
+            cross -= a[i] * (2.0 * c / stats.total[i]) * log2_a[i];
+        } else {
+            cross -= a[i] * (c / stats.total[i]) * log2_a[j];
+            cross -= a[j] * (c / stats.total[j]) * log2_a[i];
+        }
+    });
+
+    let mut entropy = 0.0;
+    for i in 0..n_p {
+        let n = stats.total[i];
+        if n == 0.0 {
+            continue;
+        }
+        let nats = row_h[i]
+            + row_term(
+                estimator,
+                n,
+                stats.seen[i],
+                stats.singletons[i],
+                stats.doubletons[i],
+            );
+        // Eq. (17) sums over patches: take the escapes' own (plug-in) term out again.
+        let q = escapes.get(i).map_or(0.0, |&e| e as f64 / n);
+        let escape_nats = if q > 0.0 { -q * q.ln() } else { 0.0 };
+        entropy += a[i] * (nats - escape_nats) / std::f64::consts::LN_2;
+    }
+    CorrectedValues {
+        entropy,
+        mutual_information: cross - entropy,
+    }
+}
+
+/// Chao–Shen sample coverage per row, `1 - f1/N` (kept above 1/N so that no probability vanishes).
+fn stats_coverage(s: &RowStats) -> Array1<f64> {
+    ndarray::Zip::from(&s.total)
+        .and(&s.singletons)
+        .map_collect(|&n, &f1| {
+            if n <= 0.0 {
+                1.0
+            } else {
+                (1.0 - f1.min(n - 1.0) / n).max(1.0 / n)
+            }
+        })
+}
+
+/// The contribution (nats) of one outcome seen `x` times in a row of `n` samples.
+fn outcome_term(estimator: EntropyEstimator, x: f64, n: f64, coverage: f64) -> f64 {
+    match estimator {
+        EntropyEstimator::PlugIn | EntropyEstimator::MillerMadow => {
+            let p = x / n;
+            -p * p.ln()
+        }
+        EntropyEstimator::Grassberger => -x / n * grassberger_g(x),
+        EntropyEstimator::ChaoShen => {
+            let p = coverage * x / n;
+            let seen_probability = 1.0 - (1.0 - p).powf(n);
+            -p * p.ln() / seen_probability
+        }
+        EntropyEstimator::ChaoWangJost => {
+            if x < n {
+                x / n * (digamma(n) - digamma(x))
+            } else {
+                0.0
+            }
+        }
+    }
+}
+
+/// The per-row part (nats) of an estimator, given the row's size, outcomes seen, singletons, doubletons.
+fn row_term(estimator: EntropyEstimator, n: f64, seen: f64, f1: f64, f2: f64) -> f64 {
+    match estimator {
+        EntropyEstimator::PlugIn | EntropyEstimator::ChaoShen => 0.0,
+        EntropyEstimator::MillerMadow => (seen - 1.0) / (2.0 * n),
+        EntropyEstimator::Grassberger => n.ln(),
+        EntropyEstimator::ChaoWangJost => chao_wang_jost_unseen(n, f1, f2),
+    }
+}
+
+/// Grassberger's G(n) = psi(n) + (-1)^n / 2 (psi((n+1)/2) - psi(n/2)).
+fn grassberger_g(n: f64) -> f64 {
+    let sign = if n % 2.0 == 0.0 { 1.0 } else { -1.0 };
+    digamma(n) + 0.5 * sign * (digamma((n + 1.0) / 2.0) - digamma(n / 2.0))
+}
+
+/// The unseen-outcome term of Chao, Wang and Jost (2013), eq. (7):
+/// `f1/N (1-A)^(1-N) (-ln A - sum_{r=1}^{N-1} (1-A)^r / r)`, with
+/// `A = 2 f2 / ((N-1) f1 + 2 f2)` (or its f2 = 0 form). Written as the tail `sum_{m>=1} x^m / (m + N - 1)`,
+/// `x = 1 - A`, which needs no cancellation: summed directly when it converges fast, otherwise from the
+/// complement.
+fn chao_wang_jost_unseen(n: f64, f1: f64, f2: f64) -> f64 {
+    if f1 == 0.0 || n < 2.0 {
+        return 0.0;
+    }
+    let a = if f2 > 0.0 {
+        2.0 * f2 / ((n - 1.0) * f1 + 2.0 * f2)
+    } else {
+        2.0 / ((n - 1.0) * (f1 - 1.0) + 2.0)
+    };
+    if a >= 1.0 {
+        return 0.0;
+    }
+    let x = 1.0 - a;
+    let tail = if 40.0 / a < n {
+        // Geometric decay: ~40/A terms reach 1e-17.
+        let mut sum = 0.0;
+        let mut power = 1.0;
+        let mut m = 1.0;
+        loop {
+            power *= x;
+            let term = power / (m + n - 1.0);
+            sum += term;
+            if term < 1e-17 * sum {
+                break sum;
+            }
+            m += 1.0;
+        }
+    } else {
+        // tail = x^(1-N) (-ln A - sum_{r=1}^{N-1} x^r / r), summing the N - 1 terms.
+        let mut partial = 0.0;
+        let mut power = 1.0;
+        for r in 1..(n as u64) {
+            power *= x;
+            partial += power / r as f64;
+        }
+        (-(a.ln()) - partial).max(0.0) * x.powf(1.0 - n)
+    };
+    f1 / n * tail
+}
+
+/// The digamma function psi(x) for x > 0: recurrence up to x >= 10, then the asymptotic series.
+pub fn digamma(mut x: f64) -> f64 {
+    let mut result = 0.0;
+    while x < 10.0 {
+        result -= 1.0 / x;
+        x += 1.0;
+    }
+    let inv = 1.0 / x;
+    let inv2 = inv * inv;
+    result + x.ln()
+        - 0.5 * inv
+        - inv2
+            * (1.0 / 12.0
+                - inv2 * (1.0 / 120.0 - inv2 * (1.0 / 252.0 - inv2 * (1.0 / 240.0 - inv2 / 132.0))))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sample::counts::pair_key;
+
+    #[test]
+    fn digamma_matches_known_values() {
+        let euler = 0.577_215_664_901_532_9;
+        assert!((digamma(1.0) + euler).abs() < 1e-12);
+        assert!((digamma(0.5) + euler + 2.0 * 2f64.ln()).abs() < 1e-12);
+        // psi(n) = -gamma + H_{n-1}
+        let h: f64 = (1..100).map(|k| 1.0 / k as f64).sum();
+        assert!((digamma(100.0) - (-euler + h)).abs() < 1e-12);
+    }
+
+    /// With every outcome seen many times the corrections vanish: all estimators agree with the plug-in.
+    #[test]
+    fn well_sampled_rows_need_no_correction() {
+        let mut keys = Vec::new();
+        for (i, j) in [(0, 1), (0, 2), (1, 2)] {
+            keys.extend(std::iter::repeat_n(pair_key(i, j), 100_000));
+        }
+        let counts = PairCounts::from_keys(3, &mut keys);
+        let plug = corrected(&[1.0; 3], &counts, &[0; 3], EntropyEstimator::PlugIn);
+        assert!((plug.entropy - 1.0).abs() < 1e-12, "{plug:?}");
+        for e in EntropyEstimator::ALL {
+            let c = corrected(&[1.0; 3], &counts, &[0; 3], e);
+            assert!((c.entropy - plug.entropy).abs() < 1e-4, "{e:?}: {c:?}");
+            assert!((c.mutual_information - (3f64.log2() - c.entropy)).abs() < 1e-12);
+        }
+    }
+
+    /// Undersampled uniform rows: a row over 400 equally likely patches sampled 400 times. The plug-in
+    /// reads far below log2(400); the corrected estimators come much closer.
+    #[test]
+    fn corrections_reduce_the_bias_of_an_undersampled_uniform_row() {
+        use rand::{Rng, SeedableRng};
+        let n = 401usize;
+        let mut rng = rand_pcg::Pcg64::seed_from_u64(5);
+        let mut keys = Vec::new();
+        // Patch 0 sends 400 segments uniformly to patches 1..=400 (only row 0 is of interest).
+        for _ in 0..400 {
+            keys.push(pair_key(0, rng.gen_range(1..n as u32)));
+        }
+        let counts = PairCounts::from_keys(n, &mut keys);
+        // Only patch 0 has area, so H_s is row 0's entropy.
+        let mut areas = vec![1e-300; n];
+        areas[0] = 1.0;
+        let truth = 400f64.log2();
+        let err = |e| (corrected(&areas, &counts, &[0; 401], e).entropy - truth).abs();
+        let plug = err(EntropyEstimator::PlugIn);
+        assert!(plug > 0.4, "plug-in error {plug}");
+        for e in [
+            EntropyEstimator::Grassberger,
+            EntropyEstimator::ChaoShen,
+            EntropyEstimator::ChaoWangJost,
+        ] {
+            assert!(err(e) < 0.5 * plug, "{e:?}: {} vs plug-in {plug}", err(e));
+        }
+    }
+}
