@@ -6,7 +6,7 @@
 #[path = "../tests/support/mod.rs"]
 mod support;
 
-use scene_complexity::analysis::{analyze, AnalysisConfig, DEFAULT_GROUPS};
+use scene_complexity::analysis::{analyze, AnalysisConfig};
 use scene_complexity::measure::bias::{corrected, EntropyEstimator};
 use scene_complexity::sample::tally::Wanted;
 use scene_complexity::scene;

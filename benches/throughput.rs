@@ -7,7 +7,7 @@
 use std::time::Instant;
 
 use rayon::prelude::*;
-use scene_complexity::analysis::{analyze, AnalysisConfig, DEFAULT_GROUPS};
+use scene_complexity::analysis::{analyze, AnalysisConfig};
 use scene_complexity::sample::lines::batch_lines;
 use scene_complexity::sample::tally::Wanted;
 use scene_complexity::scene;
