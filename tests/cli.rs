@@ -121,3 +121,138 @@ fn bad_input_is_one_clear_error_with_exit_code_2() {
     assert_eq!(zero.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&zero.stderr).contains("whole number from 1"));
 }
+
+fn json_of(out: &std::process::Output) -> serde_json::Value {
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).expect("valid JSON")
+}
+
+#[test]
+fn corrected_estimates_are_reported_beside_the_plug_in() {
+    let doc = json_of(&scx(&[
+        "analyze", "@cube:3", "--lines", "2e4", "--format", "json",
+    ]));
+    for key in ["entropy", "mutual_information", "accuracy"] {
+        let c = &doc["visibility"][key]["corrected"];
+        assert!(
+            c["value"].as_f64().unwrap().is_finite() && c["stderr"].as_f64().unwrap() > 0.0,
+            "{key}: {c}"
+        );
+    }
+    assert_eq!(doc["estimator"], "chao-wang-jost");
+    assert_eq!(doc["stop_reason"], "lines");
+}
+
+#[test]
+fn budgets_stop_the_run_and_say_why() {
+    let doc = json_of(&scx(&[
+        "analyze",
+        "@cube:2",
+        "--seconds",
+        "0.3",
+        "--format",
+        "json",
+    ]));
+    assert_eq!(doc["stop_reason"], "seconds");
+    assert!(
+        doc["lines"].as_u64().unwrap() > 0 && doc["lines"].as_u64().unwrap() % 4096 == 0,
+        "whole batches"
+    );
+
+    let target = 0.004;
+    let doc = json_of(&scx(&[
+        "analyze",
+        "@cube:2",
+        "--target-stderr",
+        "0.004",
+        "--target-measure",
+        "continuous_mutual_information",
+        "--format",
+        "json",
+    ]));
+    assert_eq!(doc["stop_reason"], "target_stderr");
+    let se = doc["visibility"]["continuous_mutual_information"]["stderr"]
+        .as_f64()
+        .unwrap();
+    assert!(se <= target, "{se}");
+
+    let doc = json_of(&scx(&[
+        "analyze",
+        "@cube:2",
+        "--target-stderr",
+        "1e-9",
+        "--lines",
+        "3e5",
+        "--format",
+        "json",
+    ]));
+    assert_eq!(
+        doc["stop_reason"], "lines",
+        "the line cap ends a run whose target is out of reach"
+    );
+    assert_eq!(doc["lines"], 300_000);
+}
+
+#[test]
+fn ctrl_c_stops_cleanly_with_a_report_marked_interrupted() {
+    let child = Command::new(env!("CARGO_BIN_EXE_scx"))
+        .args(["analyze", "@cube:20", "--lines", "1e10", "--format", "json"])
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(std::time::Duration::from_millis(1000));
+    let status = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(status.success());
+    let out = child.wait_with_output().unwrap();
+    let doc = json_of(&out);
+    assert_eq!(doc["interrupted"], true);
+    assert_eq!(doc["stop_reason"], "interrupted");
+    assert!(doc["lines"].as_u64().unwrap() > 0);
+    assert!(doc["visibility"]["mutual_information"]["value"]
+        .as_f64()
+        .unwrap()
+        .is_finite());
+}
+
+#[test]
+fn convergence_writes_a_table_a_csv_and_a_plot() {
+    let dir = tempfile::tempdir().unwrap();
+    let (csv, svg) = (dir.path().join("c.csv"), dir.path().join("c.svg"));
+    let out = scx(&[
+        "convergence",
+        "@cube:2",
+        "--lines",
+        "1e3,1e4",
+        "--repeats",
+        "2",
+        "--csv",
+        csv.to_str().unwrap(),
+        "--plot",
+        svg.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let table = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        table.contains("I_s corrected") && table.contains("10000"),
+        "{table}"
+    );
+    let rows = std::fs::read_to_string(&csv).unwrap();
+    // 2 line counts x 2 repeats x 8 measures, plus the header.
+    assert_eq!(rows.lines().count(), 1 + 2 * 2 * 8, "{rows}");
+    let plot = std::fs::read_to_string(&svg).unwrap();
+    assert!(
+        plot.starts_with("<svg") && plot.contains("run time") && plot.contains("I_s corrected")
+    );
+}

@@ -1,5 +1,7 @@
 //! Command-line arguments and dispatch. Knows the library's public API only (never a backend's types).
 
+mod convergence;
+mod plot;
 mod progress;
 mod report;
 
@@ -9,8 +11,8 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand, ValueEnum};
 use scene_complexity::analysis::{
-    analyze_with, AnalysisConfig, Budget, RunControl, Target, TargetMeasure, DEFAULT_ESTIMATOR,
-    DEFAULT_GROUPS,
+    analyze_with, Analysis, AnalysisConfig, Budget, RunControl, Target, TargetMeasure,
+    DEFAULT_ESTIMATOR, DEFAULT_GROUPS,
 };
 use scene_complexity::measure::bias::EntropyEstimator;
 use scene_complexity::sample::tally::Wanted;
@@ -34,6 +36,8 @@ enum Command {
     Scenes,
     /// Write a scene (built-in or file) as OBJ + MTL.
     Export(ExportArgs),
+    /// Run a scene at growing line counts: every measure with its error against run time.
+    Convergence(ConvergenceArgs),
 }
 
 #[derive(clap::Args, Debug)]
@@ -45,28 +49,21 @@ struct ExportArgs {
     output: std::path::PathBuf,
 }
 
+/// Options shared by every command that casts lines.
 #[derive(clap::Args, Debug)]
-struct AnalyzeArgs {
-    /// An OBJ file, or a built-in scene such as `@cube:10` (see `scx scenes`).
-    scene: String,
-    /// Number of global lines (accepts `1e7`).
-    #[arg(long, value_parser = parse_count)]
-    lines: Option<u64>,
+struct RunOptions {
     /// Seed of the random line streams.
     #[arg(long, default_value_t = 1)]
     seed: u64,
     /// Worker threads (default: all cores). Results do not depend on it.
     #[arg(long)]
     threads: Option<usize>,
-    /// Tracing backend.
+    /// Tracing backend (default: embree when built in).
     #[arg(long, value_enum)]
     tracer: Option<TracerArg>,
     /// Ray query: `single`, or `packet4`/`packet8`/`packet16` (Embree, native widths only).
     #[arg(long, default_value = "single", value_parser = parse_query)]
     query: Query,
-    /// Which measures to compute (comma separated): discrete, continuous. Default: all.
-    #[arg(long, value_delimiter = ',', value_enum)]
-    measures: Option<Vec<MeasureArg>>,
     /// Independent groups of lines behind each standard error.
     #[arg(long, default_value_t = DEFAULT_GROUPS as u16, value_parser = clap::value_parser!(u16).range(2..=1024))]
     groups: u16,
@@ -74,6 +71,20 @@ struct AnalyzeArgs {
     /// chao-wang-jost.
     #[arg(long, default_value = DEFAULT_ESTIMATOR.name(), value_parser = parse_estimator)]
     estimator: EntropyEstimator,
+}
+
+#[derive(clap::Args, Debug)]
+struct AnalyzeArgs {
+    /// An OBJ file, or a built-in scene such as `@cube:10` (see `scx scenes`).
+    scene: String,
+    /// Number of global lines (accepts `1e7`; default 1e6, or no limit with a budget).
+    #[arg(long, value_parser = parse_count)]
+    lines: Option<u64>,
+    #[command(flatten)]
+    run: RunOptions,
+    /// Which measures to compute (comma separated): discrete, continuous. Default: all.
+    #[arg(long, value_delimiter = ',', value_enum)]
+    measures: Option<Vec<MeasureArg>>,
     /// Stop after this many seconds (then --lines is only a cap).
     #[arg(long, value_parser = parse_positive)]
     seconds: Option<f64>,
@@ -87,6 +98,26 @@ struct AnalyzeArgs {
     /// Output format.
     #[arg(long, value_enum, default_value_t = Format::Table)]
     format: Format,
+}
+
+#[derive(clap::Args, Debug)]
+struct ConvergenceArgs {
+    /// An OBJ file, or a built-in scene such as `@cube:30`.
+    scene: String,
+    /// The line counts to run, comma separated.
+    #[arg(long, value_delimiter = ',', value_parser = parse_count, default_value = "1e4,1e5,1e6,1e7")]
+    lines: Vec<u64>,
+    /// Runs per line count (seeds seed, seed+1, ...).
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=1000))]
+    repeats: u32,
+    #[command(flatten)]
+    run: RunOptions,
+    /// Also write every run's measures as CSV.
+    #[arg(long)]
+    csv: Option<std::path::PathBuf>,
+    /// Also draw error against run time, log-log (.svg or .png).
+    #[arg(long)]
+    plot: Option<std::path::PathBuf>,
 }
 
 #[derive(Clone, Copy, Debug, ValueEnum)]
@@ -170,6 +201,7 @@ pub fn main() -> ExitCode {
         }
         Command::Analyze(args) => finish(try_analyze(&args)),
         Command::Export(args) => finish(try_export(&args)),
+        Command::Convergence(args) => finish(convergence::run(&args)),
     }
 }
 
@@ -218,14 +250,79 @@ fn bad_input(message: impl ToString) -> Failure {
     }
 }
 
+/// A scene with its tracer and thread pool, ready to run analyses.
+struct Runner {
+    scene: scene::Scene,
+    tracer: Box<dyn scene_complexity::trace::Tracer>,
+    pool: rayon::ThreadPool,
+    threads: usize,
+    query: Query,
+    control: Arc<RunControl>,
+}
+
+impl Runner {
+    fn new(spec: &str, opts: &RunOptions) -> Result<Runner, Failure> {
+        let scene = load_scene(spec)?;
+        let backend = match opts.tracer {
+            Some(TracerArg::Embree) => Backend::Embree,
+            Some(TracerArg::Rust) => Backend::Rust,
+            None => Backend::default_available(),
+        };
+        let tracer = make_tracer(backend, &scene, opts.query).map_err(bad_input)?;
+        let threads = opts.threads.unwrap_or_else(|| {
+            std::thread::available_parallelism()
+                .map(|n| n.get())
+                .unwrap_or(1)
+        });
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .map_err(|e| bad_input(format!("cannot start {threads} threads: {e}")))?;
+        let control = Arc::new(RunControl::default());
+        watch_ctrl_c(&control);
+        Ok(Runner {
+            scene,
+            tracer,
+            pool,
+            threads,
+            query: opts.query,
+            control,
+        })
+    }
+
+    /// Runs one analysis with a progress bar (of `total` lines when known).
+    fn analyze(&self, cfg: &AnalysisConfig, total: Option<u64>) -> Result<Analysis, Failure> {
+        progress::while_running(&self.control, total, || {
+            self.pool
+                .install(|| analyze_with(&self.scene, self.tracer.as_ref(), cfg, &self.control))
+        })
+        .map_err(|e| Failure {
+            code: 1,
+            message: e.to_string(),
+        })
+    }
+
+    fn info(&self) -> report::RunInfo<'_> {
+        report::RunInfo {
+            scene: &self.scene,
+            tracer: self.tracer.name(),
+            query: self.query,
+            threads: self.threads,
+        }
+    }
+
+    /// A config for `lines` lines with these options.
+    fn config(&self, opts: &RunOptions, lines: u64, seed: u64) -> AnalysisConfig {
+        AnalysisConfig {
+            groups: usize::from(opts.groups),
+            estimator: opts.estimator,
+            ..AnalysisConfig::new(lines, seed)
+        }
+    }
+}
+
 fn try_analyze(args: &AnalyzeArgs) -> Result<(), Failure> {
-    let scene = load_scene(&args.scene)?;
-    let backend = match args.tracer {
-        Some(TracerArg::Embree) => Backend::Embree,
-        Some(TracerArg::Rust) => Backend::Rust,
-        None => Backend::default_available(),
-    };
-    let tracer = make_tracer(backend, &scene, args.query).map_err(bad_input)?;
+    let runner = Runner::new(&args.scene, &args.run)?;
     let wanted = match &args.measures {
         None => Wanted {
             discrete: true,
@@ -236,15 +333,6 @@ fn try_analyze(args: &AnalyzeArgs) -> Result<(), Failure> {
             continuous: m.contains(&MeasureArg::Continuous),
         },
     };
-    let threads = args.threads.unwrap_or_else(|| {
-        std::thread::available_parallelism()
-            .map(|n| n.get())
-            .unwrap_or(1)
-    });
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .map_err(|e| bad_input(format!("cannot start {threads} threads: {e}")))?;
     let budget = Budget {
         seconds: args.seconds,
         target: args.target_stderr.map(|stderr| Target {
@@ -260,29 +348,14 @@ fn try_analyze(args: &AnalyzeArgs) -> Result<(), Failure> {
     });
     let cfg = AnalysisConfig {
         wanted,
-        groups: usize::from(args.groups),
-        estimator: args.estimator,
         budget,
-        ..AnalysisConfig::new(lines, args.seed)
+        ..runner.config(&args.run, lines, args.run.seed)
     };
-    let control = Arc::new(RunControl::default());
-    watch_ctrl_c(&control);
-    let analysis = progress::while_running(&control, (!open_ended).then_some(lines), || {
-        pool.install(|| analyze_with(&scene, tracer.as_ref(), &cfg, &control))
-    })
-    .map_err(|e| Failure {
-        code: 1,
-        message: e.to_string(),
-    })?;
-    let run = report::RunInfo {
-        scene: &scene,
-        tracer: tracer.name(),
-        query: args.query,
-        threads,
-    };
-    for w in report::warnings(&scene, &analysis) {
+    let analysis = runner.analyze(&cfg, (!open_ended).then_some(lines))?;
+    for w in report::warnings(&runner.scene, &analysis) {
         eprintln!("scx: warning: {w}");
     }
+    let run = runner.info();
     let text = match args.format {
         Format::Table => report::table(&run, &analysis),
         Format::Json => report::json(&run, &analysis),

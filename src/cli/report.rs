@@ -20,16 +20,16 @@ pub struct RunInfo<'a> {
 }
 
 /// One row of the report: JSON key, table label, paper reference, plug-in and bias-corrected estimates.
-struct Row {
-    key: &'static str,
-    label: &'static str,
-    reference: &'static str,
-    estimate: Option<Estimate>,
-    corrected: Option<Estimate>,
+pub(super) struct Row {
+    pub key: &'static str,
+    pub label: &'static str,
+    pub reference: &'static str,
+    pub estimate: Option<Estimate>,
+    pub corrected: Option<Estimate>,
 }
 
 /// The visibility measures in report order.
-fn measures(a: &Analysis) -> Vec<Row> {
+pub(super) fn measures(a: &Analysis) -> Vec<Row> {
     let v = &a.visibility;
     let row = |key, label, reference, estimate, corrected| Row {
         key,
