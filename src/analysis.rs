@@ -108,6 +108,18 @@ pub fn analyze(
     tracer: &dyn Tracer,
     cfg: &AnalysisConfig,
 ) -> Result<Analysis, TraceError> {
+    analyze_observed(scene, tracer, cfg, &mut |_| {})
+}
+
+/// [`analyze`], also handing each group's tally to `each_group` (in group order, before it is merged),
+/// for measures that need their own per-group values, such as the radiosity measures
+/// ([`crate::radiosity`]).
+pub fn analyze_observed(
+    scene: &Scene,
+    tracer: &dyn Tracer,
+    cfg: &AnalysisConfig,
+    each_group: &mut dyn FnMut(&Tally),
+) -> Result<Analysis, TraceError> {
     let start = Instant::now();
     let plan = BatchPlan::new(cfg.lines);
     let batches = plan.batches();
@@ -120,6 +132,7 @@ pub fn analyze(
         let range = g * batches / groups..(g + 1) * batches / groups;
         let tally = tally_batches(scene, tracer, &plan, cfg.seed, range, cfg.wanted)?;
         per_group.push(GroupValues::of(scene, &areas, &tally));
+        each_group(&tally);
         merged.push(tally);
     }
     let total = merged

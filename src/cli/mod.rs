@@ -6,6 +6,9 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand, ValueEnum};
 use scene_complexity::analysis::{analyze, AnalysisConfig, DEFAULT_GROUPS};
+use scene_complexity::measure::radiosity::SolveOptions;
+use scene_complexity::radiosity::{analyze_with_radiosity, RadiosityOutcome};
+use scene_complexity::refine::{refine, RefineConfig, RefineRound, Strategy};
 use scene_complexity::sample::tally::Wanted;
 use scene_complexity::scene::{self, builtin};
 use scene_complexity::trace::{make_tracer, Backend, Query};
@@ -27,6 +30,47 @@ enum Command {
     Scenes,
     /// Write a scene (built-in or file) as OBJ + MTL.
     Export(ExportArgs),
+    /// Refine a scene's patches with a meshing strategy (paper Table 9) and write the mesh as OBJ + MTL.
+    Refine(RefineArgs),
+}
+
+#[derive(clap::Args, Debug)]
+struct RefineArgs {
+    /// An OBJ file, or a built-in scene such as `@cornell`.
+    scene: String,
+    /// Which patches to split: uniform (all, largest first), power (A_i B_i), smoothness (jumps of
+    /// received radiosity), information (loss of information transfer).
+    #[arg(long, value_enum)]
+    strategy: StrategyArg,
+    /// Stop at about this many patches (at most 2 over).
+    #[arg(long)]
+    patches: usize,
+    /// The OBJ file to write; the MTL library goes beside it.
+    #[arg(short, long)]
+    output: std::path::PathBuf,
+    /// Global lines per refinement round (accepts `1e6`).
+    #[arg(long, default_value = "1e6", value_parser = parse_count)]
+    lines: u64,
+    /// Each round grows the mesh by at most this factor.
+    #[arg(long, default_value_t = 1.5)]
+    growth: f64,
+    /// Seed of the first round's lines.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Worker threads (default: all cores).
+    #[arg(long)]
+    threads: Option<usize>,
+    /// Tracing backend.
+    #[arg(long, value_enum)]
+    tracer: Option<TracerArg>,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+enum StrategyArg {
+    Uniform,
+    Power,
+    Smoothness,
+    Information,
 }
 
 #[derive(clap::Args, Debug)]
@@ -57,7 +101,8 @@ struct AnalyzeArgs {
     /// Ray query: `single`, or `packet4`/`packet8`/`packet16` (Embree, native widths only).
     #[arg(long, default_value = "single", value_parser = parse_query)]
     query: Query,
-    /// Which measures to compute (comma separated): discrete, continuous. Default: all.
+    /// Which measures to compute (comma separated): discrete, continuous, radiosity. Default: all that
+    /// apply (radiosity needs an emitting material, and brings the discrete counts along).
     #[arg(long, value_delimiter = ',', value_enum)]
     measures: Option<Vec<MeasureArg>>,
     /// Independent groups of lines behind each standard error.
@@ -78,6 +123,7 @@ enum TracerArg {
 enum MeasureArg {
     Discrete,
     Continuous,
+    Radiosity,
 }
 
 /// Output formats of `analyze`.
@@ -128,6 +174,7 @@ pub fn main() -> ExitCode {
         }
         Command::Analyze(args) => finish(try_analyze(&args)),
         Command::Export(args) => finish(try_export(&args)),
+        Command::Refine(args) => finish(try_refine(&args)),
     }
 }
 
@@ -194,32 +241,41 @@ fn try_analyze(args: &AnalyzeArgs) -> Result<(), Failure> {
             continuous: m.contains(&MeasureArg::Continuous),
         },
     };
-    let threads = args.threads.unwrap_or_else(|| {
-        std::thread::available_parallelism()
-            .map(|n| n.get())
-            .unwrap_or(1)
-    });
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .map_err(|e| bad_input(format!("cannot start {threads} threads: {e}")))?;
+    let want_radiosity = match &args.measures {
+        None => true,
+        Some(m) => m.contains(&MeasureArg::Radiosity),
+    };
+    let (threads, pool) = thread_pool(args.threads)?;
     let cfg = AnalysisConfig {
         lines: args.lines,
         seed: args.seed,
         wanted,
         groups: usize::from(args.groups),
     };
-    let analysis = pool
-        .install(|| analyze(&scene, tracer.as_ref(), &cfg))
+    let (analysis, radiosity) = if want_radiosity {
+        pool.install(|| {
+            analyze_with_radiosity(&scene, tracer.as_ref(), &cfg, &SolveOptions::default())
+        })
         .map_err(|e| Failure {
-            code: 1,
+            code: if e.is_bad_input() { 2 } else { 1 },
             message: e.to_string(),
-        })?;
+        })?
+    } else {
+        let a = pool
+            .install(|| analyze(&scene, tracer.as_ref(), &cfg))
+            .map_err(|e| Failure {
+                code: 1,
+                message: e.to_string(),
+            })?;
+        let why = "not requested (--measures leaves radiosity out)".to_string();
+        (a, RadiosityOutcome::Skipped(why))
+    };
     let run = report::RunInfo {
         scene: &scene,
         tracer: tracer.name(),
         query: args.query,
         threads,
+        radiosity: &radiosity,
     };
     for w in report::warnings(&scene, &analysis) {
         eprintln!("scx: warning: {w}");
@@ -230,6 +286,83 @@ fn try_analyze(args: &AnalyzeArgs) -> Result<(), Failure> {
         Format::Csv => report::csv(&run, &analysis),
     };
     write_stdout(&text)
+}
+
+/// The worker threads (default: all cores) and a rayon pool of that size.
+fn thread_pool(threads: Option<usize>) -> Result<(usize, rayon::ThreadPool), Failure> {
+    let threads = threads.unwrap_or_else(|| {
+        std::thread::available_parallelism()
+            .map(|n| n.get())
+            .unwrap_or(1)
+    });
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .map_err(|e| bad_input(format!("cannot start {threads} threads: {e}")))?;
+    Ok((threads, pool))
+}
+
+fn try_refine(args: &RefineArgs) -> Result<(), Failure> {
+    let scene = load_scene(&args.scene)?;
+    let backend = match args.tracer {
+        Some(TracerArg::Embree) => Backend::Embree,
+        Some(TracerArg::Rust) => Backend::Rust,
+        None => Backend::default_available(),
+    };
+    // Check the backend once up front, so that an unavailable one is a clear input error.
+    make_tracer(backend, &scene, Query::Single).map_err(bad_input)?;
+    let strategy = match args.strategy {
+        StrategyArg::Uniform => Strategy::Uniform,
+        StrategyArg::Power => Strategy::Power,
+        StrategyArg::Smoothness => Strategy::Smoothness,
+        StrategyArg::Information => Strategy::Information,
+    };
+    let cfg = RefineConfig {
+        strategy,
+        target_patches: args.patches,
+        lines_per_round: args.lines,
+        seed: args.seed,
+        growth: args.growth,
+        solve: SolveOptions::default(),
+    };
+    let (_, pool) = thread_pool(args.threads)?;
+    let started = std::time::Instant::now();
+    let mut log = |r: &RefineRound| {
+        let mi = r
+            .radiosity_mutual_information
+            .map(|x| format!(", radiosity I_s {x:.4} (this round's lines)"))
+            .unwrap_or_default();
+        eprintln!(
+            "scx: refine {strategy}: {} -> {} patches, {} lines, {:.2} s{mi}",
+            r.patches_before, r.patches_after, r.lines, r.seconds
+        );
+    };
+    let refined = pool
+        .install(|| {
+            refine(
+                &scene,
+                &|s| make_tracer(backend, s, Query::Single),
+                &cfg,
+                &mut log,
+            )
+        })
+        .map_err(|e| Failure {
+            code: if e.is_bad_input() { 2 } else { 1 },
+            message: e.to_string(),
+        })?;
+    scene::obj::write(&refined.scene, &args.output).map_err(|e| Failure {
+        code: 1,
+        message: e.to_string(),
+    })?;
+    let lines: u64 = refined.rounds.iter().map(|r| r.lines).sum();
+    eprintln!(
+        "scx: wrote {} ({} patches) and its MTL library: {} rounds, {lines} lines, {:.2} s",
+        args.output.display(),
+        refined.scene.patch_count(),
+        refined.rounds.len(),
+        started.elapsed().as_secs_f64()
+    );
+    Ok(())
 }
 
 /// Writes a report to stdout; a reader that went away (`scx ... | head`) is not an error worth a panic.
