@@ -31,7 +31,7 @@ fn cornell_json_has_the_radiosity_object() {
         assert!(r[key]["stderr"].as_f64().unwrap() > 0.0, "{key}: {r}");
     }
     assert!(r["solver_residual"].as_f64().unwrap() <= 1e-10);
-    assert!(r["solver_sweeps"].as_u64().unwrap() > 0);
+    assert!(r["solver_iterations"].as_u64().unwrap() > 0);
     assert_eq!(r["excluded_patches"], 0);
     assert!(doc["radiosity_skipped"].is_null());
     // H_p - H_s = I_s holds for the transformed scene as for any closed one, up to sampling.

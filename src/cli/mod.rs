@@ -330,7 +330,7 @@ fn try_refine(args: &RefineArgs) -> Result<(), Failure> {
     let mut log = |r: &RefineRound| {
         let mi = r
             .radiosity_mutual_information
-            .map(|x| format!(", radiosity I_s {x:.4} (this round's lines)"))
+            .map(|x| format!(", radiosity I_s {x:.4} (plug-in, this round's lines only)"))
             .unwrap_or_default();
         eprintln!(
             "scx: refine {strategy}: {} -> {} patches, {} lines, {:.2} s{mi}",

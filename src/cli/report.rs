@@ -181,7 +181,7 @@ fn radiosity_json(outcome: &RadiosityOutcome) -> Value {
     }
     m.insert("solver_residual".into(), json!(finite(r.solver_residual)));
     m.insert("solver_tolerance".into(), json!(r.solver_tolerance));
-    m.insert("solver_sweeps".into(), json!(r.solver_sweeps));
+    m.insert("solver_iterations".into(), json!(r.solver_sweeps));
     m.insert("excluded_patches".into(), json!(r.excluded_patches));
     m.insert(
         "excluded_area_fraction".into(),
