@@ -38,8 +38,8 @@ enum Command {
 struct RefineArgs {
     /// An OBJ file, or a built-in scene such as `@cornell`.
     scene: String,
-    /// Which patches to split: uniform (all, largest first), power (A_i B_i), smoothness (jumps of
-    /// received radiosity), information (loss of information transfer).
+    /// Which patches to split: uniform (all, largest first), power (A_i B_i), smoothness (variation of
+    /// received radiosity over the patch), information (loss of information transfer).
     #[arg(long, value_enum)]
     strategy: StrategyArg,
     /// Stop at about this many patches (at most 2 over).
