@@ -148,8 +148,11 @@ pub fn refine(
             cfg.growth
         )));
     }
-    let materials = PatchMaterials::of_scene(scene).map_err(RadiosityError::from)?;
-    let lit = materials.any_emission();
+    // Uniform refinement needs no light and no valid materials: it only looks at the areas.
+    let lit = cfg.strategy != Strategy::Uniform
+        && PatchMaterials::of_scene(scene)
+            .map_err(RadiosityError::from)?
+            .any_emission();
     if !lit && matches!(cfg.strategy, Strategy::Power | Strategy::Smoothness) {
         return Err(RefineError::NeedsLight {
             scene: scene.name.clone(),

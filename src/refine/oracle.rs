@@ -6,7 +6,7 @@ use rayon::prelude::*;
 use crate::measure::radiosity::{FormFactors, Solution};
 use crate::measure::visibility::row_totals;
 use crate::sample::counts::pair_key;
-use crate::sample::counts::{split_key, PairCounts};
+use crate::sample::counts::PairCounts;
 use crate::sample::lines::batch_lines;
 use crate::sample::lines::orthonormal_basis;
 use crate::sample::pairs::{segments, LineF64, Segment};
@@ -19,7 +19,7 @@ use crate::trace::{Line, LineHits, RawHit, TraceError, Tracer};
 pub struct PairSample {
     /// Pair counts `N_ij` (sparse, sorted by pair key).
     pub counts: PairCounts,
-    /// Per entry of `counts` (same order): the sum of `log2 F(x, y)` over its pairs of points, with
+    /// Per entry of `counts` (in pair-key order, the order of [`PairCounts::for_each`]): the sum of `log2 F(x, y)` over its pairs of points, with
     /// `F(x, y) = cos_x cos_y / (pi d^2)` in tracing space (the point-to-point form factor of eq. (25)).
     pub log_kernel_sums: Vec<f64>,
     /// Per entry: how many pairs entered the sum (pairs of coincident points are left out).
@@ -281,22 +281,23 @@ pub fn information(areas: &[f64], sample: &PairSample, radiosity: Option<&Soluti
     let totals = row_totals(n, &sample.counts, &sample.escapes);
     let b = |i: usize| radiosity.map_or(1.0, |s| s.radiosity[i]);
     let mut score = vec![0.0; n];
-    let PairCounts::Sparse(list) = &sample.counts else {
-        unreachable!("sample_pairs builds sparse counts")
-    };
-    for (k, &(key, count)) in list.iter().enumerate() {
-        let (i, j) = split_key(key);
+    // Both layouts visit their entries in pair-key order, the order of the sums.
+    let mut k = 0;
+    sample.counts.for_each(|i, j, count| {
+        let entry = k;
+        k += 1;
         let (i, j) = (i as usize, j as usize);
-        if i == j || sample.log_kernel_pairs[k] == 0 {
-            continue; // A planar patch cannot see itself; no usable pair of points.
+        let used = sample.log_kernel_pairs[entry];
+        if i == j || used == 0 {
+            return; // A planar patch cannot see itself; no usable pair of points.
         }
-        let mean_log = sample.log_kernel_sums[k] / sample.log_kernel_pairs[k] as f64;
+        let mean_log = sample.log_kernel_sums[entry] / used as f64;
         let weight = b(i) * b(j);
         for (p, q) in [(i, j), (j, i)] {
             let f = count as f64 / totals[p];
             score[p] += weight * areas[p] * f * (mean_log - (f / areas[q]).log2());
         }
-    }
+    });
     score
 }
 
