@@ -279,6 +279,18 @@ pub fn analyze_with(
     cfg: &AnalysisConfig,
     control: &RunControl,
 ) -> Result<Analysis, TraceError> {
+    analyze_observed(scene, tracer, cfg, control, &mut |_| {})
+}
+
+/// [`analyze_with`], also handing each group's final tally to `each_group` (in group order), for
+/// measures that need their own per-group values, such as the radiosity measures ([`crate::radiosity`]).
+pub fn analyze_observed(
+    scene: &Scene,
+    tracer: &dyn Tracer,
+    cfg: &AnalysisConfig,
+    control: &RunControl,
+    each_group: &mut dyn FnMut(&Tally),
+) -> Result<Analysis, TraceError> {
     let start = Instant::now();
     let open_ended = cfg.budget.seconds.is_some() || cfg.budget.target.is_some();
     let plan = if open_ended {
@@ -356,7 +368,7 @@ pub fn analyze_with(
         round = round.min(max_round);
     };
 
-    let (total, per_group) = run.finish(&areas, cfg.estimator);
+    let (total, per_group) = run.finish(&areas, cfg.estimator, each_group);
     let all = GroupValues::of(&areas, &total, cfg.estimator);
     let visibility = if total.lines == 0 {
         VisibilityEstimates {
@@ -455,8 +467,14 @@ impl<'a> GroupedRun<'a> {
     }
 
     /// The merged total and every non-empty group's values.
-    fn finish(self, areas: &[f64], estimator: EntropyEstimator) -> (Tally, Vec<GroupValues>) {
+    fn finish(
+        self,
+        areas: &[f64],
+        estimator: EntropyEstimator,
+        each_group: &mut dyn FnMut(&Tally),
+    ) -> (Tally, Vec<GroupValues>) {
         let filled: Vec<Tally> = self.groups.into_iter().flatten().collect();
+        filled.iter().for_each(&mut *each_group);
         let per_group = filled
             .iter()
             .map(|t| GroupValues::of(areas, t, estimator))

@@ -8,6 +8,8 @@
 
 pub mod analysis;
 pub mod measure;
+pub mod radiosity;
+pub mod refine;
 pub mod sample;
 pub mod scene;
 pub mod trace;

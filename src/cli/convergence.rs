@@ -180,7 +180,9 @@ fn curves(levels: &[Level]) -> Vec<Curve> {
 
 fn table(runner: &Runner, levels: &[Level], repeats: u32) -> String {
     let mut s = String::new();
-    let info = runner.info();
+    let skipped =
+        scene_complexity::radiosity::RadiosityOutcome::Skipped("not part of convergence".into());
+    let info = runner.info(&skipped);
     let _ = writeln!(
         s,
         "scene {} ({} patches), tracer {}, {} thread(s), {repeats} run(s) per line count (means shown)\n",

@@ -15,6 +15,9 @@ use scene_complexity::analysis::{
     DEFAULT_ESTIMATOR, DEFAULT_GROUPS,
 };
 use scene_complexity::measure::bias::EntropyEstimator;
+use scene_complexity::measure::radiosity::SolveOptions;
+use scene_complexity::radiosity::{analyze_with_radiosity, RadiosityOutcome};
+use scene_complexity::refine::{refine, RefineConfig, RefineRound, Strategy};
 use scene_complexity::sample::tally::Wanted;
 use scene_complexity::scene::{self, builtin};
 use scene_complexity::trace::{make_tracer, Backend, Query};
@@ -38,6 +41,47 @@ enum Command {
     Export(ExportArgs),
     /// Run a scene at growing line counts: every measure with its error against run time.
     Convergence(ConvergenceArgs),
+    /// Refine a scene's patches with a meshing strategy (paper Table 9) and write the mesh as OBJ + MTL.
+    Refine(RefineArgs),
+}
+
+#[derive(clap::Args, Debug)]
+struct RefineArgs {
+    /// An OBJ file, or a built-in scene such as `@cornell`.
+    scene: String,
+    /// Which patches to split: uniform (all, largest first), power (A_i B_i), smoothness (variation of
+    /// received radiosity over the patch), information (loss of information transfer).
+    #[arg(long, value_enum)]
+    strategy: StrategyArg,
+    /// Stop at about this many patches (at most 2 over).
+    #[arg(long)]
+    patches: usize,
+    /// The OBJ file to write; the MTL library goes beside it.
+    #[arg(short, long)]
+    output: std::path::PathBuf,
+    /// Global lines per refinement round (accepts `1e6`).
+    #[arg(long, default_value = "1e6", value_parser = parse_count)]
+    lines: u64,
+    /// Each round grows the mesh by at most this factor.
+    #[arg(long, default_value_t = 1.5)]
+    growth: f64,
+    /// Seed of the first round's lines.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Worker threads (default: all cores).
+    #[arg(long)]
+    threads: Option<usize>,
+    /// Tracing backend.
+    #[arg(long, value_enum)]
+    tracer: Option<TracerArg>,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+enum StrategyArg {
+    Uniform,
+    Power,
+    Smoothness,
+    Information,
 }
 
 #[derive(clap::Args, Debug)]
@@ -82,7 +126,8 @@ struct AnalyzeArgs {
     lines: Option<u64>,
     #[command(flatten)]
     run: RunOptions,
-    /// Which measures to compute (comma separated): discrete, continuous. Default: all.
+    /// Which measures to compute (comma separated): discrete, continuous, radiosity. Default: all that
+    /// apply (radiosity needs an emitting material, and brings the discrete counts along).
     #[arg(long, value_delimiter = ',', value_enum)]
     measures: Option<Vec<MeasureArg>>,
     /// Stop after this many seconds (then --lines is only a cap).
@@ -130,6 +175,7 @@ enum TracerArg {
 enum MeasureArg {
     Discrete,
     Continuous,
+    Radiosity,
 }
 
 /// Output formats of `analyze`.
@@ -202,6 +248,7 @@ pub fn main() -> ExitCode {
         Command::Analyze(args) => finish(try_analyze(&args)),
         Command::Export(args) => finish(try_export(&args)),
         Command::Convergence(args) => finish(convergence::run(&args)),
+        Command::Refine(args) => finish(try_refine(&args)),
     }
 }
 
@@ -269,15 +316,7 @@ impl Runner {
             None => Backend::default_available(),
         };
         let tracer = make_tracer(backend, &scene, opts.query).map_err(bad_input)?;
-        let threads = opts.threads.unwrap_or_else(|| {
-            std::thread::available_parallelism()
-                .map(|n| n.get())
-                .unwrap_or(1)
-        });
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .map_err(|e| bad_input(format!("cannot start {threads} threads: {e}")))?;
+        let (threads, pool) = thread_pool(opts.threads)?;
         let control = Arc::new(RunControl::default());
         watch_ctrl_c(&control);
         Ok(Runner {
@@ -302,12 +341,36 @@ impl Runner {
         })
     }
 
-    fn info(&self) -> report::RunInfo<'_> {
+    /// Runs one analysis with the radiosity measures (when the scene emits) and a progress bar.
+    fn analyze_radiosity(
+        &self,
+        cfg: &AnalysisConfig,
+        total: Option<u64>,
+    ) -> Result<(Analysis, RadiosityOutcome), Failure> {
+        progress::while_running(&self.control, total, || {
+            self.pool.install(|| {
+                analyze_with_radiosity(
+                    &self.scene,
+                    self.tracer.as_ref(),
+                    cfg,
+                    &SolveOptions::default(),
+                    &self.control,
+                )
+            })
+        })
+        .map_err(|e| Failure {
+            code: if e.is_bad_input() { 2 } else { 1 },
+            message: e.to_string(),
+        })
+    }
+
+    fn info<'a>(&'a self, radiosity: &'a RadiosityOutcome) -> report::RunInfo<'a> {
         report::RunInfo {
             scene: &self.scene,
             tracer: self.tracer.name(),
             query: self.query,
             threads: self.threads,
+            radiosity,
         }
     }
 
@@ -351,17 +414,104 @@ fn try_analyze(args: &AnalyzeArgs) -> Result<(), Failure> {
         budget,
         ..runner.config(&args.run, lines, args.run.seed)
     };
-    let analysis = runner.analyze(&cfg, (!open_ended).then_some(lines))?;
+    let want_radiosity = args
+        .measures
+        .as_ref()
+        .is_none_or(|m| m.contains(&MeasureArg::Radiosity));
+    let total = (!open_ended).then_some(lines);
+    let (analysis, radiosity) = if want_radiosity {
+        runner.analyze_radiosity(&cfg, total)?
+    } else {
+        let why = "not requested (--measures leaves radiosity out)".to_string();
+        (runner.analyze(&cfg, total)?, RadiosityOutcome::Skipped(why))
+    };
     for w in report::warnings(&runner.scene, &analysis) {
         eprintln!("scx: warning: {w}");
     }
-    let run = runner.info();
+    let run = runner.info(&radiosity);
     let text = match args.format {
         Format::Table => report::table(&run, &analysis),
         Format::Json => report::json(&run, &analysis),
         Format::Csv => report::csv(&run, &analysis),
     };
     write_stdout(&text)
+}
+
+fn try_refine(args: &RefineArgs) -> Result<(), Failure> {
+    let scene = load_scene(&args.scene)?;
+    let backend = match args.tracer {
+        Some(TracerArg::Embree) => Backend::Embree,
+        Some(TracerArg::Rust) => Backend::Rust,
+        None => Backend::default_available(),
+    };
+    // Check the backend once up front, so that an unavailable one is a clear input error.
+    make_tracer(backend, &scene, Query::Single).map_err(bad_input)?;
+    let strategy = match args.strategy {
+        StrategyArg::Uniform => Strategy::Uniform,
+        StrategyArg::Power => Strategy::Power,
+        StrategyArg::Smoothness => Strategy::Smoothness,
+        StrategyArg::Information => Strategy::Information,
+    };
+    let cfg = RefineConfig {
+        strategy,
+        target_patches: args.patches,
+        lines_per_round: args.lines,
+        seed: args.seed,
+        growth: args.growth,
+        solve: SolveOptions::default(),
+    };
+    let (_, pool) = thread_pool(args.threads)?;
+    let started = std::time::Instant::now();
+    let mut log = |r: &RefineRound| {
+        let mi = r
+            .radiosity_mutual_information
+            .map(|x| format!(", radiosity I_s {x:.4} (plug-in, this round's lines only)"))
+            .unwrap_or_default();
+        eprintln!(
+            "scx: refine {strategy}: {} -> {} patches, {} lines, {:.2} s{mi}",
+            r.patches_before, r.patches_after, r.lines, r.seconds
+        );
+    };
+    let refined = pool
+        .install(|| {
+            refine(
+                &scene,
+                &|s| make_tracer(backend, s, Query::Single),
+                &cfg,
+                &mut log,
+            )
+        })
+        .map_err(|e| Failure {
+            code: if e.is_bad_input() { 2 } else { 1 },
+            message: e.to_string(),
+        })?;
+    scene::obj::write(&refined.scene, &args.output).map_err(|e| Failure {
+        code: 1,
+        message: e.to_string(),
+    })?;
+    let lines: u64 = refined.rounds.iter().map(|r| r.lines).sum();
+    eprintln!(
+        "scx: wrote {} ({} patches) and its MTL library: {} rounds, {lines} lines, {:.2} s",
+        args.output.display(),
+        refined.scene.patch_count(),
+        refined.rounds.len(),
+        started.elapsed().as_secs_f64()
+    );
+    Ok(())
+}
+
+/// The worker threads (default: all cores) and a rayon pool of that size.
+fn thread_pool(threads: Option<usize>) -> Result<(usize, rayon::ThreadPool), Failure> {
+    let threads = threads.unwrap_or_else(|| {
+        std::thread::available_parallelism()
+            .map(|n| n.get())
+            .unwrap_or(1)
+    });
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .map_err(|e| bad_input(format!("cannot start {threads} threads: {e}")))?;
+    Ok((threads, pool))
 }
 
 /// The first Ctrl-C asks the run to stop and report what it gathered; a second one ends the program.

@@ -4,6 +4,7 @@ use std::fmt::Write;
 
 use scene_complexity::analysis::{Analysis, StopReason};
 use scene_complexity::measure::Estimate;
+use scene_complexity::radiosity::{RadiosityEstimates, RadiosityOutcome};
 use scene_complexity::scene::Scene;
 use scene_complexity::trace::Query;
 use serde_json::{json, Value};
@@ -17,6 +18,8 @@ pub struct RunInfo<'a> {
     pub tracer: &'static str,
     pub query: Query,
     pub threads: usize,
+    /// The radiosity measures, or why they were left out.
+    pub radiosity: &'a RadiosityOutcome,
 }
 
 /// One row of the report: JSON key, table label, paper reference, plug-in and bias-corrected estimates.
@@ -179,6 +182,11 @@ pub fn json(run: &RunInfo, a: &Analysis) -> String {
         "unsampled_patches": a.unsampled.map(|u| u.0),
         "unsampled_area_fraction": a.unsampled.map(|u| u.1),
         "visibility": Value::Object(visibility),
+        "radiosity": radiosity_json(run.radiosity),
+        "radiosity_skipped": match run.radiosity {
+            RadiosityOutcome::Skipped(reason) => Value::from(reason.as_str()),
+            RadiosityOutcome::Computed(_) => Value::Null,
+        },
         "warnings": warnings(run.scene, a),
     });
     let mut s = serde_json::to_string_pretty(&doc).expect("a JSON value always serialises");
@@ -186,8 +194,80 @@ pub fn json(run: &RunInfo, a: &Analysis) -> String {
     s
 }
 
+/// The radiosity measures in report order: (key, table label, paper reference, estimate).
+fn radiosity_measures(
+    r: &RadiosityEstimates,
+) -> [(&'static str, &'static str, &'static str, Estimate); 3] {
+    [
+        (
+            "positional_entropy",
+            "radiosity positional entropy H_p",
+            "eq. 33",
+            r.positional_entropy,
+        ),
+        ("entropy", "radiosity entropy H_s", "eq. 34", r.entropy),
+        (
+            "mutual_information",
+            "radiosity mutual information I_s",
+            "eq. 35",
+            r.mutual_information,
+        ),
+    ]
+}
+
+/// The `radiosity` object of the JSON report (`null` when skipped).
+fn radiosity_json(outcome: &RadiosityOutcome) -> Value {
+    let RadiosityOutcome::Computed(r) = outcome else {
+        return Value::Null;
+    };
+    let mut m = serde_json::Map::new();
+    for (key, _, _, e) in radiosity_measures(r) {
+        m.insert(key.into(), estimate_json(Some(e)));
+    }
+    m.insert("solver_residual".into(), json!(finite(r.solver_residual)));
+    m.insert("solver_tolerance".into(), json!(r.solver_tolerance));
+    m.insert("solver_iterations".into(), json!(r.solver_sweeps));
+    m.insert("excluded_patches".into(), json!(r.excluded_patches));
+    m.insert(
+        "excluded_area_fraction".into(),
+        json!(finite(r.excluded_area_fraction)),
+    );
+    Value::Object(m)
+}
+
+/// The radiosity lines of the table.
+fn radiosity_table(s: &mut String, outcome: &RadiosityOutcome) {
+    match outcome {
+        RadiosityOutcome::Skipped(reason) => {
+            let _ = writeln!(s, "\nradiosity measures left out: {reason}");
+        }
+        RadiosityOutcome::Computed(r) => {
+            let _ = writeln!(s);
+            for (_, label, reference, e) in radiosity_measures(r) {
+                let _ = writeln!(
+                    s,
+                    "{label:<36} {:>12.6} {:>10}  {:>23}  {reference}",
+                    e.value,
+                    stderr_text(e),
+                    ""
+                );
+            }
+            let _ = writeln!(
+                s,
+                "radiosity: B = E + R F B solved by Gauss-Seidel to relative residual {:.1e} (tolerance {:.0e}) \
+                 in {} sweeps; {} patch(es) ({:.4}% of the area) receive or send no light and leave the channel",
+                r.solver_residual,
+                r.solver_tolerance,
+                r.solver_sweeps,
+                r.excluded_patches,
+                100.0 * r.excluded_area_fraction
+            );
+        }
+    }
+}
+
 /// `measure,value,stderr` rows with a header.
-pub fn csv(_run: &RunInfo, a: &Analysis) -> String {
+pub fn csv(run: &RunInfo, a: &Analysis) -> String {
     let mut s = String::from("measure,value,stderr,corrected,corrected_stderr\n");
     let field = |e: Option<Estimate>| {
         (
@@ -201,6 +281,12 @@ pub fn csv(_run: &RunInfo, a: &Analysis) -> String {
         if r.estimate.is_some() {
             let ((v, se), (c, cse)) = (field(r.estimate), field(r.corrected));
             let _ = writeln!(s, "{},{v},{se},{c},{cse}", r.key);
+        }
+    }
+    if let RadiosityOutcome::Computed(r) = run.radiosity {
+        for (key, _, _, e) in radiosity_measures(r) {
+            let (v, se) = field(Some(e));
+            let _ = writeln!(s, "radiosity_{key},{v},{se},,");
         }
     }
     s
@@ -262,6 +348,7 @@ pub fn table(run: &RunInfo, a: &Analysis) -> String {
             );
         }
     }
+    radiosity_table(&mut s, run.radiosity);
     let _ = writeln!(
         s,
         "\nstandard errors: spread of {} independent groups of lines / sqrt({}) (statistical error only).\n\

@@ -1,10 +1,11 @@
-//! The paper's measures, computed from counts and sums (sections 3.1, 3.2, 3.3).
+//! The paper's measures, computed from counts and sums (sections 3.1, 3.2, 3.3, and 4 for radiosity).
 //!
 //! Logarithms are base 2 (bits). `0 log 0 = 0` everywhere ([`entropy::xlog2x`]).
 
 pub mod bias;
 pub mod entropy;
 pub mod estimate;
+pub mod radiosity;
 pub mod visibility;
 
 pub use estimate::Estimate;

@@ -8,6 +8,11 @@
 //! * `@tetrahedron`, `@octahedron`, `@icosahedron` (`:N` cuts each triangular face into N^2 equal
 //!   triangles) and `@dodecahedron` (one pentagon patch per face; `:N` cuts each pentagon into 5 triangles
 //!   from its centre, then each into N^2): the interiors of the regular solids, circumradius 1.
+//! * `@cornell[:N]` and `@cornell-open[:N]`: the Cornell box, see [`super::cornell`].
+//!
+//! Materials: every built-in but the Cornell box has one material, `wall`, with reflectance R = 0.5 and
+//! no emission (an even grey; nothing emits, so these scenes have no radiosity measures). The Cornell box
+//! has its published materials and a light.
 
 use super::build::{cross, dot, norm, sub};
 use super::{Material, Scene, SceneBuilder, SceneError};
@@ -47,6 +52,15 @@ pub const BUILTINS: &[BuiltinInfo] = &[
         usage: "@dodecahedron[:N]",
         description: "regular dodecahedron interior, one pentagon per face; N > 1 cuts each into 5 N^2 triangles",
     },
+    BuiltinInfo {
+        usage: "@cornell[:N]",
+        description: "the Cornell box (published geometry, mm), closed by a white front wall; light E = 10.93, \
+                      white/red/green R = 0.723/0.243/0.198; 29 N^2 patches",
+    },
+    BuiltinInfo {
+        usage: "@cornell-open[:N]",
+        description: "the Cornell box as published, open at the front (lines escape there); 28 N^2 patches",
+    },
 ];
 
 /// Builds a built-in scene from its name (`@cube:10`).
@@ -63,6 +77,8 @@ pub fn build(spec: &str) -> Result<Scene, SceneError> {
         "octahedron" => solid(spec, &octahedron(), parse_count(spec, param, 1, 1000)?),
         "icosahedron" => solid(spec, &icosahedron(), parse_count(spec, param, 1, 1000)?),
         "dodecahedron" => solid(spec, &dodecahedron(), parse_count(spec, param, 1, 1000)?),
+        "cornell" => super::cornell::build(spec, parse_count(spec, param, 1, 100)?, true),
+        "cornell-open" => super::cornell::build(spec, parse_count(spec, param, 1, 100)?, false),
         _ => Err(SceneError::Builtin(format!(
             "{spec}: unknown built-in scene; `scx scenes` lists them ({})",
             BUILTINS

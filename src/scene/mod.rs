@@ -7,6 +7,7 @@
 
 mod build;
 pub mod builtin;
+pub mod cornell;
 pub mod obj;
 
 pub use build::SceneBuilder;
@@ -15,7 +16,10 @@ use std::fmt;
 
 /// Diffuse material of a patch (paper eq. (2)): emission `E_i` and reflectance `R_i`, one channel each.
 ///
-/// From an MTL file, the single value is the mean of the three RGB channels of `Ke` and `Kd`.
+/// From an MTL file, the single value is the mean of the three RGB channels of `Ke` and `Kd` (exactly the
+/// value of a grey triple): the response to an equal-energy white light with every channel weighted
+/// alike. The radiosity measures (paper sec. 4) use these values; they require `0 <= R_i <= 1` and
+/// `E_i >= 0` (see [`crate::measure::radiosity::PatchMaterials`]).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Material {
     /// Name as in the MTL file, or a built-in name.

@@ -107,11 +107,11 @@ pub fn load(path: &Path) -> Result<Scene, SceneError> {
 }
 
 fn convert_material(m: &tobj::Material) -> Material {
-    let mean = |c: [f64; 3]| (c[0] + c[1] + c[2]) / 3.0;
+    let mean = grey_value;
+    // tobj 4 parses `Ke` into `emissive`; the key-value fallback covers readers that leave it unknown.
     let emission = m
-        .unknown_param
-        .get("Ke")
-        .and_then(|s| parse_rgb(s))
+        .emissive
+        .or_else(|| m.unknown_param.get("Ke").and_then(|s| parse_rgb(s)))
         .map(mean)
         .unwrap_or(0.0);
     Material {
@@ -121,6 +121,17 @@ fn convert_material(m: &tobj::Material) -> Material {
             .diffuse
             .map(mean)
             .unwrap_or(Material::default().reflectance),
+    }
+}
+
+/// One channel from RGB: the plain mean (the value seen under an equal-energy white light, the same
+/// weight for each channel). A grey triple gives its value exactly, so that an MTL written by [`write`]
+/// reads back bit-identical (the mean of three equal values can be off by an ulp).
+fn grey_value(c: [f64; 3]) -> f64 {
+    if c[0] == c[1] && c[1] == c[2] {
+        c[0]
+    } else {
+        (c[0] + c[1] + c[2]) / 3.0
     }
 }
 

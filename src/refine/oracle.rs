@@ -1,0 +1,307 @@
+//! What a refinement round measures: pair counts with the sum of `log2 F(x, y)` per patch pair, and the
+//! per-patch scores of the strategies.
+
+use rayon::prelude::*;
+
+use crate::measure::radiosity::{FormFactors, Solution};
+use crate::measure::visibility::row_totals;
+use crate::sample::counts::pair_key;
+use crate::sample::counts::PairCounts;
+use crate::sample::lines::batch_lines;
+use crate::sample::lines::orthonormal_basis;
+use crate::sample::pairs::{segments, LineF64, Segment};
+use crate::sample::tally::BatchPlan;
+use crate::scene::Scene;
+use crate::trace::{Line, LineHits, RawHit, TraceError, Tracer};
+
+/// What one round's lines found, per unordered patch pair.
+#[derive(Clone, Debug)]
+pub struct PairSample {
+    /// Pair counts `N_ij` (sparse, sorted by pair key).
+    pub counts: PairCounts,
+    /// Per entry of `counts` (in pair-key order, the order of [`PairCounts::for_each`]): the sum of `log2 F(x, y)` over its pairs of points, with
+    /// `F(x, y) = cos_x cos_y / (pi d^2)` in tracing space (the point-to-point form factor of eq. (25)).
+    pub log_kernel_sums: Vec<f64>,
+    /// Per entry: how many pairs entered the sum (pairs of coincident points are left out).
+    pub log_kernel_pairs: Vec<u64>,
+    /// Escapes per patch.
+    pub escapes: Vec<u64>,
+}
+
+/// Per-thread buffers.
+#[derive(Default)]
+struct Scratch {
+    lines: Vec<Line>,
+    raw: Vec<RawHit>,
+    hits: LineHits,
+}
+
+/// Traces `lines` global lines in batches (in parallel) and hands every segment, with its line, to
+/// `visit`, which fills one `T` per batch; the results come back in batch order, so whatever is merged
+/// from them does not depend on the thread count.
+fn trace_segments<T: Default + Send>(
+    scene: &Scene,
+    tracer: &dyn Tracer,
+    lines: u64,
+    seed: u64,
+    visit: impl Fn(&LineF64, Segment, &mut T) + Sync,
+) -> Result<Vec<T>, TraceError> {
+    let plan = BatchPlan::new(lines);
+    (0..plan.batches())
+        .into_par_iter()
+        .map_init(Scratch::default, |s, b| {
+            s.lines.clear();
+            batch_lines(
+                seed,
+                b,
+                plan.batch_len(b),
+                scene.bounding_radius(),
+                &mut s.lines,
+            );
+            tracer.all_hits(&s.lines, &mut s.raw, &mut s.hits)?;
+            let mut out = T::default();
+            for (k, line) in s.lines.iter().enumerate() {
+                let l = LineF64::from(line);
+                segments(scene, line, s.hits.of_line(k), |seg| {
+                    visit(&l, seg, &mut out)
+                });
+            }
+            Ok(out)
+        })
+        .collect()
+}
+
+/// Casts `lines` global lines and gathers a [`PairSample`].
+pub fn sample_pairs(
+    scene: &Scene,
+    tracer: &dyn Tracer,
+    lines: u64,
+    seed: u64,
+) -> Result<PairSample, TraceError> {
+    let log2_pi = std::f64::consts::PI.log2();
+    let per_batch = trace_segments(
+        scene,
+        tracer,
+        lines,
+        seed,
+        |_, seg, out: &mut (Vec<(u64, f64)>, Vec<u32>)| match seg {
+            Segment::Pair {
+                from,
+                to,
+                distance,
+                cos_from,
+                cos_to,
+            } => {
+                // Coincident points (d = 0) give an infinite kernel: NaN keeps them out of the sum.
+                let term = if distance > 0.0 && cos_from * cos_to > 0.0 {
+                    (cos_from * cos_to / (distance * distance)).log2() - log2_pi
+                } else {
+                    f64::NAN
+                };
+                out.0.push((pair_key(from, to), term));
+            }
+            Segment::Escape { patch } => out.1.push(patch),
+            Segment::Unpaired => {}
+        },
+    )?;
+    let mut escapes = vec![0u64; scene.patch_count()];
+    let mut terms: Vec<(u64, f64)> = Vec::new();
+    for (t, e) in per_batch {
+        terms.extend(t);
+        for p in e {
+            escapes[p as usize] += 1;
+        }
+    }
+    // A stable sort keeps equal keys in batch order: the sums are added in a fixed order.
+    terms.par_sort_by_key(|t| t.0);
+    let (mut list, mut sums, mut used) = (Vec::new(), Vec::new(), Vec::new());
+    for (key, term) in terms {
+        if list.last().map(|&(k, _)| k) != Some(key) {
+            list.push((key, 0u64));
+            sums.push(0.0);
+            used.push(0u64);
+        }
+        let last = list.len() - 1;
+        list[last].1 += 1;
+        if term.is_finite() {
+            sums[last] += term;
+            used[last] += 1;
+        }
+    }
+    Ok(PairSample {
+        counts: PairCounts::Sparse(list),
+        log_kernel_sums: sums,
+        log_kernel_pairs: used,
+        escapes,
+    })
+}
+
+/// Power: `A_i B_i`, the light leaving each patch.
+pub fn power(areas: &[f64], s: &Solution) -> Vec<f64> {
+    areas.iter().zip(&s.radiosity).map(|(a, b)| a * b).collect()
+}
+
+/// Moments of the radiosity arriving at one patch, against the arrival point `(u, v)` in the patch's
+/// plane: enough for a least-squares plane `w = a + g . (u, v)` through the samples.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ArrivalMoments {
+    n: f64,
+    su: f64,
+    sv: f64,
+    sw: f64,
+    suu: f64,
+    suv: f64,
+    svv: f64,
+    suw: f64,
+    svw: f64,
+    sww: f64,
+}
+
+impl ArrivalMoments {
+    fn add(&mut self, u: f64, v: f64, w: f64) {
+        self.n += 1.0;
+        self.su += u;
+        self.sv += v;
+        self.sw += w;
+        self.suu += u * u;
+        self.suv += u * v;
+        self.svv += v * v;
+        self.suw += u * w;
+        self.svw += v * w;
+        self.sww += w * w;
+    }
+
+    /// The spatial variance of the fitted plane over the arrival points, `g^T Cov(u, v) g`, less its
+    /// expected excess from noise (2 fitted slopes: `2 sigma^2 / n`), at least 0; 0 with fewer than 4
+    /// samples or collinear ones.
+    pub fn explained_variance(&self) -> f64 {
+        let n = self.n;
+        if n < 4.0 {
+            return 0.0;
+        }
+        let c = |sxy: f64, sx: f64, sy: f64| sxy - sx * sy / n;
+        let (uu, uv, vv) = (
+            c(self.suu, self.su, self.su),
+            c(self.suv, self.su, self.sv),
+            c(self.svv, self.sv, self.sv),
+        );
+        let (uw, vw, ww) = (
+            c(self.suw, self.su, self.sw),
+            c(self.svw, self.sv, self.sw),
+            c(self.sww, self.sw, self.sw),
+        );
+        let det = uu * vv - uv * uv;
+        if det.is_nan() || det <= 1e-12 * (uu * vv).max(f64::MIN_POSITIVE) {
+            return 0.0;
+        }
+        let (gu, gv) = ((vv * uw - uv * vw) / det, (uu * vw - uv * uw) / det);
+        let explained = gu * uw + gv * vw;
+        let residual = (ww - explained).max(0.0) / (n - 3.0);
+        ((explained - 2.0 * residual) / n).max(0.0)
+    }
+}
+
+/// Casts the round's lines again (same seed: the same lines as the form factors came from) and gathers,
+/// per patch, the moments of the radiosity `B_j` arriving from each visible patch `j` against the
+/// arrival point. Given a point x of patch i, the patch a line from x reaches is distributed by the
+/// point-to-patch form factors, so the mean of the arriving `B_j` there is the received radiosity
+/// `B^in(x)`: the fitted plane is its linear trend over the patch.
+pub fn arrivals(
+    scene: &Scene,
+    tracer: &dyn Tracer,
+    lines: u64,
+    seed: u64,
+    radiosity: &[f64],
+) -> Result<Vec<ArrivalMoments>, TraceError> {
+    let bases: Vec<([f64; 3], [f64; 3])> = scene
+        .patches
+        .iter()
+        .map(|p| orthonormal_basis(p.normal))
+        .collect();
+    let point_on = |p: usize, l: &LineF64| -> (f64, f64) {
+        let patch = &scene.patches[p];
+        let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+        let t = (patch.offset - dot(patch.normal, l.origin)) / dot(patch.normal, l.dir);
+        let x = [0, 1, 2].map(|k| l.origin[k] + t * l.dir[k]);
+        (dot(x, bases[p].0), dot(x, bases[p].1))
+    };
+    let per_batch = trace_segments(
+        scene,
+        tracer,
+        lines,
+        seed,
+        |l, seg, out: &mut Vec<(u32, f64, f64, f64)>| {
+            if let Segment::Pair { from, to, .. } = seg {
+                let (f, t) = (from as usize, to as usize);
+                let (u, v) = point_on(t, l);
+                out.push((to, u, v, radiosity[f]));
+                let (u, v) = point_on(f, l);
+                out.push((from, u, v, radiosity[t]));
+            }
+        },
+    )?;
+    let mut moments = vec![ArrivalMoments::default(); scene.patch_count()];
+    for batch in per_batch {
+        for (p, u, v, w) in batch {
+            moments[p as usize].add(u, v, w);
+        }
+    }
+    Ok(moments)
+}
+
+/// Smoothness: how far the received radiosity departs from a constant over each patch, the jump of
+/// `B^in` across the patch. From the linear trend `g` fitted to the arriving radiosity
+/// ([`arrivals`]), the score is `A_i g^T Cov_i g`: the squared L2 error of a constant `B^in` over the
+/// patch, which splitting into 4 cuts by about 4 (each child has a quarter of the area and of the
+/// spread). A trend over the patch itself, rather than a jump to a neighbour, also serves a face that
+/// is still a single patch with no coplanar neighbour.
+pub fn smoothness(areas: &[f64], moments: &[ArrivalMoments]) -> Vec<f64> {
+    areas
+        .iter()
+        .zip(moments)
+        .map(|(a, m)| a * m.explained_variance())
+        .collect()
+}
+
+/// Information: each patch's share of the information transfer the discretisation loses.
+///
+/// For the transformed scene of sec. 4 with the patch radiosities held constant over each patch, the
+/// loss `𝓘^c - 𝓘_s` (eq. (25) against eq. (35)) is a sum over ordered patch pairs of
+///
+/// ```text
+///   (B_i B_j / 𝒜_T) [ ∫_i ∫_j F(x,y) log F(x,y) dx dy  -  A_i F_ij log(F_ij / A_j) ],
+/// ```
+///
+/// the radiosity-weighted visibility loss of the pair; each bracket is >= 0 (log-sum inequality; 0 when
+/// F(x, y) is constant over the pair). Patch i's score is its row of the sum (𝒜_T dropped: a common
+/// factor). The integral is `A_i F_ij` times the mean of `log2 F(x, y)` over the sampled pairs of
+/// points between i and j. Without light, `B = 1` gives the visibility loss `I_s^c - I_s` (sec. 3.3).
+pub fn information(areas: &[f64], sample: &PairSample, radiosity: Option<&Solution>) -> Vec<f64> {
+    let n = areas.len();
+    let totals = row_totals(n, &sample.counts, &sample.escapes);
+    let b = |i: usize| radiosity.map_or(1.0, |s| s.radiosity[i]);
+    let mut score = vec![0.0; n];
+    // Both layouts visit their entries in pair-key order, the order of the sums.
+    let mut k = 0;
+    sample.counts.for_each(|i, j, count| {
+        let entry = k;
+        k += 1;
+        let (i, j) = (i as usize, j as usize);
+        let used = sample.log_kernel_pairs[entry];
+        if i == j || used == 0 {
+            return; // A planar patch cannot see itself; no usable pair of points.
+        }
+        let mean_log = sample.log_kernel_sums[entry] / used as f64;
+        let weight = b(i) * b(j);
+        for (p, q) in [(i, j), (j, i)] {
+            let f = count as f64 / totals[p];
+            score[p] += weight * areas[p] * f * (mean_log - (f / areas[q]).log2());
+        }
+    });
+    score
+}
+
+/// The form factors of a sample.
+pub fn form_factors(scene: &Scene, sample: &PairSample) -> FormFactors {
+    FormFactors::from_counts(scene.patch_count(), &sample.counts, &sample.escapes)
+}
