@@ -7,6 +7,7 @@
 //! the group values gives the batch-means standard error of the full-run values.
 
 use crate::analysis::{analyze_observed, analyze_with, Analysis, AnalysisConfig, RunControl};
+use crate::measure::bias::{row_corrections, EntropyEstimator};
 use crate::measure::radiosity::{
     self, FormFactors, MaterialError, PatchMaterials, RadiosityValues, SolveError, SolveOptions,
 };
@@ -24,6 +25,10 @@ pub struct RadiosityEstimates {
     pub entropy: Estimate,
     /// Eq. (35).
     pub mutual_information: Estimate,
+    /// Eq. (34) with bias-corrected rows ([`radiosity::corrected`]).
+    pub entropy_corrected: Estimate,
+    /// Eq. (35) with bias-corrected rows.
+    pub mutual_information_corrected: Estimate,
     /// Relative residual `max |B - E - R F B| / max B` of the full-run solution.
     pub solver_residual: f64,
     /// The tolerance it was solved to.
@@ -97,13 +102,13 @@ pub fn analyze_with_radiosity(
     let a = analyze_observed(scene, tracer, &cfg, control, &mut |t| {
         // A group whose own solve fails (too few lines) only loses the standard error.
         per_group.push(
-            solve_tally(&areas, &materials, t, opts)
+            solve_tally(&areas, &materials, t, opts, cfg.estimator)
                 .ok()
                 .flatten()
                 .map(|r| r.0),
         );
     })?;
-    let outcome = match solve_tally(&areas, &materials, &a.tally, opts) {
+    let outcome = match solve_tally(&areas, &materials, &a.tally, opts, cfg.estimator) {
         Err(e) => return Err(solve_error(scene, &materials, e)),
         Ok(None) => RadiosityOutcome::Skipped(
             "no patch both receives and sends light: every transformed area A_i B_i^in B_i (eq. 30) is 0"
@@ -123,13 +128,24 @@ fn solve_tally(
     materials: &PatchMaterials,
     t: &Tally,
     opts: &SolveOptions,
+    estimator: EntropyEstimator,
 ) -> Result<Option<(RadiosityValues, radiosity::Solution)>, SolveError> {
     let Some(counts) = &t.counts else {
         return Ok(None);
     };
     let ff = FormFactors::from_counts(areas.len(), counts, &t.escapes_by_patch);
     let solution = radiosity::solve(&ff, materials, opts)?;
-    Ok(radiosity::measures(areas, &ff, &solution).map(|v| (v, solution)))
+    let Some(mut values) = radiosity::measures(areas, &ff, &solution) else {
+        return Ok(None);
+    };
+    let deltas = row_corrections(counts, &t.escapes_by_patch, estimator);
+    radiosity::corrected(
+        &mut values,
+        areas,
+        &solution,
+        deltas.as_slice().unwrap_or(&[]),
+    );
+    Ok(Some((values, solution)))
 }
 
 fn estimates(
@@ -153,6 +169,8 @@ fn estimates(
         positional_entropy: est(|v| v.positional_entropy),
         entropy: est(|v| v.entropy),
         mutual_information: est(|v| v.mutual_information),
+        entropy_corrected: est(|v| v.entropy_corrected),
+        mutual_information_corrected: est(|v| v.mutual_information_corrected),
         solver_residual: solution.residual,
         solver_tolerance: opts.tolerance,
         solver_sweeps: solution.sweeps,

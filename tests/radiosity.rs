@@ -65,6 +65,16 @@ fn table_8_constant_radiosity_gives_the_visibility_measures() {
                 ("H_p", r.positional_entropy, v.positional_entropy.unwrap()),
                 ("H_s", r.entropy, v.entropy.unwrap()),
                 ("I_s", r.mutual_information, v.mutual_information.unwrap()),
+                (
+                    "corrected H_s",
+                    r.entropy_corrected,
+                    v.entropy_corrected.unwrap(),
+                ),
+                (
+                    "corrected I_s",
+                    r.mutual_information_corrected,
+                    v.mutual_information_corrected.unwrap(),
+                ),
             ] {
                 assert!(
                     (rad.value - vis.value).abs() < 1e-8,

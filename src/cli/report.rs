@@ -194,23 +194,36 @@ pub fn json(run: &RunInfo, a: &Analysis) -> String {
     s
 }
 
-/// The radiosity measures in report order: (key, table label, paper reference, estimate).
-fn radiosity_measures(
-    r: &RadiosityEstimates,
-) -> [(&'static str, &'static str, &'static str, Estimate); 3] {
+/// The radiosity measures in report order.
+fn radiosity_measures(r: &RadiosityEstimates) -> [Row; 3] {
+    let row = |key, label, reference, estimate, corrected| Row {
+        key,
+        label,
+        reference,
+        estimate: Some(estimate),
+        corrected,
+    };
     [
-        (
+        row(
             "positional_entropy",
             "radiosity positional entropy H_p",
             "eq. 33",
             r.positional_entropy,
+            None,
         ),
-        ("entropy", "radiosity entropy H_s", "eq. 34", r.entropy),
-        (
+        row(
+            "entropy",
+            "radiosity entropy H_s",
+            "eq. 34",
+            r.entropy,
+            Some(r.entropy_corrected),
+        ),
+        row(
             "mutual_information",
             "radiosity mutual information I_s",
             "eq. 35",
             r.mutual_information,
+            Some(r.mutual_information_corrected),
         ),
     ]
 }
@@ -221,8 +234,8 @@ fn radiosity_json(outcome: &RadiosityOutcome) -> Value {
         return Value::Null;
     };
     let mut m = serde_json::Map::new();
-    for (key, _, _, e) in radiosity_measures(r) {
-        m.insert(key.into(), estimate_json(Some(e)));
+    for row in radiosity_measures(r) {
+        m.insert(row.key.into(), row_json(&row));
     }
     m.insert("solver_residual".into(), json!(finite(r.solver_residual)));
     m.insert("solver_tolerance".into(), json!(r.solver_tolerance));
@@ -243,14 +256,8 @@ fn radiosity_table(s: &mut String, outcome: &RadiosityOutcome) {
         }
         RadiosityOutcome::Computed(r) => {
             let _ = writeln!(s);
-            for (_, label, reference, e) in radiosity_measures(r) {
-                let _ = writeln!(
-                    s,
-                    "{label:<36} {:>12.6} {:>10}  {:>23}  {reference}",
-                    e.value,
-                    stderr_text(e),
-                    ""
-                );
+            for row in radiosity_measures(r) {
+                table_row(s, &row);
             }
             let _ = writeln!(
                 s,
@@ -284,9 +291,9 @@ pub fn csv(run: &RunInfo, a: &Analysis) -> String {
         }
     }
     if let RadiosityOutcome::Computed(r) = run.radiosity {
-        for (key, _, _, e) in radiosity_measures(r) {
-            let (v, se) = field(Some(e));
-            let _ = writeln!(s, "radiosity_{key},{v},{se},,");
+        for row in radiosity_measures(r) {
+            let ((v, se), (c, cse)) = (field(row.estimate), field(row.corrected));
+            let _ = writeln!(s, "radiosity_{},{v},{se},{c},{cse}", row.key);
         }
     }
     s
@@ -333,20 +340,7 @@ pub fn table(run: &RunInfo, a: &Analysis) -> String {
         "measure", "plug-in", "stderr", "corrected", "stderr"
     );
     for r in measures(a) {
-        if let Some(e) = r.estimate {
-            let corrected = r
-                .corrected
-                .map(|c| format!("{:>12.6} {:>10}", c.value, stderr_text(c)))
-                .unwrap_or_else(|| format!("{:>23}", ""));
-            let _ = writeln!(
-                s,
-                "{:<36} {:>12.6} {:>10}  {corrected}  {}",
-                r.label,
-                e.value,
-                stderr_text(e),
-                r.reference
-            );
-        }
+        table_row(&mut s, &r);
     }
     radiosity_table(&mut s, run.radiosity);
     let _ = writeln!(
@@ -362,6 +356,24 @@ pub fn table(run: &RunInfo, a: &Analysis) -> String {
         let _ = writeln!(s, "stopped by: {}", stop_text(a.stop_reason));
     }
     s
+}
+
+/// One measure's line of the table: plug-in and corrected values with their standard errors.
+fn table_row(s: &mut String, r: &Row) {
+    if let Some(e) = r.estimate {
+        let corrected = r
+            .corrected
+            .map(|c| format!("{:>12.6} {:>10}", c.value, stderr_text(c)))
+            .unwrap_or_else(|| format!("{:>23}", ""));
+        let _ = writeln!(
+            s,
+            "{:<36} {:>12.6} {:>10}  {corrected}  {}",
+            r.label,
+            e.value,
+            stderr_text(e),
+            r.reference
+        );
+    }
 }
 
 fn stderr_text(e: Estimate) -> String {

@@ -130,14 +130,9 @@ pub fn corrected(
     let a = area_distribution(areas);
     let stats = row_stats(n_p, counts, escapes);
     let log2_a: Array1<f64> = a.mapv(|x| if x > 0.0 { x.log2() } else { 0.0 });
+    let rows = row_entropies(counts, escapes, estimator, &stats);
 
-    // Per-outcome part of each row's estimate (nats), then the per-row part.
-    let mut row_h = Array1::<f64>::zeros(n_p);
     let mut cross = 0.0;
-    let coverage = stats_coverage(&stats);
-    for_each_outcome(counts, escapes, |i, x| {
-        row_h[i] += outcome_term(estimator, x, stats.total[i], coverage[i]);
-    });
     counts.for_each(|i, j, c| {
         let (i, j, c) = (i as usize, j as usize, c as f64);
         if i == j {
@@ -148,29 +143,65 @@ pub fn corrected(
         }
     });
 
-    let mut entropy = 0.0;
+    let entropy = a.dot(&rows);
+    CorrectedValues {
+        entropy,
+        mutual_information: cross - entropy,
+    }
+}
+
+/// Each row's entropy over the patches (bits) by `estimator`: `-sum_j F_ij log2 F_ij` corrected for
+/// undersampling; 0 for a row without samples.
+fn row_entropies(
+    counts: &PairCounts,
+    escapes: &[u64],
+    estimator: EntropyEstimator,
+    stats: &RowStats,
+) -> Array1<f64> {
+    let n_p = stats.total.len();
+    let coverage = stats_coverage(stats);
+    let mut nats = Array1::<f64>::zeros(n_p);
+    for_each_outcome(counts, escapes, |i, x| {
+        nats[i] += outcome_term(estimator, x, stats.total[i], coverage[i]);
+    });
     for i in 0..n_p {
         let n = stats.total[i];
         if n == 0.0 {
             continue;
         }
-        let nats = row_h[i]
-            + row_term(
-                estimator,
-                n,
-                stats.seen[i],
-                stats.singletons[i],
-                stats.doubletons[i],
-            );
+        nats[i] += row_term(
+            estimator,
+            n,
+            stats.seen[i],
+            stats.singletons[i],
+            stats.doubletons[i],
+        );
         // Eq. (17) sums over patches: take the escapes' own (plug-in) term out again.
         let q = escapes.get(i).map_or(0.0, |&e| e as f64 / n);
-        let escape_nats = if q > 0.0 { -q * q.ln() } else { 0.0 };
-        entropy += a[i] * (nats - escape_nats) / std::f64::consts::LN_2;
+        if q > 0.0 {
+            nats[i] += q * q.ln();
+        }
     }
-    CorrectedValues {
-        entropy,
-        mutual_information: cross - entropy,
-    }
+    nats / std::f64::consts::LN_2
+}
+
+/// How much `estimator` raises each row's entropy above the plug-in value (bits): the per-row bias
+/// correction, which [`crate::measure::radiosity`] applies to the rows of the radiosity channel.
+pub fn row_corrections(
+    counts: &PairCounts,
+    escapes: &[u64],
+    estimator: EntropyEstimator,
+) -> Array1<f64> {
+    let stats = row_stats(escapes.len().max(row_count(counts)), counts, escapes);
+    row_entropies(counts, escapes, estimator, &stats)
+        - row_entropies(counts, escapes, EntropyEstimator::PlugIn, &stats)
+}
+
+/// The number of rows the counts need (largest patch index + 1).
+fn row_count(counts: &PairCounts) -> usize {
+    let mut n = 0;
+    counts.for_each(|_, j, _| n = n.max(j as usize + 1));
+    n
 }
 
 /// Chao–Shen sample coverage per row, `1 - f1/N` (kept above 1/N so that no probability vanishes).
