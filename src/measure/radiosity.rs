@@ -430,6 +430,33 @@ pub fn measures(areas: &[f64], ff: &FormFactors, s: &Solution) -> Option<Radiosi
     })
 }
 
+/// Applies per-row bias corrections (bits, from [`crate::measure::bias::row_corrections`]) to radiosity
+/// values: 𝓗_s gains `sum_i (𝒜_i/𝒜_T) delta_i` and 𝓘_s loses it (𝓘_s = X - 𝓗_s with X linear in 𝓕).
+///
+/// Row i of the radiosity channel reweights row i of F by the radiosities `B_j` it reaches, so the patches
+/// its undersampled sample missed are missing from both; using the visibility row's correction assumes
+/// the missed patches carry about the row's mean radiosity. It is exact when B is constant (paper
+/// Table 8: the radiosity channel is then the visibility channel) and first order otherwise.
+pub fn corrected(
+    values: &mut RadiosityValues,
+    areas: &[f64],
+    s: &Solution,
+    row_corrections: &[f64],
+) {
+    let t = transformed_areas(areas, s);
+    let total: f64 = t.iter().sum();
+    if !(total > 0.0 && total.is_finite()) {
+        return;
+    }
+    let shift: f64 = t
+        .iter()
+        .zip(row_corrections)
+        .map(|(ti, d)| ti / total * d)
+        .sum();
+    values.entropy_corrected = values.entropy + shift;
+    values.mutual_information_corrected = values.mutual_information - shift;
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -589,31 +616,4 @@ mod tests {
         assert_eq!(s.sweeps, 0);
         assert!(measures(&[1.0, 1.0], &ff, &s).is_none());
     }
-}
-
-/// Applies per-row bias corrections (bits, from [`crate::measure::bias::row_corrections`]) to radiosity
-/// values: 𝓗_s gains `sum_i (𝒜_i/𝒜_T) delta_i` and 𝓘_s loses it (𝓘_s = X - 𝓗_s with X linear in 𝓕).
-///
-/// Row i of the radiosity channel reweights row i of F by the radiosities `B_j` it reaches, so the patches
-/// its undersampled sample missed are missing from both; using the visibility row's correction assumes
-/// the missed patches carry about the row's mean radiosity. It is exact when B is constant (paper
-/// Table 8: the radiosity channel is then the visibility channel) and first order otherwise.
-pub fn corrected(
-    values: &mut RadiosityValues,
-    areas: &[f64],
-    s: &Solution,
-    row_corrections: &[f64],
-) {
-    let t = transformed_areas(areas, s);
-    let total: f64 = t.iter().sum();
-    if !(total > 0.0 && total.is_finite()) {
-        return;
-    }
-    let shift: f64 = t
-        .iter()
-        .zip(row_corrections)
-        .map(|(ti, d)| ti / total * d)
-        .sum();
-    values.entropy_corrected = values.entropy + shift;
-    values.mutual_information_corrected = values.mutual_information - shift;
 }
