@@ -4,7 +4,8 @@ use std::time::Instant;
 
 use crate::measure::visibility::{self, ContinuousValues, DiscreteValues};
 use crate::measure::Estimate;
-use crate::sample::tally::{tally_batches, BatchPlan, Tally, Wanted};
+use crate::sample::lines::LineSource;
+use crate::sample::tally::{tally_batches_from, BatchPlan, Tally, Wanted};
 use crate::scene::Scene;
 use crate::trace::{TraceError, Tracer};
 
@@ -100,7 +101,7 @@ impl GroupValues {
     }
 }
 
-/// Runs an analysis: casts `cfg.lines` global lines through `scene` with `tracer`.
+/// Runs an analysis: casts `cfg.lines` independent global lines through `scene` with `tracer`.
 ///
 /// Uses the current rayon thread pool; results do not depend on its size.
 pub fn analyze(
@@ -108,8 +109,21 @@ pub fn analyze(
     tracer: &dyn Tracer,
     cfg: &AnalysisConfig,
 ) -> Result<Analysis, TraceError> {
+    analyze_with(scene, tracer, cfg, LineSource::Independent)
+}
+
+/// Runs an analysis with lines from `source`: independent lines as [`analyze`], or bundles of parallel
+/// lines (the line count then rounds up to whole bundles). A bundle never straddles two standard-error
+/// groups, so the group-to-group spread, and with it every standard error, includes the correlation of
+/// the lines within a bundle.
+pub fn analyze_with(
+    scene: &Scene,
+    tracer: &dyn Tracer,
+    cfg: &AnalysisConfig,
+    source: LineSource,
+) -> Result<Analysis, TraceError> {
     let start = Instant::now();
-    let plan = BatchPlan::new(cfg.lines);
+    let plan = BatchPlan::for_source(cfg.lines, source);
     let batches = plan.batches();
     let groups = (cfg.groups.max(1) as u64).min(batches.max(1));
     let areas: Vec<f64> = scene.patches.iter().map(|p| p.area).collect();
@@ -118,7 +132,7 @@ pub fn analyze(
     let mut per_group = Vec::with_capacity(groups as usize);
     for g in 0..groups {
         let range = g * batches / groups..(g + 1) * batches / groups;
-        let tally = tally_batches(scene, tracer, &plan, cfg.seed, range, cfg.wanted)?;
+        let tally = tally_batches_from(scene, tracer, &plan, source, cfg.seed, range, cfg.wanted)?;
         per_group.push(GroupValues::of(scene, &areas, &tally));
         merged.push(tally);
     }

@@ -5,9 +5,11 @@ mod report;
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand, ValueEnum};
-use scene_complexity::analysis::{analyze, AnalysisConfig, DEFAULT_GROUPS};
+use scene_complexity::analysis::{analyze_with, AnalysisConfig, DEFAULT_GROUPS};
+use scene_complexity::sample::lines::LineSource;
 use scene_complexity::sample::tally::Wanted;
 use scene_complexity::scene::{self, builtin};
+use scene_complexity::trace::crosscheck::{self, CrossCheckConfig, Tolerance};
 use scene_complexity::trace::{make_tracer, Backend, Query};
 
 /// scx: how hard is a 3D scene to light and to mesh? Information-theoretic scene complexity
@@ -27,6 +29,30 @@ enum Command {
     Scenes,
     /// Write a scene (built-in or file) as OBJ + MTL.
     Export(ExportArgs),
+    /// Trace the same lines with Embree and the pure-Rust tracer, compare them hit for hit and measure
+    /// for measure; exit 1 when a line differs beyond the tolerance.
+    Crosscheck(CrosscheckArgs),
+}
+
+#[derive(clap::Args, Debug)]
+struct CrosscheckArgs {
+    /// An OBJ file, or a built-in scene such as `@cube:10` (see `scx scenes`).
+    scene: String,
+    /// Number of global lines (accepts `1e6`).
+    #[arg(long, default_value = "1e6", value_parser = parse_count)]
+    lines: u64,
+    /// Seed of the random line streams (the lines of `scx analyze` with the same seed).
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Worker threads (default: all cores). Results do not depend on it.
+    #[arg(long)]
+    threads: Option<usize>,
+    /// Distances agree within this many f32 ulps at max(t, 1).
+    #[arg(long, default_value_t = Tolerance::default().ulps)]
+    ulps: f32,
+    /// How many differing lines to print.
+    #[arg(long, default_value_t = 5)]
+    show: usize,
 }
 
 #[derive(clap::Args, Debug)]
@@ -57,6 +83,10 @@ struct AnalyzeArgs {
     /// Ray query: `single`, or `packet4`/`packet8`/`packet16` (Embree, native widths only).
     #[arg(long, default_value = "single", value_parser = parse_query)]
     query: Query,
+    /// Cast the lines in bundles of G x G parallel lines (jittered grid over the disc, traced as adjacent
+    /// packets); 0 casts independent lines. The standard errors include the correlation within a bundle.
+    #[arg(long, default_value_t = 0, value_parser = parse_bundle)]
+    bundle: u32,
     /// Which measures to compute (comma separated): discrete, continuous. Default: all.
     #[arg(long, value_delimiter = ',', value_enum)]
     measures: Option<Vec<MeasureArg>>,
@@ -103,6 +133,14 @@ fn parse_count(s: &str) -> Result<u64, String> {
     Ok(v as u64)
 }
 
+fn parse_bundle(s: &str) -> Result<u32, String> {
+    let g: u32 = s
+        .trim()
+        .parse()
+        .map_err(|_| format!("`{s}` is not a whole number"))?;
+    LineSource::bundles(g).map(|_| g)
+}
+
 fn parse_query(s: &str) -> Result<Query, String> {
     match s {
         "single" => Ok(Query::Single),
@@ -128,6 +166,7 @@ pub fn main() -> ExitCode {
         }
         Command::Analyze(args) => finish(try_analyze(&args)),
         Command::Export(args) => finish(try_export(&args)),
+        Command::Crosscheck(args) => finish(try_crosscheck(&args)),
     }
 }
 
@@ -176,6 +215,60 @@ fn bad_input(message: impl ToString) -> Failure {
     }
 }
 
+/// A rayon pool of `threads` threads (default: all cores).
+fn thread_pool(threads: Option<usize>) -> Result<(rayon::ThreadPool, usize), Failure> {
+    let threads = threads.unwrap_or_else(|| {
+        std::thread::available_parallelism()
+            .map(|n| n.get())
+            .unwrap_or(1)
+    });
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .map_err(|e| bad_input(format!("cannot start {threads} threads: {e}")))?;
+    Ok((pool, threads))
+}
+
+fn try_crosscheck(args: &CrosscheckArgs) -> Result<(), Failure> {
+    if !(args.ulps.is_finite() && args.ulps >= 0.0) {
+        return Err(bad_input(format!(
+            "--ulps {}: need a finite number >= 0",
+            args.ulps
+        )));
+    }
+    let scene = load_scene(&args.scene)?;
+    let embree = make_tracer(Backend::Embree, &scene, Query::Single).map_err(bad_input)?;
+    let rust = make_tracer(Backend::Rust, &scene, Query::Single).map_err(bad_input)?;
+    let (pool, _) = thread_pool(args.threads)?;
+    let cfg = CrossCheckConfig {
+        lines: args.lines,
+        seed: args.seed,
+        tolerance: Tolerance { ulps: args.ulps },
+        examples: args.show,
+    };
+    let check = pool
+        .install(|| {
+            crosscheck::crosscheck(&scene, embree.as_ref(), rust.as_ref(), &cfg, DEFAULT_GROUPS)
+        })
+        .map_err(|e| Failure {
+            code: 1,
+            message: e.to_string(),
+        })?;
+    write_stdout(&crosscheck::report(&check, &scene))?;
+    if check.passed() {
+        Ok(())
+    } else {
+        Err(Failure {
+            code: 1,
+            message: format!(
+                "{} of {} lines differ between the tracers",
+                check.hits.differing_lines(),
+                check.hits.lines
+            ),
+        })
+    }
+}
+
 fn try_analyze(args: &AnalyzeArgs) -> Result<(), Failure> {
     let scene = load_scene(&args.scene)?;
     let backend = match args.tracer {
@@ -194,15 +287,8 @@ fn try_analyze(args: &AnalyzeArgs) -> Result<(), Failure> {
             continuous: m.contains(&MeasureArg::Continuous),
         },
     };
-    let threads = args.threads.unwrap_or_else(|| {
-        std::thread::available_parallelism()
-            .map(|n| n.get())
-            .unwrap_or(1)
-    });
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .map_err(|e| bad_input(format!("cannot start {threads} threads: {e}")))?;
+    let (pool, threads) = thread_pool(args.threads)?;
+    let source = LineSource::bundles(args.bundle).map_err(bad_input)?;
     let cfg = AnalysisConfig {
         lines: args.lines,
         seed: args.seed,
@@ -210,7 +296,7 @@ fn try_analyze(args: &AnalyzeArgs) -> Result<(), Failure> {
         groups: usize::from(args.groups),
     };
     let analysis = pool
-        .install(|| analyze(&scene, tracer.as_ref(), &cfg))
+        .install(|| analyze_with(&scene, tracer.as_ref(), &cfg, source))
         .map_err(|e| Failure {
             code: 1,
             message: e.to_string(),
@@ -220,6 +306,7 @@ fn try_analyze(args: &AnalyzeArgs) -> Result<(), Failure> {
         tracer: tracer.name(),
         query: args.query,
         threads,
+        bundle: args.bundle,
     };
     for w in report::warnings(&scene, &analysis) {
         eprintln!("scx: warning: {w}");

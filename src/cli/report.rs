@@ -17,6 +17,8 @@ pub struct RunInfo<'a> {
     pub tracer: &'static str,
     pub query: Query,
     pub threads: usize,
+    /// Lines per side of a bundle, 0 for independent lines.
+    pub bundle: u32,
 }
 
 /// The visibility measures in report order: (JSON key, table label, paper reference, estimate).
@@ -120,6 +122,7 @@ pub fn json(run: &RunInfo, a: &Analysis) -> String {
         "area": run.scene.total_area_scene_units(),
         "tracer": run.tracer,
         "query": run.query.to_string(),
+        "bundle": run.bundle,
         "lines": a.lines,
         "seed": a.seed,
         "threads": run.threads,
@@ -167,8 +170,13 @@ pub fn table(run: &RunInfo, a: &Analysis) -> String {
     );
     let _ = writeln!(
         s,
-        "lines    {}  seed {}  tracer {} ({})  threads {}  {:.3} s  ({:.2} M lines/s)",
+        "lines    {}{}  seed {}  tracer {} ({})  threads {}  {:.3} s  ({:.2} M lines/s)",
         a.lines,
+        if run.bundle > 0 {
+            format!(" in bundles of {0} x {0}", run.bundle)
+        } else {
+            String::new()
+        },
         a.seed,
         run.tracer,
         run.query,

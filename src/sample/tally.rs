@@ -9,7 +9,7 @@ use std::ops::Range;
 use rayon::prelude::*;
 
 use super::counts::{pair_key, PairCounts};
-use super::lines::batch_lines;
+use super::lines::LineSource;
 use super::pairs::{segments, Segment};
 use crate::scene::Scene;
 use crate::trace::{LineHits, RawHit, TraceError, Tracer};
@@ -37,6 +37,17 @@ impl BatchPlan {
     /// work spreads over threads and the standard-error groups each get several batches.
     pub fn new(lines: u64) -> Self {
         let batch_size = (lines / 64).clamp(256, 4096);
+        BatchPlan { lines, batch_size }
+    }
+
+    /// The plan for lines from `source`: the line count is rounded up to whole bundles, and each batch
+    /// holds whole bundles only, so that a bundle never straddles two batches (nor two standard-error
+    /// groups, which are made of whole batches). For independent lines this is [`BatchPlan::new`].
+    pub fn for_source(lines: u64, source: LineSource) -> Self {
+        let unit = source.lines_per_unit();
+        let lines = lines.div_ceil(unit) * unit;
+        let plain = BatchPlan::new(lines);
+        let batch_size = (plain.batch_size / unit).max(1) * unit;
         BatchPlan { lines, batch_size }
     }
 
@@ -146,7 +157,8 @@ struct Scratch {
     hits: LineHits,
 }
 
-/// Traces and tallies the batches `batches` of `plan` in parallel, merging in batch order.
+/// Traces and tallies the batches `batches` of `plan` in parallel, merging in batch order (independent
+/// lines).
 pub fn tally_batches(
     scene: &Scene,
     tracer: &dyn Tracer,
@@ -155,10 +167,38 @@ pub fn tally_batches(
     batches: Range<u64>,
     wanted: Wanted,
 ) -> Result<Tally, TraceError> {
+    tally_batches_from(
+        scene,
+        tracer,
+        plan,
+        LineSource::Independent,
+        seed,
+        batches,
+        wanted,
+    )
+}
+
+/// Traces and tallies the batches `batches` of `plan`, with lines from `source`, in parallel, merging in
+/// batch order. `plan` must come from [`BatchPlan::for_source`] with the same source.
+pub fn tally_batches_from(
+    scene: &Scene,
+    tracer: &dyn Tracer,
+    plan: &BatchPlan,
+    source: LineSource,
+    seed: u64,
+    batches: Range<u64>,
+    wanted: Wanted,
+) -> Result<Tally, TraceError> {
     let per_batch: Vec<BatchTally> = batches
         .into_par_iter()
         .map_init(Scratch::default, |scratch, b| {
-            tally_batch(scene, tracer, seed, b, plan.batch_len(b), wanted, scratch)
+            let lines = BatchLines {
+                source,
+                seed,
+                batch: b,
+                count: plan.batch_len(b),
+            };
+            tally_batch(scene, tracer, lines, wanted, scratch)
         })
         .collect::<Result<_, _>>()?;
 
@@ -185,19 +225,27 @@ pub fn tally_batches(
     Ok(tally)
 }
 
-fn tally_batch(
-    scene: &Scene,
-    tracer: &dyn Tracer,
+/// Which lines a batch casts.
+#[derive(Clone, Copy, Debug)]
+struct BatchLines {
+    source: LineSource,
     seed: u64,
     batch: u64,
     count: usize,
+}
+
+fn tally_batch(
+    scene: &Scene,
+    tracer: &dyn Tracer,
+    lines: BatchLines,
     wanted: Wanted,
     scratch: &mut Scratch,
 ) -> Result<BatchTally, TraceError> {
+    let count = lines.count;
     scratch.lines.clear();
-    batch_lines(
-        seed,
-        batch,
+    lines.source.batch_lines(
+        lines.seed,
+        lines.batch,
         count,
         scene.bounding_radius(),
         &mut scratch.lines,

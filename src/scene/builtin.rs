@@ -47,6 +47,10 @@ pub const BUILTINS: &[BuiltinInfo] = &[
         usage: "@dodecahedron[:N]",
         description: "regular dodecahedron interior, one pentagon per face; N > 1 cuts each into 5 N^2 triangles",
     },
+    BuiltinInfo {
+        usage: "@cubes512",
+        description: "unit cube room holding 512 small cubes (side 1/16, one per cell of an 8^3 grid, fixed random offsets)",
+    },
 ];
 
 /// Builds a built-in scene from its name (`@cube:10`).
@@ -63,6 +67,7 @@ pub fn build(spec: &str) -> Result<Scene, SceneError> {
         "octahedron" => solid(spec, &octahedron(), parse_count(spec, param, 1, 1000)?),
         "icosahedron" => solid(spec, &icosahedron(), parse_count(spec, param, 1, 1000)?),
         "dodecahedron" => solid(spec, &dodecahedron(), parse_count(spec, param, 1, 1000)?),
+        "cubes512" if param.is_none() => super::clutter::cubes512(spec),
         _ => Err(SceneError::Builtin(format!(
             "{spec}: unknown built-in scene; `scx scenes` lists them ({})",
             BUILTINS

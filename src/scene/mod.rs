@@ -7,6 +7,7 @@
 
 mod build;
 pub mod builtin;
+pub mod clutter;
 pub mod obj;
 
 pub use build::SceneBuilder;
