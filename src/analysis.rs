@@ -130,11 +130,29 @@ pub fn analyze_with(
 
     let mut merged = MergeStack::default();
     let mut per_group = Vec::with_capacity(groups as usize);
-    for g in 0..groups {
+    // Group g's measures and its merge into the total run while group g + 1 is traced (rayon::join lets
+    // an idle thread take them), so this serial work hides behind the parallel tracing.
+    let mut done: Option<Tally> = None;
+    for g in 0..=groups {
         let range = g * batches / groups..(g + 1) * batches / groups;
-        let tally = tally_batches_from(scene, tracer, &plan, source, cfg.seed, range, cfg.wanted)?;
-        per_group.push(GroupValues::of(scene, &areas, &tally));
-        merged.push(tally);
+        let (next, ()) = rayon::join(
+            || {
+                (g < groups)
+                    .then(|| {
+                        tally_batches_from(
+                            scene, tracer, &plan, source, cfg.seed, range, cfg.wanted,
+                        )
+                    })
+                    .transpose()
+            },
+            || {
+                if let Some(tally) = done.take() {
+                    per_group.push(GroupValues::of(scene, &areas, &tally));
+                    merged.push(tally);
+                }
+            },
+        );
+        done = next?;
     }
     let total = merged
         .finish()

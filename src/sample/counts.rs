@@ -58,6 +58,46 @@ impl PairCounts {
         counts
     }
 
+    /// Counts for `patches` patches from per-batch counts ([`BatchCounts::of_keys`]: sorted run-length
+    /// lists for the sparse layout, raw keys for the dense one). The order of the batches does not matter:
+    /// integer sums do not depend on it.
+    pub fn from_batches(patches: usize, batches: Vec<BatchCounts>) -> Self {
+        let mut counts = PairCounts::new(patches);
+        match &mut counts {
+            PairCounts::Dense(m) => {
+                for b in &batches {
+                    let keys = match b {
+                        BatchCounts::Keys(k) => k.as_slice(),
+                        BatchCounts::Runs(_) => unreachable!("a dense scene's batches keep keys"),
+                    };
+                    for &k in keys {
+                        let (i, j) = split_key(k);
+                        m[[i as usize, j as usize]] += 1;
+                    }
+                }
+            }
+            PairCounts::Sparse(list) => {
+                let runs: Vec<Vec<(u64, u64)>> = batches
+                    .into_iter()
+                    .map(|b| match b {
+                        BatchCounts::Runs(r) => r,
+                        BatchCounts::Keys(mut k) => {
+                            k.sort_unstable();
+                            run_lengths(&k)
+                        }
+                    })
+                    .collect();
+                *list = merge_all(runs);
+            }
+        }
+        counts
+    }
+
+    /// How a batch of `patches` patches should hand over its pair keys (see [`BatchCounts::of_keys`]).
+    pub fn is_dense_for(patches: usize) -> bool {
+        patches <= DENSE_MAX_PATCHES
+    }
+
     /// Adds `other` (of the same size and layout) into `self`.
     pub fn merge(&mut self, other: &PairCounts) {
         match (self, other) {
@@ -98,6 +138,45 @@ impl PairCounts {
     pub fn is_dense(&self) -> bool {
         matches!(self, PairCounts::Dense(_))
     }
+}
+
+/// One batch's pair counts on their way to a group's [`PairCounts`]: the batch does the sorting of its own
+/// keys (in parallel with the other batches) when the scene's counts are sparse.
+#[derive(Clone, Debug)]
+pub enum BatchCounts {
+    /// Unsorted pair keys (dense layout: adding them to the matrix needs no order).
+    Keys(Vec<u64>),
+    /// `(key, count)` sorted by key, as [`PairCounts::Sparse`] holds them.
+    Runs(Vec<(u64, u64)>),
+}
+
+impl BatchCounts {
+    /// A batch's keys in the form its scene's layout merges fastest: sorted runs for sparse counts.
+    pub fn of_keys(patches: usize, mut keys: Vec<u64>) -> Self {
+        if PairCounts::is_dense_for(patches) {
+            BatchCounts::Keys(keys)
+        } else {
+            keys.sort_unstable();
+            BatchCounts::Runs(run_lengths(&keys))
+        }
+    }
+}
+
+/// Merges sorted run lists, adding the counts of equal keys: pairwise in a balanced tree, in parallel, so
+/// each entry is copied O(log n) times. Integer sums make the result independent of the merge order.
+fn merge_all(mut runs: Vec<Vec<(u64, u64)>>) -> Vec<(u64, u64)> {
+    use rayon::prelude::*;
+    while runs.len() > 1 {
+        runs = runs
+            .par_chunks(2)
+            .map(|pair| match pair {
+                [a, b] => merge_sorted(a, b),
+                [a] => a.clone(),
+                _ => unreachable!("chunks of two"),
+            })
+            .collect();
+    }
+    runs.pop().unwrap_or_default()
 }
 
 fn run_lengths(sorted: &[u64]) -> Vec<(u64, u64)> {
@@ -163,6 +242,23 @@ mod tests {
         assert!(dense.is_dense() && !sparse.is_dense());
         assert_eq!(entries(&dense), vec![(0, 0, 1), (1, 3, 2), (2, 5, 3)]);
         assert_eq!(entries(&dense), entries(&sparse));
+
+        // Per-batch hand-over, both layouts, gives the same counts.
+        let halves = |patches| {
+            let (a, b) = keys.split_at(3);
+            vec![
+                BatchCounts::of_keys(patches, a.to_vec()),
+                BatchCounts::of_keys(patches, b.to_vec()),
+                BatchCounts::of_keys(patches, Vec::new()),
+            ]
+        };
+        let from_dense = PairCounts::from_batches(8, halves(8));
+        assert!(from_dense.is_dense());
+        assert_eq!(entries(&from_dense), entries(&dense));
+        let many = DENSE_MAX_PATCHES + 1;
+        let from_sparse = PairCounts::from_batches(many, halves(many));
+        assert!(!from_sparse.is_dense());
+        assert_eq!(entries(&from_sparse), entries(&dense));
 
         let mut twice = sparse.clone();
         twice.merge(&sparse);
