@@ -3,7 +3,8 @@
 //! tracer (Embree single lines and native packets, the pure-Rust BVH) and thread count. Best of three runs
 //! (the machine is shared).
 //!
-//! `cargo bench --bench throughput [-- SCENE... [LINES]]`, default `@cube:30 @cubes512` and 10^6 lines.
+//! `cargo bench --bench throughput [-- SCENE... [LINES]]`, default `@cube:30 @cubes512` and 10^6 lines;
+//! `SCX_BENCH_TRACERS=rust,single` keeps only the tracers whose names contain one of the words.
 
 use std::time::Instant;
 
@@ -72,7 +73,10 @@ fn bench_scene(spec: &str, count: u64, pools: &[rayon::ThreadPool]) -> anyhow::R
         },
         groups: DEFAULT_GROUPS,
     };
-    for (name, backend, query) in candidates() {
+    // `SCX_BENCH_TRACERS=rust,embree single` keeps the tracers whose names contain one of the words.
+    let only = std::env::var("SCX_BENCH_TRACERS").unwrap_or_default();
+    let wanted = |name: &str| only.is_empty() || only.split(',').any(|w| name.contains(w.trim()));
+    for (name, backend, query) in candidates().into_iter().filter(|c| wanted(&c.0)) {
         let Ok(tracer) = make_tracer(backend, &scene, query) else {
             continue;
         };

@@ -8,7 +8,7 @@ use std::ops::Range;
 
 use rayon::prelude::*;
 
-use super::counts::{pair_key, BatchCounts, PairCounts};
+use super::counts::{pair_key, PairCounts};
 use super::lines::LineSource;
 use super::pairs::{segments, Segment};
 use crate::scene::Scene;
@@ -143,7 +143,7 @@ struct BatchTally {
     escapes: u64,
     unpaired: u64,
     degenerate_pairs: u64,
-    counts: Option<BatchCounts>,
+    pair_keys: Vec<u64>,
     escape_patches: Vec<u32>,
     cmi_sum: f64,
     cmi_pairs: u64,
@@ -216,7 +216,7 @@ pub fn tally_batches_from(
         for &p in &b.escape_patches {
             tally.escapes_by_patch[p as usize] += 1;
         }
-        batch_counts.extend(b.counts);
+        batch_counts.push(b.pair_keys);
     }
     if wanted.discrete {
         tally.counts = Some(PairCounts::from_batches(scene.patch_count(), batch_counts));
@@ -286,10 +286,7 @@ fn tally_batch(
     }
     let log2_area_over_pi = (scene.total_area() / std::f64::consts::PI).log2();
     (t.cmi_sum, t.cmi_pairs) = log2_sum.finish(log2_area_over_pi);
-    if wanted.discrete {
-        // Sorting here, in the parallel part, leaves the group only a merge of sorted lists.
-        t.counts = Some(BatchCounts::of_keys(scene.patch_count(), keys));
-    }
+    t.pair_keys = keys;
     Ok(t)
 }
 
