@@ -100,13 +100,12 @@ fn all_hits_equal_the_brute_force_tracer_to_the_bit() {
         let reference = trace(&BruteForceTracer::new(scene), &lines);
         let bvh = BvhTracer::new(scene).unwrap();
         let got = trace(&bvh, &lines);
-        for l in 0..lines.len() {
+        for (l, line) in lines.iter().enumerate() {
             assert_eq!(
                 got.of_line(l),
                 reference.of_line(l),
-                "{}: line {l} {:?}",
+                "{}: line {l} {line:?}",
                 scene.name,
-                lines[l]
             );
         }
         // The check means something: lines did hit, and some hits were at t = 0.
