@@ -4,18 +4,26 @@
 //! # Why obvhs, and its CWBVH
 //!
 //! We need a well-kept BVH crate with an *all-hits* traversal, since a global line keeps every
-//! intersection. `obvhs` (0.4, MIT/Apache-2.0, maintained, edition 2024: builds on our Rust 1.95) has
-//! `ray_traverse_anyhit`, which calls a closure for every primitive whose box the ray crosses and never
-//! shortens the ray: exactly "propose candidates, let us decide". It builds two layouts:
+//! intersection. `obvhs` (0.4, MIT/Apache-2.0, maintained, edition 2024: it needs Rust >= 1.85 and builds
+//! on our 1.95; pure Rust, no `unsafe` needed on our side) has `ray_traverse_anyhit`, which calls a
+//! closure for every primitive whose box the ray crosses and never shortens the ray: exactly "propose
+//! candidates, let us decide". It builds two layouts from the same boxes:
 //!
 //! * `Bvh2`, a binary BVH;
 //! * `CwBvh`, the 8-wide compressed BVH of Ylitie, Karras and Laine (HPG 2017), traversed with SSE.
 //!
-//! Measured on this machine (`cargo bench --bench throughput`, one thread, all hits on `@cube:30`): the
-//! CWBVH traversed about twice the lines per second of the `Bvh2` (see the README's throughput table for
-//! the final numbers against Embree), so we use the CWBVH. The `bvh` crate (nalgebra based, binary only,
-//! with an iterator of candidate boxes) was the other candidate; its traversal is a plain binary BVH, so it
-//! can be no faster than obvhs's `Bvh2`.
+//! Measured (`cargo run --release --example bvh_layouts`: 10^6 global lines on one thread, every
+//! candidate decided by the watertight test, shared machine), M lines/s:
+//!
+//! | scene       | CWBVH, leaves <= 3 | CWBVH, leaves <= 1 | Bvh2, leaves <= 3 | Bvh2, leaves <= 1 |
+//! |-------------|-------------------:|-------------------:|------------------:|------------------:|
+//! | `@cube:30`  | 3.83               | 3.48               | 2.81              | 2.82              |
+//! | `@cubes512` | 2.66               | 2.14               | 2.06              | 1.95              |
+//!
+//! with about 2.6 (`@cube:30`) and 7.7 (`@cubes512`) candidates per line whatever the layout: traversal,
+//! not the triangle test, is the cost, and the CWBVH with leaves of up to 3 triangles traverses fastest,
+//! so that is what we use. The `bvh` crate (nalgebra-based) was the other candidate; it offers only a
+//! binary BVH, the layout that loses here, so it was not measured.
 //!
 //! # Exactness
 //!
