@@ -67,7 +67,7 @@ pub fn build(spec: &str) -> Result<Scene, SceneError> {
         "octahedron" => solid(spec, &octahedron(), parse_count(spec, param, 1, 1000)?),
         "icosahedron" => solid(spec, &icosahedron(), parse_count(spec, param, 1, 1000)?),
         "dodecahedron" => solid(spec, &dodecahedron(), parse_count(spec, param, 1, 1000)?),
-        "cubes512" if param.is_none() => super::clutter::cubes512(spec),
+        "cubes512" => super::clutter::cubes512(spec, param),
         _ => Err(SceneError::Builtin(format!(
             "{spec}: unknown built-in scene; `scx scenes` lists them ({})",
             BUILTINS

@@ -73,8 +73,14 @@ pub fn cube_corners() -> Vec<[f64; 3]> {
     corners
 }
 
-/// `@cubes512`: the unit room holding 512 small cubes (see the module documentation).
-pub fn cubes512(spec: &str) -> Result<Scene, SceneError> {
+/// `@cubes512`: the unit room holding 512 small cubes (see the module documentation). It takes no
+/// parameter (`param` must be `None`).
+pub fn cubes512(spec: &str, param: Option<&str>) -> Result<Scene, SceneError> {
+    if let Some(p) = param {
+        return Err(SceneError::Builtin(format!(
+            "{spec}: @cubes512 takes no parameter, not `{p}`"
+        )));
+    }
     let mut b = SceneBuilder::new(spec);
     let m = b.material(Material {
         name: "wall".into(),
@@ -111,7 +117,12 @@ mod tests {
 
     #[test]
     fn counts_and_facing() {
-        let s = cubes512("@cubes512").unwrap();
+        let s = cubes512("@cubes512", None).unwrap();
+        let e = cubes512("@cubes512:3", Some("3")).unwrap_err().to_string();
+        assert!(
+            e.starts_with("@cubes512:3") && e.contains("no parameter"),
+            "{e}"
+        );
         assert_eq!(s.patch_count(), 6 + 512 * 6);
         assert_eq!(s.triangles.len(), 2 * s.patch_count());
         // Area: room 6, each small cube 6 / 256, in room units squared.
