@@ -5,7 +5,7 @@ use std::time::Instant;
 use crate::measure::visibility::{self, ContinuousValues, DiscreteValues};
 use crate::measure::Estimate;
 use crate::sample::lines::LineSource;
-use crate::sample::tally::{tally_batches_from, BatchPlan, Tally, Wanted};
+use crate::sample::tally::{trace_batches, BatchPlan, Tally, TracedBatches, Wanted};
 use crate::scene::Scene;
 use crate::trace::{TraceError, Tracer};
 
@@ -130,23 +130,23 @@ pub fn analyze_with(
 
     let mut merged = MergeStack::default();
     let mut per_group = Vec::with_capacity(groups as usize);
-    // Group g's measures and its merge into the total run while group g + 1 is traced (rayon::join lets
-    // an idle thread take them), so this serial work hides behind the parallel tracing.
-    let mut done: Option<Tally> = None;
+    // Group g's counting (sorting its pair keys), measures and merge into the total run while group
+    // g + 1 is traced (rayon::join lets an idle thread take them), so this serial work hides behind the
+    // parallel tracing.
+    let mut done: Option<TracedBatches> = None;
     for g in 0..=groups {
         let range = g * batches / groups..(g + 1) * batches / groups;
         let (next, ()) = rayon::join(
             || {
                 (g < groups)
                     .then(|| {
-                        tally_batches_from(
-                            scene, tracer, &plan, source, cfg.seed, range, cfg.wanted,
-                        )
+                        trace_batches(scene, tracer, &plan, source, cfg.seed, range, cfg.wanted)
                     })
                     .transpose()
             },
             || {
-                if let Some(tally) = done.take() {
+                if let Some(traced) = done.take() {
+                    let tally = traced.into_tally(scene, cfg.wanted);
                     per_group.push(GroupValues::of(scene, &areas, &tally));
                     merged.push(tally);
                 }

@@ -189,7 +189,29 @@ pub fn tally_batches_from(
     batches: Range<u64>,
     wanted: Wanted,
 ) -> Result<Tally, TraceError> {
-    let per_batch: Vec<BatchTally> = batches
+    Ok(
+        trace_batches(scene, tracer, plan, source, seed, batches, wanted)?
+            .into_tally(scene, wanted),
+    )
+}
+
+/// The batches of a group, traced and paired but not yet counted: the parallel part of
+/// [`tally_batches_from`]. [`TracedBatches::into_tally`] is the serial rest, which a caller may overlap
+/// with tracing the next group.
+#[derive(Debug)]
+pub(crate) struct TracedBatches(Vec<BatchTally>);
+
+/// Traces and pairs the batches `batches` in parallel (see [`tally_batches_from`]).
+pub(crate) fn trace_batches(
+    scene: &Scene,
+    tracer: &dyn Tracer,
+    plan: &BatchPlan,
+    source: LineSource,
+    seed: u64,
+    batches: Range<u64>,
+    wanted: Wanted,
+) -> Result<TracedBatches, TraceError> {
+    let per_batch = batches
         .into_par_iter()
         .map_init(Scratch::default, |scratch, b| {
             let lines = BatchLines {
@@ -201,27 +223,34 @@ pub fn tally_batches_from(
             tally_batch(scene, tracer, lines, wanted, scratch)
         })
         .collect::<Result<_, _>>()?;
+    Ok(TracedBatches(per_batch))
+}
 
-    let mut tally = Tally::empty(scene, wanted);
-    let mut batch_counts = Vec::with_capacity(per_batch.len());
-    for b in per_batch {
-        tally.lines += b.lines;
-        tally.hits += b.hits;
-        tally.pairs += b.pairs;
-        tally.escapes += b.escapes;
-        tally.unpaired += b.unpaired;
-        tally.degenerate_pairs += b.degenerate_pairs;
-        tally.cmi_sum += b.cmi_sum;
-        tally.cmi_pairs += b.cmi_pairs;
-        for &p in &b.escape_patches {
-            tally.escapes_by_patch[p as usize] += 1;
+impl TracedBatches {
+    /// Adds the batches up in batch order (so f64 sums are the same whatever the threads) and counts
+    /// their pairs.
+    pub(crate) fn into_tally(self, scene: &Scene, wanted: Wanted) -> Tally {
+        let mut tally = Tally::empty(scene, wanted);
+        let mut batch_counts = Vec::with_capacity(self.0.len());
+        for b in self.0 {
+            tally.lines += b.lines;
+            tally.hits += b.hits;
+            tally.pairs += b.pairs;
+            tally.escapes += b.escapes;
+            tally.unpaired += b.unpaired;
+            tally.degenerate_pairs += b.degenerate_pairs;
+            tally.cmi_sum += b.cmi_sum;
+            tally.cmi_pairs += b.cmi_pairs;
+            for &p in &b.escape_patches {
+                tally.escapes_by_patch[p as usize] += 1;
+            }
+            batch_counts.push(b.pair_keys);
         }
-        batch_counts.push(b.pair_keys);
+        if wanted.discrete {
+            tally.counts = Some(PairCounts::from_batches(scene.patch_count(), batch_counts));
+        }
+        tally
     }
-    if wanted.discrete {
-        tally.counts = Some(PairCounts::from_batches(scene.patch_count(), batch_counts));
-    }
-    Ok(tally)
 }
 
 /// Which lines a batch casts.
