@@ -1,15 +1,16 @@
 //! A throughput table for notes and the README: million lines per second of the all-hits kernel (raw and
-//! canonical hits), of first-hit queries, and of the whole analysis on the same number of lines, per query
-//! kind and thread count. Best of three runs (the machine is shared).
+//! canonical hits), of first-hit queries, and of the whole analysis on the same number of lines, per
+//! tracer (Embree single lines and native packets, the pure-Rust BVH) and thread count. Best of three runs
+//! (the machine is shared).
 //!
-//! `cargo bench --bench throughput [-- SCENE [LINES]]`, default `@cube:30` and 10^6 lines.
+//! `cargo bench --bench throughput [-- SCENE... [LINES]]`, default `@cube:30 @cubes512` and 10^6 lines;
+//! `SCX_BENCH_TRACERS=rust,single` keeps only the tracers whose names contain one of the words.
 
 use std::time::Instant;
 
 use rayon::prelude::*;
-use scene_complexity::analysis::{analyze, AnalysisConfig};
+use scene_complexity::analysis::{analyze, AnalysisConfig, DEFAULT_GROUPS};
 use scene_complexity::sample::lines::batch_lines;
-use scene_complexity::sample::tally::Wanted;
 use scene_complexity::scene;
 use scene_complexity::trace::{make_tracer, Backend, Line, LineHits, Query, Tracer};
 
@@ -17,18 +18,41 @@ const CHUNK: usize = 4096;
 const REPEATS: usize = 3;
 
 fn main() -> anyhow::Result<()> {
-    // `cargo bench` passes `--bench`; keep only our own arguments.
+    // `cargo bench` passes `--bench`; keep only our own arguments: numbers are the line count, the rest
+    // scenes.
     let args: Vec<String> = std::env::args()
         .skip(1)
         .filter(|a| !a.starts_with("--"))
         .collect();
-    let spec = args.first().cloned().unwrap_or_else(|| "@cube:30".into());
-    let count: u64 = args
-        .get(1)
-        .map(|a| a.parse::<f64>())
-        .transpose()?
-        .unwrap_or(1e6) as u64;
-    let scene = scene::load(&spec)?;
+    let (counts, mut specs): (Vec<String>, Vec<String>) =
+        args.into_iter().partition(|a| a.parse::<f64>().is_ok());
+    if specs.is_empty() {
+        specs = vec!["@cube:30".into(), "@cubes512".into()];
+    }
+    let count = counts.first().map_or(Ok(1e6), |c| c.parse::<f64>())? as u64;
+    println!(
+        "M lines/s: wall clock, and per CPU-second of all threads (robust when the machine is shared)"
+    );
+    println!(
+        "{:<11} {:<16} {:>3}  {:>14}  {:>14}  {:>14}  {:>10}",
+        "scene", "tracer", "thr", "all-hits", "first-hit", "analyze", "an./all"
+    );
+    println!(
+        "{:<11} {:<16} {:>3}  {:>6} {:>7}  {:>6} {:>7}  {:>6} {:>7}  {:>4} {:>5}",
+        "", "", "", "wall", "cpu", "wall", "cpu", "wall", "cpu", "wall", "cpu"
+    );
+    // The pools live for the whole run: a thread that exits during a measurement would take its CPU time
+    // out of the sum.
+    let pools = [1, 2].map(|n| rayon::ThreadPoolBuilder::new().num_threads(n).build());
+    let pools: Vec<rayon::ThreadPool> = pools.into_iter().collect::<Result<_, _>>()?;
+    for spec in &specs {
+        bench_scene(spec, count, &pools)?;
+    }
+    Ok(())
+}
+
+fn bench_scene(spec: &str, count: u64, pools: &[rayon::ThreadPool]) -> anyhow::Result<()> {
+    let scene = scene::load(spec)?;
     let mut lines = Vec::with_capacity(count as usize);
     for b in 0..count.div_ceil(CHUNK as u64) {
         batch_lines(
@@ -39,37 +63,38 @@ fn main() -> anyhow::Result<()> {
             &mut lines,
         );
     }
-    println!("{spec}: {} triangles, {count} lines", scene.triangles.len());
-    println!("tracer          threads  raw Ml/s  all-hits Ml/s  analyze Ml/s  analyze/all-hits");
-    for (name, backend, query) in candidates() {
+    let cfg = AnalysisConfig {
+        groups: DEFAULT_GROUPS,
+        ..AnalysisConfig::new(count, 1)
+    };
+    // `SCX_BENCH_TRACERS=rust,embree single` keeps the tracers whose names contain one of the words.
+    let only = std::env::var("SCX_BENCH_TRACERS").unwrap_or_default();
+    let wanted = |name: &str| only.is_empty() || only.split(',').any(|w| name.contains(w.trim()));
+    for (name, backend, query) in candidates().into_iter().filter(|c| wanted(&c.0)) {
         let Ok(tracer) = make_tracer(backend, &scene, query) else {
             continue;
         };
-        for threads in [1, 2] {
-            let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(threads)
-                .build()?;
-            let raw = pool.install(|| best(|| raw_pass(tracer.as_ref(), &lines)));
-            let all = pool.install(|| best(|| all_hits_pass(tracer.as_ref(), &lines)));
-            let cfg = AnalysisConfig {
-                wanted: Wanted {
-                    discrete: true,
-                    continuous: true,
-                },
-                ..AnalysisConfig::new(count, 1)
-            };
+        for pool in pools {
+            let threads = pool.current_num_threads();
+            let t = tracer.as_ref();
+            let all = pool.install(|| best(|| all_hits_pass(t, &lines)));
+            let first = pool.install(|| best(|| first_hit_pass(t, &lines)));
             let end_to_end = pool.install(|| {
                 best(|| {
-                    analyze(&scene, tracer.as_ref(), &cfg).unwrap();
+                    analyze(&scene, t, &cfg).unwrap();
                 })
             });
             let rate = |s: f64| count as f64 / s / 1e6;
             println!(
-                "{name:<15} {threads:>7}  {:>8.2}  {:>13.2}  {:>12.2}  {:>16.2}",
-                rate(raw),
-                rate(all),
-                rate(end_to_end),
-                all / end_to_end
+                "{spec:<11} {name:<16} {threads:>3}  {:>6.2} {:>7.2}  {:>6.2} {:>7.2}  {:>6.2} {:>7.2}  {:>4.2} {:>5.2}",
+                rate(all.wall),
+                rate(all.cpu),
+                rate(first.wall),
+                rate(first.cpu),
+                rate(end_to_end.wall),
+                rate(end_to_end.cpu),
+                all.wall / end_to_end.wall,
+                all.cpu / end_to_end.cpu,
             );
         }
     }
@@ -85,24 +110,56 @@ fn candidates() -> Vec<(String, Backend, Query)> {
             Query::Packet(w),
         ));
     }
+    v.push(("rust single".to_string(), Backend::Rust, Query::Single));
     v
 }
 
-/// Fastest of a few runs, in seconds.
-fn best(mut f: impl FnMut()) -> f64 {
-    (0..REPEATS)
-        .map(|_| {
-            let t = Instant::now();
-            f();
-            t.elapsed().as_secs_f64()
-        })
-        .fold(f64::INFINITY, f64::min)
+/// The fastest of a few runs: wall-clock seconds, and CPU seconds of all the process's threads.
+#[derive(Clone, Copy, Debug)]
+struct Timing {
+    wall: f64,
+    cpu: f64,
 }
 
-fn raw_pass(tracer: &dyn Tracer, lines: &[Line]) {
+/// Best wall time and best CPU time of `REPEATS` runs.
+fn best(mut f: impl FnMut()) -> Timing {
+    let mut t = Timing {
+        wall: f64::INFINITY,
+        cpu: f64::INFINITY,
+    };
+    for _ in 0..REPEATS {
+        let (w0, c0) = (Instant::now(), cpu_seconds());
+        f();
+        t.wall = t.wall.min(w0.elapsed().as_secs_f64());
+        t.cpu = t.cpu.min(cpu_seconds() - c0);
+    }
+    t
+}
+
+/// CPU time used so far by the live threads of this process (Linux: the first field of each
+/// `/proc/self/task/*/schedstat`, nanoseconds on a CPU); NaN where that is not available.
+fn cpu_seconds() -> f64 {
+    let Ok(tasks) = std::fs::read_dir("/proc/self/task") else {
+        return f64::NAN;
+    };
+    let mut ns = 0u64;
+    for task in tasks.flatten() {
+        let stat = std::fs::read_to_string(task.path().join("schedstat")).unwrap_or_default();
+        ns += stat
+            .split_whitespace()
+            .next()
+            .and_then(|v| v.parse::<u64>().ok())
+            .unwrap_or(0);
+    }
+    ns as f64 * 1e-9
+}
+
+fn first_hit_pass(tracer: &dyn Tracer, lines: &[Line]) {
     lines
         .par_chunks(CHUNK)
-        .for_each_init(Vec::new, |raw, chunk| tracer.raw_hits(chunk, raw).unwrap());
+        .for_each_init(Vec::new, |first, chunk| {
+            tracer.first_hits(chunk, first).unwrap()
+        });
 }
 
 fn all_hits_pass(tracer: &dyn Tracer, lines: &[Line]) {

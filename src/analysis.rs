@@ -15,7 +15,10 @@ use std::time::{Duration, Instant};
 use crate::measure::bias::{self, CorrectedValues, EntropyEstimator};
 use crate::measure::visibility::{self, ContinuousValues, DiscreteValues};
 use crate::measure::Estimate;
-use crate::sample::tally::{trace_batches, BatchPlan, BatchTally, Tally, Wanted};
+use rayon::prelude::*;
+
+use crate::sample::lines::LineSource;
+use crate::sample::tally::{trace_batches, BatchPlan, Tally, TracedBatches, Wanted};
 use crate::scene::Scene;
 use crate::trace::{TraceError, Tracer};
 
@@ -44,6 +47,9 @@ pub struct AnalysisConfig {
     pub estimator: EntropyEstimator,
     /// When to stop before `lines`.
     pub budget: Budget,
+    /// Independent lines, or bundles of parallel lines ([`LineSource`]); a bundle never straddles two
+    /// batches, so the group spread includes the correlation within a bundle.
+    pub source: LineSource,
 }
 
 impl AnalysisConfig {
@@ -59,6 +65,7 @@ impl AnalysisConfig {
             groups: DEFAULT_GROUPS,
             estimator: DEFAULT_ESTIMATOR,
             budget: Budget::default(),
+            source: LineSource::Independent,
         }
     }
 }
@@ -294,9 +301,9 @@ pub fn analyze_observed(
     let start = Instant::now();
     let open_ended = cfg.budget.seconds.is_some() || cfg.budget.target.is_some();
     let plan = if open_ended {
-        BatchPlan::open_ended(cfg.lines)
+        BatchPlan::open_ended(cfg.lines, cfg.source)
     } else {
-        BatchPlan::new(cfg.lines)
+        BatchPlan::for_source(cfg.lines, cfg.source)
     };
     let deadline = cfg
         .budget
@@ -326,16 +333,17 @@ pub fn analyze_observed(
     let stop_reason = loop {
         let first = run.batches_done;
         let last = (first + round).min(plan.batches());
-        let traced = trace_batches(
+        let (traced, complete) = trace_batches(
             scene,
             tracer,
             &plan,
+            cfg.source,
             cfg.seed,
             first..last,
             cfg.wanted,
             &stop,
         )?;
-        let complete = run.add_prefix(traced);
+        run.add(traced);
         if !complete {
             break if control.stop_requested() {
                 StopReason::Interrupted
@@ -423,28 +431,24 @@ impl<'a> GroupedRun<'a> {
         self.groups.len() as u64
     }
 
-    /// Adds the longest prefix of finished batches to their groups; true when every batch finished.
-    fn add_prefix(&mut self, traced: Vec<Option<BatchTally>>) -> bool {
-        let finished = traced.iter().take_while(|b| b.is_some()).count();
-        let first = self.batches_done;
-        let g_count = self.groups();
-        for (g, slot) in self.groups.iter_mut().enumerate() {
-            let members = traced[..finished]
-                .iter()
-                .enumerate()
-                .filter(|(k, _)| (first + *k as u64) % g_count == g as u64)
-                .map(|(_, b)| b.as_ref().expect("within the finished prefix"));
-            if members.clone().next().is_none() {
-                continue;
-            }
-            let tally = Tally::from_batches(self.scene, self.wanted, members);
-            match slot {
-                Some(t) => t.merge(&tally),
-                None => *slot = Some(tally),
-            }
-        }
-        self.batches_done += finished as u64;
-        finished == traced.len()
+    /// Adds traced batches (consecutive from `batches_done`) to their groups, counting the groups in
+    /// parallel.
+    fn add(&mut self, traced: TracedBatches) {
+        let batches = traced.len() as u64;
+        let (scene, wanted) = (self.scene, self.wanted);
+        let pieces = traced.split_into_groups(self.groups());
+        self.groups
+            .par_iter_mut()
+            .zip(pieces)
+            .filter(|(_, piece)| !piece.is_empty())
+            .for_each(|(slot, piece)| {
+                let tally = piece.into_tally(scene, wanted);
+                match slot {
+                    Some(t) => t.merge(&tally),
+                    None => *slot = Some(tally),
+                }
+            });
+        self.batches_done += batches;
     }
 
     /// The standard error of `measure` from the groups so far.
@@ -456,7 +460,7 @@ impl<'a> GroupedRun<'a> {
     ) -> Option<f64> {
         let filled: Vec<&Tally> = self.groups.iter().flatten().collect();
         let values: Vec<GroupValues> = filled
-            .iter()
+            .par_iter()
             .map(|t| GroupValues::of(areas, t, cfg.estimator))
             .collect();
         // The total's value does not change the spread of the groups; any stand-in does.
@@ -476,7 +480,7 @@ impl<'a> GroupedRun<'a> {
         let filled: Vec<Tally> = self.groups.into_iter().flatten().collect();
         filled.iter().for_each(&mut *each_group);
         let per_group = filled
-            .iter()
+            .par_iter()
             .map(|t| GroupValues::of(areas, t, estimator))
             .collect();
         let mut merged = MergeStack::default();

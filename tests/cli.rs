@@ -34,7 +34,7 @@ fn json_report_parses_and_carries_the_documented_fields() {
     assert_eq!(doc["patches"], 54);
     assert_eq!(doc["triangles"], 108);
     assert!((doc["area"].as_f64().unwrap() - 6.0).abs() < 1e-9);
-    assert_eq!(doc["tracer"], "rust-brute");
+    assert_eq!(doc["tracer"], "rust");
     assert_eq!(doc["lines"], 20000);
     assert_eq!(doc["seed"], 1);
     assert_eq!(doc["threads"], 2);

@@ -18,8 +18,10 @@ use scene_complexity::measure::bias::EntropyEstimator;
 use scene_complexity::measure::radiosity::SolveOptions;
 use scene_complexity::radiosity::{analyze_with_radiosity, RadiosityOutcome};
 use scene_complexity::refine::{refine, RefineConfig, RefineRound, Strategy};
+use scene_complexity::sample::lines::LineSource;
 use scene_complexity::sample::tally::Wanted;
 use scene_complexity::scene::{self, builtin};
+use scene_complexity::trace::crosscheck::{self, CrossCheckConfig, Tolerance};
 use scene_complexity::trace::{make_tracer, Backend, Query};
 
 /// scx: how hard is a 3D scene to light and to mesh? Information-theoretic scene complexity
@@ -43,6 +45,30 @@ enum Command {
     Convergence(ConvergenceArgs),
     /// Refine a scene's patches with a meshing strategy (paper Table 9) and write the mesh as OBJ + MTL.
     Refine(RefineArgs),
+    /// Trace the same lines with Embree and the pure-Rust tracer, compare them hit for hit and measure
+    /// for measure; exit 1 when a line differs beyond the tolerance.
+    Crosscheck(CrosscheckArgs),
+}
+
+#[derive(clap::Args, Debug)]
+struct CrosscheckArgs {
+    /// An OBJ file, or a built-in scene such as `@cube:10` (see `scx scenes`).
+    scene: String,
+    /// Number of global lines (accepts `1e6`).
+    #[arg(long, default_value = "1e6", value_parser = parse_count)]
+    lines: u64,
+    /// Seed of the random line streams (the lines of `scx analyze` with the same seed).
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Worker threads (default: all cores). Results do not depend on it.
+    #[arg(long)]
+    threads: Option<usize>,
+    /// Distances agree within this many f32 ulps at max(t, 1).
+    #[arg(long, default_value_t = Tolerance::default().ulps)]
+    ulps: f32,
+    /// How many differing lines to print.
+    #[arg(long, default_value_t = 5)]
+    show: usize,
 }
 
 #[derive(clap::Args, Debug)]
@@ -140,6 +166,10 @@ struct AnalyzeArgs {
     /// accuracy.
     #[arg(long, default_value = "mutual_information", value_parser = parse_target_measure)]
     target_measure: TargetMeasure,
+    /// Cast the lines in bundles of G x G parallel lines (jittered grid over the disc, traced as adjacent
+    /// packets); 0 casts independent lines. The standard errors include the correlation within a bundle.
+    #[arg(long, default_value_t = 0, value_parser = parse_bundle)]
+    bundle: u32,
     /// Output format.
     #[arg(long, value_enum, default_value_t = Format::Table)]
     format: Format,
@@ -222,6 +252,14 @@ fn parse_target_measure(s: &str) -> Result<TargetMeasure, String> {
     })
 }
 
+fn parse_bundle(s: &str) -> Result<u32, String> {
+    let g: u32 = s
+        .trim()
+        .parse()
+        .map_err(|_| format!("`{s}` is not a whole number"))?;
+    LineSource::bundles(g).map(|_| g)
+}
+
 fn parse_query(s: &str) -> Result<Query, String> {
     match s {
         "single" => Ok(Query::Single),
@@ -249,6 +287,7 @@ pub fn main() -> ExitCode {
         Command::Export(args) => finish(try_export(&args)),
         Command::Convergence(args) => finish(convergence::run(&args)),
         Command::Refine(args) => finish(try_refine(&args)),
+        Command::Crosscheck(args) => finish(try_crosscheck(&args)),
     }
 }
 
@@ -371,6 +410,7 @@ impl Runner {
             query: self.query,
             threads: self.threads,
             radiosity,
+            bundle: 0,
         }
     }
 
@@ -412,6 +452,7 @@ fn try_analyze(args: &AnalyzeArgs) -> Result<(), Failure> {
     let cfg = AnalysisConfig {
         wanted,
         budget,
+        source: LineSource::bundles(args.bundle).map_err(bad_input)?,
         ..runner.config(&args.run, lines, args.run.seed)
     };
     let want_radiosity = args
@@ -428,7 +469,10 @@ fn try_analyze(args: &AnalyzeArgs) -> Result<(), Failure> {
     for w in report::warnings(&runner.scene, &analysis) {
         eprintln!("scx: warning: {w}");
     }
-    let run = runner.info(&radiosity);
+    let run = report::RunInfo {
+        bundle: args.bundle,
+        ..runner.info(&radiosity)
+    };
     let text = match args.format {
         Format::Table => report::table(&run, &analysis),
         Format::Json => report::json(&run, &analysis),
@@ -498,6 +542,46 @@ fn try_refine(args: &RefineArgs) -> Result<(), Failure> {
         started.elapsed().as_secs_f64()
     );
     Ok(())
+}
+
+fn try_crosscheck(args: &CrosscheckArgs) -> Result<(), Failure> {
+    if !(args.ulps.is_finite() && args.ulps >= 0.0) {
+        return Err(bad_input(format!(
+            "--ulps {}: need a finite number >= 0",
+            args.ulps
+        )));
+    }
+    let scene = load_scene(&args.scene)?;
+    let embree = make_tracer(Backend::Embree, &scene, Query::Single).map_err(bad_input)?;
+    let rust = make_tracer(Backend::Rust, &scene, Query::Single).map_err(bad_input)?;
+    let (_, pool) = thread_pool(args.threads)?;
+    let cfg = CrossCheckConfig {
+        lines: args.lines,
+        seed: args.seed,
+        tolerance: Tolerance { ulps: args.ulps },
+        examples: args.show,
+    };
+    let check = pool
+        .install(|| {
+            crosscheck::crosscheck(&scene, embree.as_ref(), rust.as_ref(), &cfg, DEFAULT_GROUPS)
+        })
+        .map_err(|e| Failure {
+            code: 1,
+            message: e.to_string(),
+        })?;
+    write_stdout(&crosscheck::report(&check, &scene))?;
+    if check.passed() {
+        Ok(())
+    } else {
+        Err(Failure {
+            code: 1,
+            message: format!(
+                "{} of {} lines differ between the tracers",
+                check.hits.differing_lines(),
+                check.hits.lines
+            ),
+        })
+    }
 }
 
 /// The worker threads (default: all cores) and a rayon pool of that size.

@@ -20,6 +20,8 @@ pub struct RunInfo<'a> {
     pub threads: usize,
     /// The radiosity measures, or why they were left out.
     pub radiosity: &'a RadiosityOutcome,
+    /// Lines per side of a bundle, 0 for independent lines.
+    pub bundle: u32,
 }
 
 /// One row of the report: JSON key, table label, paper reference, plug-in and bias-corrected estimates.
@@ -165,6 +167,7 @@ pub fn json(run: &RunInfo, a: &Analysis) -> String {
         "area": run.scene.total_area_scene_units(),
         "tracer": run.tracer,
         "query": run.query.to_string(),
+        "bundle": run.bundle,
         "lines": a.lines,
         "seed": a.seed,
         "threads": run.threads,
@@ -313,8 +316,13 @@ pub fn table(run: &RunInfo, a: &Analysis) -> String {
     );
     let _ = writeln!(
         s,
-        "lines    {}  seed {}  tracer {} ({})  threads {}  {:.3} s  ({:.2} M lines/s)",
+        "lines    {}{}  seed {}  tracer {} ({})  threads {}  {:.3} s  ({:.2} M lines/s)",
         a.lines,
+        if run.bundle > 0 {
+            format!(" in bundles of {0} x {0}", run.bundle)
+        } else {
+            String::new()
+        },
         a.seed,
         run.tracer,
         run.query,

@@ -5,7 +5,6 @@
 //! scene has at most [`DENSE_MAX_PATCHES`] patches, a sorted sparse list otherwise.
 
 use ndarray::Array2;
-use rayon::slice::ParallelSliceMut;
 
 /// Scenes with at most this many patches keep their counts in a dense matrix (32 MiB at most).
 pub const DENSE_MAX_PATCHES: usize = 2048;
@@ -51,8 +50,28 @@ impl PairCounts {
                 }
             }
             PairCounts::Sparse(list) => {
-                keys.par_sort_unstable();
+                sort_keys(patches, keys);
                 *list = run_lengths(keys);
+            }
+        }
+        counts
+    }
+
+    /// Counts for `patches` patches from the pair keys of several batches, in any order (integer sums do
+    /// not depend on it). Sparse counts radix-sort all the keys at once ([`sort_keys`]).
+    pub fn from_batches(patches: usize, batches: Vec<Vec<u64>>) -> Self {
+        let mut counts = PairCounts::new(patches);
+        match &mut counts {
+            PairCounts::Dense(m) => {
+                for &k in batches.iter().flatten() {
+                    let (i, j) = split_key(k);
+                    m[[i as usize, j as usize]] += 1;
+                }
+            }
+            PairCounts::Sparse(list) => {
+                let mut keys = batches.concat();
+                sort_keys(patches, &mut keys);
+                *list = run_lengths(&keys);
             }
         }
         counts
@@ -100,6 +119,55 @@ impl PairCounts {
     }
 }
 
+/// Sorts pair keys of a scene of `patches` patches. Below 2^16 patches a key is first packed into
+/// `i * patches + j < 2^32` and sorted by an LSD radix sort in passes of 11 bits (3 passes at most,
+/// linear time: a group's keys are mostly distinct, so a comparison sort or a merge of sorted batches
+/// would cost log n times more); larger scenes fall back to a comparison sort.
+fn sort_keys(patches: usize, keys: &mut [u64]) {
+    let n = patches as u64;
+    if n == 0 || n >= 1 << 16 {
+        keys.sort_unstable();
+        return;
+    }
+    let mut packed: Vec<u32> = keys
+        .iter()
+        .map(|&k| {
+            let (i, j) = split_key(k);
+            (u64::from(i) * n + u64::from(j)) as u32
+        })
+        .collect();
+    let bits = 64 - (n * n - 1).max(1).leading_zeros();
+    radix_sort_u32(&mut packed, bits);
+    for (k, &p) in keys.iter_mut().zip(&packed) {
+        *k = pair_key((u64::from(p) / n) as u32, (u64::from(p) % n) as u32);
+    }
+}
+
+/// Least-significant-digit radix sort of values below 2^bits, 11 bits per pass.
+fn radix_sort_u32(values: &mut Vec<u32>, bits: u32) {
+    const DIGIT: u32 = 11;
+    let mut scratch = vec![0u32; values.len()];
+    let mut shift = 0;
+    while shift < bits {
+        let mut offsets = [0usize; 1 << DIGIT];
+        let digit = |v: u32| ((v >> shift) & ((1 << DIGIT) - 1)) as usize;
+        for &v in values.iter() {
+            offsets[digit(v)] += 1;
+        }
+        let mut sum = 0;
+        for o in offsets.iter_mut() {
+            (*o, sum) = (sum, sum + *o);
+        }
+        for &v in values.iter() {
+            let d = digit(v);
+            scratch[offsets[d]] = v;
+            offsets[d] += 1;
+        }
+        std::mem::swap(values, &mut scratch);
+        shift += DIGIT;
+    }
+}
+
 fn run_lengths(sorted: &[u64]) -> Vec<(u64, u64)> {
     let mut out: Vec<(u64, u64)> = Vec::new();
     for &k in sorted {
@@ -111,25 +179,20 @@ fn run_lengths(sorted: &[u64]) -> Vec<(u64, u64)> {
     out
 }
 
+/// Merges two sorted `(key, count)` lists, adding the counts of equal keys. Branch-free in the loop body
+/// (which list advances is data, not control flow: the keys of two groups interleave at random, so a
+/// branch would be mispredicted half the time), and the output is allocated once at its largest size.
 fn merge_sorted(a: &[(u64, u64)], b: &[(u64, u64)]) -> Vec<(u64, u64)> {
-    let mut out = Vec::with_capacity(a.len().max(b.len()));
+    let mut out = Vec::with_capacity(a.len() + b.len());
     let (mut i, mut j) = (0, 0);
     while i < a.len() && j < b.len() {
-        match a[i].0.cmp(&b[j].0) {
-            std::cmp::Ordering::Less => {
-                out.push(a[i]);
-                i += 1;
-            }
-            std::cmp::Ordering::Greater => {
-                out.push(b[j]);
-                j += 1;
-            }
-            std::cmp::Ordering::Equal => {
-                out.push((a[i].0, a[i].1 + b[j].1));
-                i += 1;
-                j += 1;
-            }
-        }
+        let ((ka, ca), (kb, cb)) = (a[i], b[j]);
+        let (take_a, take_b) = (ka <= kb, kb <= ka);
+        let key = if take_a { ka } else { kb };
+        let count = u64::from(take_a) * ca + u64::from(take_b) * cb;
+        out.push((key, count));
+        i += usize::from(take_a);
+        j += usize::from(take_b);
     }
     out.extend_from_slice(&a[i..]);
     out.extend_from_slice(&b[j..]);
@@ -163,6 +226,35 @@ mod tests {
         assert!(dense.is_dense() && !sparse.is_dense());
         assert_eq!(entries(&dense), vec![(0, 0, 1), (1, 3, 2), (2, 5, 3)]);
         assert_eq!(entries(&dense), entries(&sparse));
+
+        // Radix sort of packed keys equals a comparison sort.
+        let mut rng = 12345u64;
+        let mut many: Vec<u64> = (0..5000)
+            .map(|_| {
+                rng = rng
+                    .wrapping_mul(6364136223846793005)
+                    .wrapping_add(1442695040888963407);
+                let (a, b) = ((rng >> 33) as u32 % 3000, (rng >> 13) as u32 % 3000);
+                pair_key(a, b)
+            })
+            .collect();
+        let mut expected = many.clone();
+        expected.sort_unstable();
+        sort_keys(3000, &mut many);
+        assert_eq!(many, expected);
+
+        // Per-batch hand-over, both layouts, gives the same counts.
+        let halves = || {
+            let (a, b) = keys.split_at(3);
+            vec![a.to_vec(), b.to_vec(), Vec::new()]
+        };
+        let from_dense = PairCounts::from_batches(8, halves());
+        assert!(from_dense.is_dense());
+        assert_eq!(entries(&from_dense), entries(&dense));
+        let many = DENSE_MAX_PATCHES + 1;
+        let from_sparse = PairCounts::from_batches(many, halves());
+        assert!(!from_sparse.is_dense());
+        assert_eq!(entries(&from_sparse), entries(&dense));
 
         let mut twice = sparse.clone();
         twice.merge(&sparse);

@@ -31,6 +31,139 @@ pub fn batch_lines(seed: u64, batch: u64, count: usize, radius: f64, out: &mut V
     out.extend((0..count).map(|_| global_line(&mut rng, radius)));
 }
 
+/// Where a run's lines come from: independent global lines, or bundles of parallel ones.
+///
+/// Either way every line is a uniformly distributed global line (its marginal law is the invariant
+/// measure), so every estimate stays unbiased; bundles make the lines of one bundle correlated, which the
+/// standard errors see because a batch always holds whole bundles (see [`LineSource::lines_per_unit`]) and
+/// the standard-error groups are made of whole batches.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum LineSource {
+    /// Every line drawn on its own ([`global_line`]).
+    #[default]
+    Independent,
+    /// Bundles of `grid x grid` parallel lines ([`bundle_lines`]).
+    Bundles {
+        /// Lines per side of a bundle's grid, 1 to [`MAX_BUNDLE_GRID`].
+        grid: u32,
+    },
+}
+
+/// The largest bundle grid: 64 x 64 = 4096 lines, the largest batch.
+pub const MAX_BUNDLE_GRID: u32 = 64;
+
+impl LineSource {
+    /// Bundles of `grid x grid` lines, or independent lines for `grid == 0`; errors beyond
+    /// [`MAX_BUNDLE_GRID`].
+    pub fn bundles(grid: u32) -> Result<Self, String> {
+        match grid {
+            0 => Ok(LineSource::Independent),
+            1..=MAX_BUNDLE_GRID => Ok(LineSource::Bundles { grid }),
+            _ => Err(format!(
+                "a bundle grid of {grid} x {grid} lines: need 0 (independent lines) to {MAX_BUNDLE_GRID}"
+            )),
+        }
+    }
+
+    /// The lines drawn together: 1 for independent lines, `grid^2` for bundles. Batches (and so the
+    /// standard-error groups) hold whole units, never part of a bundle.
+    pub fn lines_per_unit(&self) -> u64 {
+        match *self {
+            LineSource::Independent => 1,
+            LineSource::Bundles { grid } => u64::from(grid) * u64::from(grid),
+        }
+    }
+
+    /// Appends the `count` lines of batch `batch` to `out`; `count` must be a whole number of units
+    /// (bundles), as [`crate::sample::tally::BatchPlan::for_source`] makes it.
+    pub fn batch_lines(
+        &self,
+        seed: u64,
+        batch: u64,
+        count: usize,
+        radius: f64,
+        out: &mut Vec<Line>,
+    ) {
+        match *self {
+            LineSource::Independent => batch_lines(seed, batch, count, radius, out),
+            LineSource::Bundles { grid } => {
+                let mut rng = batch_rng(seed, batch);
+                let per = (grid * grid) as usize;
+                debug_assert_eq!(count % per, 0, "batches hold whole bundles");
+                for _ in 0..count / per {
+                    bundle_lines(&mut rng, grid, radius, out);
+                }
+            }
+        }
+    }
+}
+
+/// Appends one bundle of `grid x grid` parallel global lines: a uniform direction, then one uniform point
+/// in each cell of a `grid x grid` grid over the square [-1, 1]^2, carried onto the disc of radius
+/// `radius` perpendicular to the direction by the concentric map of Shirley and Chiu (1997).
+///
+/// Why this is unbiased: the concentric map preserves area fractions, so a point uniform in a cell of the
+/// square lands uniformly in the cell's image, and the images of the cells tile the disc with equal areas.
+/// Each line is therefore a uniform point of the disc on a uniform direction: a uniformly distributed
+/// global line, exactly as [`global_line`] draws them. The bundle is a stratified (jittered) sample of the
+/// disc, with exactly `grid^2` lines (rejecting the points of a square grid that fall outside the disc
+/// would make the count random, and bundles could then not fill batches exactly).
+///
+/// The lines come in Morton (Z) order of their cells, so 4, 8 or 16 consecutive lines are neighbours:
+/// packets of adjacent parallel lines, which Embree traces coherently.
+pub fn bundle_lines(rng: &mut impl RngCore, grid: u32, radius: f64, out: &mut Vec<Line>) {
+    let (x, y, s) = point_in_unit_disc(rng);
+    let k = 2.0 * (1.0 - s).sqrt();
+    let dir = [x * k, y * k, 1.0 - 2.0 * s];
+    let (e1, e2) = orthonormal_basis(dir);
+    let reach = radius * SPHERE_MARGIN;
+    let cell = 2.0 / f64::from(grid);
+    let side = grid.next_power_of_two();
+    for code in 0..side * side {
+        let (i, j) = morton_decode(code);
+        if i >= grid || j >= grid {
+            continue;
+        }
+        let a = -1.0 + cell * (f64::from(i) + unit(rng));
+        let b = -1.0 + cell * (f64::from(j) + unit(rng));
+        let (px, py) = concentric_disc(a, b);
+        let origin = [0, 1, 2].map(|c| radius * (px * e1[c] + py * e2[c]) - reach * dir[c]);
+        out.push(Line {
+            origin: origin.map(|v| v as f32),
+            dir: dir.map(|v| v as f32),
+            t_max: (2.0 * reach) as f32,
+        });
+    }
+}
+
+/// The cell `(i, j)` whose Morton code (bits of `i` at even, of `j` at odd positions) is `code`.
+fn morton_decode(code: u32) -> (u32, u32) {
+    let compact = |mut v: u32| {
+        v &= 0x5555_5555;
+        v = (v | (v >> 1)) & 0x3333_3333;
+        v = (v | (v >> 2)) & 0x0f0f_0f0f;
+        v = (v | (v >> 4)) & 0x00ff_00ff;
+        (v | (v >> 8)) & 0x0000_ffff
+    };
+    (compact(code), compact(code >> 1))
+}
+
+/// Shirley and Chiu's concentric map, "A low distortion map between disk and square" (JGT 1997): the
+/// square [-1, 1]^2 onto the unit disc, area-preserving (up to the constant pi / 4) and continuous.
+pub fn concentric_disc(a: f64, b: f64) -> (f64, f64) {
+    use std::f64::consts::{FRAC_PI_2, FRAC_PI_4};
+    if a == 0.0 && b == 0.0 {
+        return (0.0, 0.0);
+    }
+    let (r, phi) = if a.abs() > b.abs() {
+        (a, FRAC_PI_4 * (b / a))
+    } else {
+        (b, FRAC_PI_2 - FRAC_PI_4 * (a / b))
+    };
+    let (s, c) = phi.sin_cos();
+    (r * c, r * s)
+}
+
 /// One uniformly distributed global line through the sphere of radius `radius` centred at the origin.
 ///
 /// Both draws use rejection from the unit disc instead of trigonometry (sin/cos cost more than the
@@ -128,6 +261,53 @@ mod tests {
         batch_lines(7, 4, 16, 1.0, &mut c);
         assert_eq!(a, b);
         assert_ne!(a, c);
+    }
+
+    #[test]
+    fn morton_order_visits_every_cell_once() {
+        let mut seen = std::collections::HashSet::new();
+        for code in 0..64 * 64 {
+            let (i, j) = morton_decode(code);
+            assert!(i < 64 && j < 64 && seen.insert((i, j)));
+        }
+        assert_eq!(morton_decode(0b1110), (0b10, 0b11));
+    }
+
+    /// Equal area: the concentric images of a square's quarters by area are the disc's, and points
+    /// land in rings with the ring's share of the disc's area.
+    #[test]
+    fn concentric_map_preserves_area_fractions() {
+        let n = 200usize;
+        let mut ring = [0usize; 4];
+        for i in 0..n {
+            for j in 0..n {
+                let a = -1.0 + 2.0 * (i as f64 + 0.5) / n as f64;
+                let b = -1.0 + 2.0 * (j as f64 + 0.5) / n as f64;
+                let (x, y) = concentric_disc(a, b);
+                let r2 = x * x + y * y;
+                assert!(r2 <= 1.0 + 1e-12);
+                ring[((r2 * 4.0) as usize).min(3)] += 1;
+            }
+        }
+        for count in ring {
+            let share = count as f64 / (n * n) as f64;
+            assert!((share - 0.25).abs() < 0.01, "{ring:?}");
+        }
+    }
+
+    #[test]
+    fn bundles_are_parallel_and_fill_batches() {
+        let source = LineSource::bundles(8).unwrap();
+        assert_eq!(source.lines_per_unit(), 64);
+        let mut lines = Vec::new();
+        source.batch_lines(3, 2, 192, 1.0, &mut lines);
+        assert_eq!(lines.len(), 192);
+        for bundle in lines.chunks(64) {
+            assert!(bundle.iter().all(|l| l.dir == bundle[0].dir));
+        }
+        assert_ne!(lines[0].dir, lines[64].dir);
+        assert_eq!(LineSource::bundles(0), Ok(LineSource::Independent));
+        assert!(LineSource::bundles(65).is_err());
     }
 
     #[test]

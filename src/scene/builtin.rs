@@ -61,6 +61,10 @@ pub const BUILTINS: &[BuiltinInfo] = &[
         usage: "@cornell-open[:N]",
         description: "the Cornell box as published, open at the front (lines escape there); 28 N^2 patches",
     },
+    BuiltinInfo {
+        usage: "@cubes512",
+        description: "unit cube room holding 512 small cubes (side 1/16, one per cell of an 8^3 grid, fixed random offsets)",
+    },
 ];
 
 /// Builds a built-in scene from its name (`@cube:10`).
@@ -79,6 +83,7 @@ pub fn build(spec: &str) -> Result<Scene, SceneError> {
         "dodecahedron" => solid(spec, &dodecahedron(), parse_count(spec, param, 1, 1000)?),
         "cornell" => super::cornell::build(spec, parse_count(spec, param, 1, 100)?, true),
         "cornell-open" => super::cornell::build(spec, parse_count(spec, param, 1, 100)?, false),
+        "cubes512" => super::clutter::cubes512(spec, param),
         _ => Err(SceneError::Builtin(format!(
             "{spec}: unknown built-in scene; `scx scenes` lists them ({})",
             BUILTINS

@@ -7,6 +7,7 @@
 
 mod build;
 pub mod builtin;
+pub mod clutter;
 pub mod cornell;
 pub mod obj;
 

@@ -1,6 +1,6 @@
 //! Tracing backends: every intersection along a batch of global lines.
 //!
-//! A backend (`embree`, and later a pure-Rust one) only reports *raw* hits: `(line, t, triangle)` in any
+//! A backend (`embree`, or the pure-Rust BVH) only reports *raw* hits: `(line, t, triangle)` in any
 //! order, possibly with the same crossing reported twice (a line through a shared edge or vertex hits every
 //! triangle that owns it). [`HitRules::canonicalize`] turns them into the canonical form that every
 //! consumer relies on, identically for every backend:
@@ -12,6 +12,7 @@
 //!   differently are a graze (the line touches a ridge and leaves) and are all kept. So a line through a
 //!   closed mesh always has an even number of hits.
 
+pub mod crosscheck;
 #[cfg(feature = "embree")]
 pub mod embree;
 mod rules;
@@ -166,6 +167,19 @@ pub trait Tracer: Send + Sync {
         self.rules().canonicalize(lines, out);
         Ok(())
     }
+
+    /// The nearest hit of each line (`None` for a miss): the least `t`, ties to the lower triangle index,
+    /// i.e. the first hit of the canonical list; replaces `out`'s contents.
+    ///
+    /// This default finds all hits; backends override it with a query that stops early.
+    fn first_hits(&self, lines: &[Line], out: &mut Vec<Option<Hit>>) -> Result<(), TraceError> {
+        let mut scratch = Vec::new();
+        let mut hits = LineHits::default();
+        self.all_hits(lines, &mut scratch, &mut hits)?;
+        out.clear();
+        out.extend((0..lines.len()).map(|k| hits.of_line(k).first().copied()));
+        Ok(())
+    }
 }
 
 /// The tracing backends a user can choose.
@@ -206,7 +220,7 @@ pub fn make_tracer(
             ))
         }
         Backend::Rust => match query {
-            Query::Single => Ok(Box::new(rust::BruteForceTracer::new(scene))),
+            Query::Single => Ok(Box::new(rust::BvhTracer::new(scene)?)),
             Query::Packet(_) => Err(TraceError::Unsupported(
                 "the pure-Rust tracer traces single lines only".into(),
             )),

@@ -6,6 +6,7 @@ use std::f64::consts::PI;
 
 use scene_complexity::scene::Scene;
 
+use scene_complexity::trace::rust::BruteForceTracer;
 use scene_complexity::trace::{make_tracer, Backend, Query, Tracer};
 
 /// Form factor between two identical, directly opposed parallel rectangles `a x b` at distance `c`.
@@ -33,11 +34,15 @@ pub fn ff_perpendicular_rectangles(w: f64, h: f64, l: f64) -> f64 {
             + 0.25 * (a * b * c).ln())
 }
 
-/// Every tracer this build has, for tests that must hold for all of them.
+/// Every tracer this build has, for tests that must hold for all of them: the pure-Rust BVH, the
+/// brute-force reference (on scenes small enough for it) and Embree when built in.
 pub fn all_tracers(scene: &Scene) -> Vec<Box<dyn Tracer>> {
     let mut v =
         vec![make_tracer(Backend::Rust, scene, Query::Single)
             .expect("the Rust tracer always builds")];
+    if scene.triangles.len() <= 4000 {
+        v.push(Box::new(BruteForceTracer::new(scene)));
+    }
     if cfg!(feature = "embree") {
         v.push(make_tracer(Backend::Embree, scene, Query::Single).expect("Embree tracer"));
     }

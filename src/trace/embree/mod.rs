@@ -463,6 +463,10 @@ impl Tracer for EmbreeTracer {
         &self.rules
     }
 
+    fn first_hits(&self, lines: &[Line], out: &mut Vec<Option<Hit>>) -> Result<(), TraceError> {
+        EmbreeTracer::first_hits(self, lines, out)
+    }
+
     fn raw_hits(&self, lines: &[Line], out: &mut Vec<RawHit>) -> Result<(), TraceError> {
         let shim_lines = to_shim_lines(lines)?;
         let mut hits = HitBuffer::new();

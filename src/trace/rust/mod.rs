@@ -1,9 +1,14 @@
-//! The pure-Rust backend: our own watertight triangle test over every triangle of the scene.
+//! The pure-Rust backends: our own watertight triangle test, over the candidates of a BVH
+//! ([`bvh::BvhTracer`], what `--tracer rust` runs) or over every triangle of the scene
+//! ([`BruteForceTracer`]).
 //!
 //! Brute force (every line against every triangle) is exact and needs no acceleration structure, so it
-//! serves as the reference for small scenes and for tests without Embree.
+//! serves as the reference for small scenes and for tests.
 
+pub mod bvh;
 pub mod watertight;
+
+pub use bvh::BvhTracer;
 
 use super::{HitRules, Line, RawHit, TraceError, Tracer};
 use crate::scene::Scene;

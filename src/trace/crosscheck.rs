@@ -1,0 +1,459 @@
+//! Hit-for-hit comparison of two tracers on the same global lines, and of the measures they lead to.
+//!
+//! Both tracers see exactly the lines an analysis with the same seed casts ([`BatchPlan`], one PCG stream
+//! per batch), and their canonical hit lists ([`Tracer::all_hits`]) are compared line by line:
+//!
+//! * the number of hits must be equal;
+//! * the k-th hits must lie on the same *patch* (two triangles of one patch are the same answer for every
+//!   measure);
+//! * their distances must agree within [`Tolerance`]: `ulps` f32 ulps at `max(|t|, 1)` (tracing space has
+//!   the unit bounding sphere, so `t <= 2.002` and an ulp there is ~2.4e-7).
+//!
+//! Every line that breaks one of these is a difference. The measures are then compared by running
+//! [`analyze`] with each tracer on the same seed.
+
+use std::fmt;
+
+use rayon::prelude::*;
+
+use super::{Hit, Line, LineHits, RawHit, TraceError, Tracer};
+use crate::analysis::{analyze, Analysis, AnalysisConfig};
+use crate::measure::Estimate;
+use crate::sample::lines::batch_lines;
+use crate::sample::tally::BatchPlan;
+use crate::scene::Scene;
+
+/// How far apart two hits' distances may be and still agree.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Tolerance {
+    /// f32 ulps at `max(|t|, 1)`.
+    pub ulps: f32,
+}
+
+impl Default for Tolerance {
+    /// 4 ulps: both backends run the same watertight test, so their `t` are normally identical; this
+    /// leaves room for a different but equally valid rounding without hiding a wrong triangle.
+    fn default() -> Self {
+        Tolerance { ulps: 4.0 }
+    }
+}
+
+impl Tolerance {
+    /// The largest allowed |t_a - t_b| around `t`.
+    pub fn at(&self, t: f32) -> f32 {
+        self.ulps * f32::EPSILON * t.abs().max(1.0)
+    }
+}
+
+/// How a line's hit lists differ (the first reason found, in this order).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum DifferenceKind {
+    /// Different numbers of hits.
+    Count,
+    /// Same count, but some k-th hits lie on different patches.
+    Patch,
+    /// Same patches, but some k-th distances differ beyond the tolerance.
+    Distance,
+}
+
+impl fmt::Display for DifferenceKind {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            DifferenceKind::Count => "hit count",
+            DifferenceKind::Patch => "patch",
+            DifferenceKind::Distance => "distance",
+        })
+    }
+}
+
+/// One line whose hit lists differ.
+#[derive(Clone, Debug)]
+pub struct LineDifference {
+    /// The line's index in the run (batch order).
+    pub index: u64,
+    /// The line.
+    pub line: Line,
+    /// Why it differs.
+    pub kind: DifferenceKind,
+    /// The first tracer's hits.
+    pub a: Vec<Hit>,
+    /// The second tracer's hits.
+    pub b: Vec<Hit>,
+}
+
+/// The result of comparing two tracers' hits.
+#[derive(Clone, Debug)]
+pub struct HitComparison {
+    /// The two tracers' names.
+    pub names: (&'static str, &'static str),
+    /// Lines compared.
+    pub lines: u64,
+    /// Canonical hits of each tracer.
+    pub hits: (u64, u64),
+    /// Lines that differ, by kind: count, patch, distance.
+    pub differing: [u64; 3],
+    /// The largest |t_a - t_b| between matched hits, in ulps at `max(|t|, 1)`, over lines of equal count.
+    pub max_ulps: f32,
+    /// The first differing lines (at most the number asked for), in line order.
+    pub examples: Vec<LineDifference>,
+    /// The tolerance used.
+    pub tolerance: Tolerance,
+}
+
+impl HitComparison {
+    /// Lines that differ beyond the tolerance.
+    pub fn differing_lines(&self) -> u64 {
+        self.differing.iter().sum()
+    }
+
+    /// Whether the tracers agree on every line.
+    pub fn agrees(&self) -> bool {
+        self.differing_lines() == 0
+    }
+
+    fn empty(names: (&'static str, &'static str), tolerance: Tolerance) -> Self {
+        HitComparison {
+            names,
+            lines: 0,
+            hits: (0, 0),
+            differing: [0; 3],
+            max_ulps: 0.0,
+            examples: Vec::new(),
+            tolerance,
+        }
+    }
+
+    /// Adds a later part of the run (keeps line order in `examples`).
+    fn merge(&mut self, other: HitComparison, keep: usize) {
+        self.lines += other.lines;
+        self.hits.0 += other.hits.0;
+        self.hits.1 += other.hits.1;
+        for (a, b) in self.differing.iter_mut().zip(other.differing) {
+            *a += b;
+        }
+        self.max_ulps = self.max_ulps.max(other.max_ulps);
+        let room = keep.saturating_sub(self.examples.len());
+        self.examples.extend(other.examples.into_iter().take(room));
+    }
+}
+
+/// Compares two patches lists of hits of one line: `None` when they agree, else why not; also the largest
+/// distance gap in ulps (0 when the counts differ).
+fn compare_line(
+    scene: &Scene,
+    a: &[Hit],
+    b: &[Hit],
+    tolerance: Tolerance,
+) -> (Option<DifferenceKind>, f32) {
+    if a.len() != b.len() {
+        return (Some(DifferenceKind::Count), 0.0);
+    }
+    let patch = |h: &Hit| scene.triangle_patch[h.triangle as usize];
+    if a.iter().zip(b).any(|(x, y)| patch(x) != patch(y)) {
+        return (Some(DifferenceKind::Patch), 0.0);
+    }
+    let mut worst = 0.0f32;
+    let mut beyond = false;
+    for (x, y) in a.iter().zip(b) {
+        let gap = (x.t - y.t).abs();
+        worst = worst.max(gap / Tolerance { ulps: 1.0 }.at(x.t));
+        beyond |= gap > tolerance.at(x.t);
+    }
+    (beyond.then_some(DifferenceKind::Distance), worst)
+}
+
+/// Per-thread buffers.
+#[derive(Default)]
+struct Buffers {
+    lines: Vec<Line>,
+    raw: Vec<RawHit>,
+    a: LineHits,
+    b: LineHits,
+}
+
+/// What to compare and how much to keep.
+#[derive(Clone, Copy, Debug)]
+pub struct CrossCheckConfig {
+    /// Global lines.
+    pub lines: u64,
+    /// Seed of the line streams (the same lines as `scx analyze --seed`).
+    pub seed: u64,
+    /// Distance tolerance.
+    pub tolerance: Tolerance,
+    /// How many differing lines to keep as examples.
+    pub examples: usize,
+}
+
+/// Traces the run's lines with both tracers and compares their canonical hits line by line, in parallel
+/// over batches (results independent of the thread count).
+pub fn compare_hits(
+    scene: &Scene,
+    a: &dyn Tracer,
+    b: &dyn Tracer,
+    cfg: &CrossCheckConfig,
+) -> Result<HitComparison, TraceError> {
+    let plan = BatchPlan::new(cfg.lines);
+    let parts: Vec<HitComparison> = (0..plan.batches())
+        .into_par_iter()
+        .map_init(Buffers::default, |buf, batch| {
+            compare_batch(scene, a, b, cfg, &plan, batch, buf)
+        })
+        .collect::<Result<_, _>>()?;
+    let mut total = HitComparison::empty((a.name(), b.name()), cfg.tolerance);
+    for p in parts {
+        total.merge(p, cfg.examples);
+    }
+    Ok(total)
+}
+
+fn compare_batch(
+    scene: &Scene,
+    a: &dyn Tracer,
+    b: &dyn Tracer,
+    cfg: &CrossCheckConfig,
+    plan: &BatchPlan,
+    batch: u64,
+    buf: &mut Buffers,
+) -> Result<HitComparison, TraceError> {
+    buf.lines.clear();
+    let count = plan.batch_len(batch);
+    batch_lines(
+        cfg.seed,
+        batch,
+        count,
+        scene.bounding_radius(),
+        &mut buf.lines,
+    );
+    a.all_hits(&buf.lines, &mut buf.raw, &mut buf.a)?;
+    b.all_hits(&buf.lines, &mut buf.raw, &mut buf.b)?;
+    let mut part = HitComparison::empty((a.name(), b.name()), cfg.tolerance);
+    part.lines = count as u64;
+    part.hits = (buf.a.hits.len() as u64, buf.b.hits.len() as u64);
+    let first_index = batch * plan.batch_size;
+    for k in 0..count {
+        let (ra, rb) = (buf.a.of_line(k), buf.b.of_line(k));
+        let (kind, ulps) = compare_line(scene, ra, rb, cfg.tolerance);
+        part.max_ulps = part.max_ulps.max(ulps);
+        let Some(kind) = kind else { continue };
+        part.differing[kind as usize] += 1;
+        if part.examples.len() < cfg.examples {
+            part.examples.push(LineDifference {
+                index: first_index + k as u64,
+                line: buf.lines[k],
+                kind,
+                a: ra.to_vec(),
+                b: rb.to_vec(),
+            });
+        }
+    }
+    Ok(part)
+}
+
+/// One measure from both runs.
+#[derive(Clone, Debug)]
+pub struct MeasureComparison {
+    /// The measure's name.
+    pub name: &'static str,
+    /// With the first tracer.
+    pub a: Estimate,
+    /// With the second tracer.
+    pub b: Estimate,
+}
+
+impl MeasureComparison {
+    /// |a - b| over the larger standard error (0 when equal; infinite when they differ with no error).
+    pub fn gap_in_stderrs(&self) -> f64 {
+        let gap = (self.a.value - self.b.value).abs();
+        if gap == 0.0 {
+            return 0.0;
+        }
+        let se = self
+            .a
+            .stderr
+            .unwrap_or(0.0)
+            .max(self.b.stderr.unwrap_or(0.0));
+        gap / se
+    }
+}
+
+/// Runs [`analyze`] with each tracer on the same lines and pairs up the measures both computed.
+pub fn compare_measures(
+    scene: &Scene,
+    a: &dyn Tracer,
+    b: &dyn Tracer,
+    cfg: &AnalysisConfig,
+) -> Result<Vec<MeasureComparison>, TraceError> {
+    let ra = analyze(scene, a, cfg)?;
+    let rb = analyze(scene, b, cfg)?;
+    Ok(measures(&ra)
+        .into_iter()
+        .zip(measures(&rb))
+        .filter_map(|((name, x), (_, y))| Some(MeasureComparison { name, a: x?, b: y? }))
+        .collect())
+}
+
+fn measures(r: &Analysis) -> Vec<(&'static str, Option<Estimate>)> {
+    let v = &r.visibility;
+    vec![
+        ("visibility entropy H_s (eq. 17)", v.entropy),
+        ("joint entropy H(X,Y) (eq. 7)", v.joint_entropy),
+        ("mutual information I_s (eq. 21)", v.mutual_information),
+        (
+            "continuous mutual information I_s^c (eq. 27)",
+            v.continuous_mutual_information,
+        ),
+        ("accuracy I_s / I_s^c (sec. 3.3)", v.accuracy),
+        ("form-factor E(MSE) per line (eq. 22)", v.mse_per_line),
+    ]
+}
+
+/// A whole cross-check: hits, then measures.
+#[derive(Clone, Debug)]
+pub struct CrossCheck {
+    /// The scene's name.
+    pub scene: String,
+    /// Seed.
+    pub seed: u64,
+    /// The hit comparison.
+    pub hits: HitComparison,
+    /// The measure comparison.
+    pub measures: Vec<MeasureComparison>,
+}
+
+/// Compares two tracers on `cfg.lines` lines: hit lists line by line, then every measure of an analysis
+/// run with each (all measures, `groups` groups for the standard errors).
+pub fn crosscheck(
+    scene: &Scene,
+    a: &dyn Tracer,
+    b: &dyn Tracer,
+    cfg: &CrossCheckConfig,
+    groups: usize,
+) -> Result<CrossCheck, TraceError> {
+    let hits = compare_hits(scene, a, b, cfg)?;
+    let analysis = AnalysisConfig {
+        groups,
+        ..AnalysisConfig::new(cfg.lines, cfg.seed)
+    };
+    let measures = compare_measures(scene, a, b, &analysis)?;
+    Ok(CrossCheck {
+        scene: scene.name.clone(),
+        seed: cfg.seed,
+        hits,
+        measures,
+    })
+}
+
+impl CrossCheck {
+    /// Whether every line agrees within the tolerance (the measures then agree too, but they are only
+    /// reported).
+    pub fn passed(&self) -> bool {
+        self.hits.agrees()
+    }
+}
+
+fn fmt_hits(scene: &Scene, hits: &[Hit]) -> String {
+    let items: Vec<String> = hits
+        .iter()
+        .map(|h| {
+            format!(
+                "t={:.9} tri {} patch {}",
+                h.t, h.triangle, scene.triangle_patch[h.triangle as usize]
+            )
+        })
+        .collect();
+    format!("[{}]", items.join(", "))
+}
+
+/// A readable report of a cross-check; `scene` names the patches of the example hits.
+pub fn report(check: &CrossCheck, scene: &Scene) -> String {
+    let h = &check.hits;
+    let (na, nb) = h.names;
+    let mut s = String::new();
+    s += &format!(
+        "crosscheck {} seed {}: {} lines, {na} {} hits, {nb} {} hits\n",
+        check.scene, check.seed, h.lines, h.hits.0, h.hits.1
+    );
+    s += &format!(
+        "tolerance: same hit count, same patches, |t_a - t_b| <= {} ulps at max(t, 1)\n",
+        h.tolerance.ulps
+    );
+    s += &format!(
+        "differing lines: {} (hit count {}, patch {}, distance {}); largest distance gap {:.1} ulps\n",
+        h.differing_lines(),
+        h.differing[0],
+        h.differing[1],
+        h.differing[2],
+        h.max_ulps
+    );
+    for d in &h.examples {
+        s += &format!(
+            "  line {} ({}): origin {:?} dir {:?}\n    {na}: {}\n    {nb}: {}\n",
+            d.index,
+            d.kind,
+            d.line.origin,
+            d.line.dir,
+            fmt_hits(scene, &d.a),
+            fmt_hits(scene, &d.b)
+        );
+    }
+    s += &format!(
+        "{:<46} {:>12} {:>12} {:>12} {:>10}\n",
+        "measure", na, nb, "difference", "/ stderr"
+    );
+    for m in &check.measures {
+        s += &format!(
+            "{:<46} {:>12.6} {:>12.6} {:>12.3e} {:>10.2}\n",
+            m.name,
+            m.a.value,
+            m.b.value,
+            m.a.value - m.b.value,
+            m.gap_in_stderrs()
+        );
+    }
+    s += if check.passed() {
+        "PASS: every line agrees\n"
+    } else {
+        "FAIL: some lines differ beyond the tolerance\n"
+    };
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn hit(t: f32, triangle: u32) -> Hit {
+        Hit { t, triangle }
+    }
+
+    #[test]
+    fn lines_are_told_apart_by_count_patch_and_distance() {
+        let scene = crate::scene::load("@cube:2").unwrap();
+        let tol = Tolerance::default();
+        // Triangles 0 and 1 are the two halves of patch 0; triangle 2 is patch 1.
+        assert_eq!(scene.triangle_patch[..3], [0, 0, 1]);
+        let a = [hit(1.0, 0), hit(1.5, 2)];
+        assert_eq!(compare_line(&scene, &a, &a, tol).0, None);
+        let other_half = [hit(1.0, 1), hit(1.5, 2)];
+        assert_eq!(compare_line(&scene, &a, &other_half, tol).0, None);
+        assert_eq!(
+            compare_line(&scene, &a, &a[..1], tol).0,
+            Some(DifferenceKind::Count)
+        );
+        let other_patch = [hit(1.0, 2), hit(1.5, 2)];
+        assert_eq!(
+            compare_line(&scene, &a, &other_patch, tol).0,
+            Some(DifferenceKind::Patch)
+        );
+        // 1.5 + 4 ulps (at 1.5: ulp = 2^-23 * 1, within "4 ulps at max(t,1)" = 4 * 2^-23 * 1.5)
+        let near = [hit(1.0, 0), hit(1.5 + 4.0 * f32::EPSILON, 2)];
+        let (kind, ulps) = compare_line(&scene, &a, &near, tol);
+        assert_eq!(kind, None);
+        assert!(ulps > 2.0 && ulps <= 4.0, "{ulps}");
+        let far = [hit(1.0, 0), hit(1.5 + 8.0 * f32::EPSILON, 2)];
+        assert_eq!(
+            compare_line(&scene, &a, &far, tol).0,
+            Some(DifferenceKind::Distance)
+        );
+    }
+}
