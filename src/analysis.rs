@@ -483,49 +483,23 @@ impl<'a> GroupedRun<'a> {
             .par_iter()
             .map(|t| GroupValues::of(areas, t, estimator))
             .collect();
-        let mut merged = MergeStack::default();
-        for t in filled {
-            merged.push(t);
-        }
-        let total = merged
-            .finish()
-            .unwrap_or_else(|| Tally::empty(self.scene, self.wanted));
+        let total = merge_tree(filled).unwrap_or_else(|| Tally::empty(self.scene, self.wanted));
         (total, per_group)
     }
 }
 
-/// Merges group tallies like a binary counter: two tallies of equal weight merge into one of the next, so
-/// every count is merged O(log G) times (merging each group into one running total would touch all
-/// distinct pairs G times) and at most log2(G) tallies are alive.
-#[derive(Default)]
-struct MergeStack {
-    /// (weight, tally), weights strictly decreasing from bottom to top.
-    stack: Vec<(u32, Tally)>,
-}
-
-impl MergeStack {
-    fn push(&mut self, tally: Tally) {
-        let mut item = (0u32, tally);
-        while let Some(top) = self.stack.last() {
-            if top.0 != item.0 {
-                break;
-            }
-            let (weight, mut below) = self.stack.pop().expect("checked non-empty");
-            // Merge in group order so that f64 sums are added in a fixed order.
-            below.merge(&item.1);
-            item = (weight + 1, below);
-        }
-        self.stack.push(item);
+/// Merges tallies pairwise in a balanced binary tree, the two halves in parallel. The tree's shape
+/// depends only on the number of tallies, so the f64 sums are added in the same order whatever the
+/// thread count; every count is merged O(log G) times.
+fn merge_tree(mut tallies: Vec<Tally>) -> Option<Tally> {
+    if tallies.len() <= 1 {
+        return tallies.pop();
     }
-
-    fn finish(mut self) -> Option<Tally> {
-        let mut acc = self.stack.pop()?.1;
-        while let Some((_, mut below)) = self.stack.pop() {
-            below.merge(&acc);
-            acc = below;
-        }
-        Some(acc)
-    }
+    let right = tallies.split_off(tallies.len() / 2);
+    let (left, right) = rayon::join(|| merge_tree(tallies), || merge_tree(right));
+    let (mut left, right) = (left?, right?);
+    left.merge(&right);
+    Some(left)
 }
 
 fn positional_entropy(areas: &[f64]) -> f64 {

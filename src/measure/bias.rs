@@ -301,8 +301,29 @@ fn chao_wang_jost_unseen(n: f64, f1: f64, f2: f64) -> f64 {
     f1 / n * tail
 }
 
-/// The digamma function psi(x) for x > 0: recurrence up to x >= 10, then the asymptotic series.
-pub fn digamma(mut x: f64) -> f64 {
+/// Integer arguments below this come from a table (counts are mostly small integers, and the estimators
+/// need psi of every count).
+const DIGAMMA_TABLE: usize = 1 << 16;
+
+/// The digamma function psi(x) for x > 0: a table for small integers (psi(n + 1) = psi(n) + 1/n), else
+/// the recurrence up to x >= 10 and the asymptotic series.
+pub fn digamma(x: f64) -> f64 {
+    static TABLE: std::sync::OnceLock<Vec<f64>> = std::sync::OnceLock::new();
+    if x.fract() == 0.0 && x >= 1.0 && x < DIGAMMA_TABLE as f64 {
+        let table = TABLE.get_or_init(|| {
+            let mut t = vec![0.0; DIGAMMA_TABLE];
+            t[1] = digamma_series(1.0);
+            for n in 1..DIGAMMA_TABLE - 1 {
+                t[n + 1] = t[n] + 1.0 / n as f64;
+            }
+            t
+        });
+        return table[x as usize];
+    }
+    digamma_series(x)
+}
+
+fn digamma_series(mut x: f64) -> f64 {
     let mut result = 0.0;
     while x < 10.0 {
         result -= 1.0 / x;
