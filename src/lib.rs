@@ -7,6 +7,7 @@
 #![forbid(unsafe_op_in_unsafe_fn)]
 
 pub mod analysis;
+pub mod crosscheck;
 pub mod measure;
 pub mod radiosity;
 pub mod refine;

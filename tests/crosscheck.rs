@@ -5,7 +5,7 @@
 mod support;
 
 use scene_complexity::scene::{self, Scene};
-use scene_complexity::trace::crosscheck::{
+use scene_complexity::crosscheck::{
     compare_hits, crosscheck, CrossCheckConfig, DifferenceKind, Tolerance,
 };
 use scene_complexity::trace::rust::{BruteForceTracer, BvhTracer};

@@ -21,7 +21,7 @@ use scene_complexity::refine::{refine, RefineConfig, RefineRound, Strategy};
 use scene_complexity::sample::lines::LineSource;
 use scene_complexity::sample::tally::Wanted;
 use scene_complexity::scene::{self, builtin};
-use scene_complexity::trace::crosscheck::{self, CrossCheckConfig, Tolerance};
+use scene_complexity::crosscheck::{self, CrossCheckConfig, Tolerance};
 use scene_complexity::trace::{make_tracer, Backend, Query};
 
 /// scx: how hard is a 3D scene to light and to mesh? Information-theoretic scene complexity

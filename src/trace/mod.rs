@@ -12,7 +12,6 @@
 //!   differently are a graze (the line touches a ridge and leaves) and are all kept. So a line through a
 //!   closed mesh always has an even number of hits.
 
-pub mod crosscheck;
 #[cfg(feature = "embree")]
 pub mod embree;
 mod rules;

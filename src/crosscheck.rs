@@ -16,7 +16,7 @@ use std::fmt;
 
 use rayon::prelude::*;
 
-use super::{Hit, Line, LineHits, RawHit, TraceError, Tracer};
+use crate::trace::{Hit, Line, LineHits, RawHit, TraceError, Tracer};
 use crate::analysis::{analyze, Analysis, AnalysisConfig};
 use crate::measure::Estimate;
 use crate::sample::lines::batch_lines;
