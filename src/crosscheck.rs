@@ -16,12 +16,12 @@ use std::fmt;
 
 use rayon::prelude::*;
 
-use crate::trace::{Hit, Line, LineHits, RawHit, TraceError, Tracer};
 use crate::analysis::{analyze, Analysis, AnalysisConfig};
 use crate::measure::Estimate;
 use crate::sample::lines::batch_lines;
 use crate::sample::tally::BatchPlan;
 use crate::scene::Scene;
+use crate::trace::{Hit, Line, LineHits, RawHit, TraceError, Tracer};
 
 /// How far apart two hits' distances may be and still agree.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -4,10 +4,10 @@
 
 mod support;
 
-use scene_complexity::scene::{self, Scene};
 use scene_complexity::crosscheck::{
     compare_hits, crosscheck, CrossCheckConfig, DifferenceKind, Tolerance,
 };
+use scene_complexity::scene::{self, Scene};
 use scene_complexity::trace::rust::{BruteForceTracer, BvhTracer};
 use scene_complexity::trace::{HitRules, Line, RawHit, TraceError, Tracer};
 

@@ -14,6 +14,7 @@ use scene_complexity::analysis::{
     analyze_with, Analysis, AnalysisConfig, Budget, RunControl, Target, TargetMeasure,
     DEFAULT_ESTIMATOR, DEFAULT_GROUPS,
 };
+use scene_complexity::crosscheck::{self, CrossCheckConfig, Tolerance};
 use scene_complexity::measure::bias::EntropyEstimator;
 use scene_complexity::measure::radiosity::SolveOptions;
 use scene_complexity::radiosity::{analyze_with_radiosity, RadiosityOutcome};
@@ -21,7 +22,6 @@ use scene_complexity::refine::{refine, RefineConfig, RefineRound, Strategy};
 use scene_complexity::sample::lines::LineSource;
 use scene_complexity::sample::tally::Wanted;
 use scene_complexity::scene::{self, builtin};
-use scene_complexity::crosscheck::{self, CrossCheckConfig, Tolerance};
 use scene_complexity::trace::{make_tracer, Backend, Query};
 
 /// scx: how hard is a 3D scene to light and to mesh? Information-theoretic scene complexity
