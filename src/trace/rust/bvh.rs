@@ -37,7 +37,7 @@
 
 use std::time::Duration;
 
-use glam_bvh::Vec3A;
+use glam::Vec3A;
 use obvhs::aabb::Aabb;
 use obvhs::cwbvh::{builder::build_cwbvh, CwBvh};
 use obvhs::ray::{Ray, RayHit};
