@@ -602,8 +602,9 @@ fn a_two_sided_panel_is_two_surfaces_back_to_back() {
 /// (the floor, the first ceiling), on both sides, deterministically. The decal is then never left by a
 /// line: it is reported among the unsampled patches with its area fraction; the crossings of the
 /// overlap are counted (`coincident_crossings`, by Crofton N A_decal / (2 pi R^2)) so the report can
-/// warn; the duplicated face is found when the scene is built and named in a warning. The floor's row is
-/// that of the plain unit cube: F(floor -> ceiling) is the closed form of parallel unit squares.
+/// warn. A face repeating an earlier face's corners in the same order could never be seen at all: it is
+/// dropped when the scene is built, with a warning naming both. The floor's row is that of the plain
+/// unit cube: F(floor -> ceiling) is the closed form of parallel unit squares.
 #[test]
 fn coplanar_overlapping_faces_are_seen_once_and_reported() {
     let mut b = SceneBuilder::new("room with a decal and a duplicated ceiling");
@@ -624,14 +625,16 @@ fn coplanar_overlapping_faces_are_seen_once_and_reported() {
     };
     b.polygon(&ceiling, m, "ceiling again");
     let scene = b.build().unwrap();
-    let (floor, ceiling, decal, again) = (4, 5, 6, 7);
-    assert!(scene.patches[decal].normal[2] > 0.99 && scene.patches[again].normal[2] < -0.99);
+    let (floor, ceiling, decal) = (4, 5, 6);
+    assert_eq!(scene.patch_count(), 7, "the repeated ceiling is dropped");
+    assert!(scene.patches[decal].normal[2] > 0.99);
     assert!(
         scene
             .warnings
             .iter()
-            .any(|w| w.contains("ceiling again") && w.contains("room face 5")),
-        "the duplicated face is named: {:?}",
+            .any(|w| w.contains("dropped 1 face(s)")
+                && w.contains("ceiling again repeats room face 5")),
+        "the repeated face is named: {:?}",
         scene.warnings
     );
     let lines = 200_000u64;
@@ -639,9 +642,9 @@ fn coplanar_overlapping_faces_are_seen_once_and_reported() {
     assert_all_finite(&a, "decal");
     assert_eq!((a.escapes, a.degenerate_pairs), (0, 0));
     let (n_unsampled, fraction) = a.unsampled.unwrap();
-    assert_eq!(n_unsampled, 2, "the decal and the duplicate are never seen");
+    assert_eq!(n_unsampled, 1, "the decal is never seen");
     let a_t: f64 = scene.patches.iter().map(|p| p.area).sum();
-    let expected_fraction = (scene.patches[decal].area + scene.patches[again].area) / a_t;
+    let expected_fraction = scene.patches[decal].area / a_t;
     assert!(
         (fraction - expected_fraction).abs() < 1e-12,
         "{fraction} vs {expected_fraction}"
@@ -654,7 +657,7 @@ fn coplanar_overlapping_faces_are_seen_once_and_reported() {
         "{got} crossings of the overlap, Crofton expects {expected}"
     );
     let exact = ff_parallel_rectangles(1.0, 1.0, 1.0);
-    let (up, total) = block_counts(&a, 8, &|i| i == floor, &|j| j == ceiling);
+    let (up, total) = block_counts(&a, 7, &|i| i == floor, &|j| j == ceiling);
     let sigma = (exact * (1.0 - exact) / total).sqrt();
     assert!(
         (up / total - exact).abs() < 4.5 * sigma,
@@ -1096,4 +1099,166 @@ fn zero_area_triangles_are_dropped_with_a_warning() {
     let exact = ff_parallel_rectangles(1.0, 1.0, 1.0);
     let (up, total) = block_counts(&rb, 6, &|i| i == 4, &|j| j == 5);
     assert!((up / total - exact).abs() < 4.5 * (exact * (1.0 - exact) / total).sqrt());
+}
+
+// ------------------------------------------------------------------------------------------------
+// Open scenes and `--enclose`.
+
+/// The unit cube without its top face, facing inwards (an open box), as OBJ text.
+const OPEN_BOX: &str = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nv 0 0 1\nv 1 0 1\nv 0 1 1\nv 1 1 1\n\
+                        f 1 3 7 5\nf 2 6 8 4\nf 1 5 6 2\nf 3 4 8 7\nf 1 2 4 3\n";
+
+/// The environment patch closes an open scene consistently.
+///
+/// Expected, a cube object in open space (outward normals, side 1, bounding radius R = sqrt(3)/2): every
+/// segment from the bounding sphere meets a front side or the sphere, so the environment's counted area
+/// is the whole sphere, 4 pi R^2 (within its error); the convex cube sees only the environment
+/// (F(face -> env) = 1) and the environment sees the cube with F = A_cube / (4 pi R^2) (reciprocity);
+/// every row of the enclosed F sums to 1; H_p is that of the areas with the environment's.
+///
+/// Expected, the open box (unit cube without its top, inward): the floor sees out through the opening
+/// with F = the closed form of parallel unit squares; the sphere's segments that meet the outside (back)
+/// of the five walls join nothing, so the environment's area is 4 pi R^2 - 5; rows sum to 1.
+/// A closed scene is left alone.
+#[test]
+fn enclose_closes_open_scenes_consistently() {
+    use scene_complexity::sample::environment::enclosed;
+    let lines = 200_000;
+    let cfg = AnalysisConfig {
+        enclose: true,
+        ..AnalysisConfig::new(lines, 19)
+    };
+    let r2 = 0.75;
+    let sphere = 4.0 * PI * r2;
+
+    let mut b = SceneBuilder::new("cube object");
+    let m = b.material(wall());
+    add_box(&mut b, [0.0; 3], [1.0; 3], false, m, "cube");
+    let cube = b.build().unwrap();
+    let a = analyze(&cube, tracer(&cube).as_ref(), &cfg).unwrap();
+    assert_all_finite(&a, "cube object");
+    let env = a.environment_area.expect("enclosed");
+    assert!(
+        (env.value - sphere).abs() < 4.5 * env.stderr.unwrap() + 1e-9,
+        "{env:?} vs {sphere}"
+    );
+    let (t, areas) = enclosed(&cube, &a.tally);
+    assert_eq!(areas.len(), 7);
+    let n = 7;
+    let counts = t.counts.as_ref().unwrap();
+    let rows = row_totals(n, counts, &t.escapes_by_patch);
+    let mut f = vec![vec![0.0; n]; n];
+    scene_complexity::measure::visibility::for_each_form_factor(counts, &rows, |i, j, v| {
+        f[i][j] = v
+    });
+    for (i, row) in f.iter().enumerate() {
+        assert!((row.iter().sum::<f64>() - 1.0).abs() < 1e-12, "row {i}");
+    }
+    for face in 0..6 {
+        assert_eq!(f[face][6], 1.0, "a convex object sees only the environment");
+    }
+    let to_cube: f64 = f[6][..6].iter().sum();
+    let exact = 6.0 / sphere;
+    let sigma = (exact * (1.0 - exact) / rows[6]).sqrt();
+    assert!(
+        (to_cube - exact).abs() < 4.5 * sigma,
+        "F(env -> cube) = {to_cube}, A_cube / 4 pi R^2 = {exact}"
+    );
+    let hp = a.visibility.positional_entropy.unwrap();
+    let total = 6.0 + sphere;
+    let exact_hp =
+        -(6.0 * (1.0 / total) * (1.0 / total).log2() + (sphere / total) * (sphere / total).log2());
+    assert!(
+        (hp.value - exact_hp).abs() < 4.5 * hp.stderr.unwrap() + 1e-9,
+        "{hp:?} vs {exact_hp}"
+    );
+
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("open_box.obj");
+    std::fs::write(&path, OPEN_BOX).unwrap();
+    let open = scene::load(path.to_str().unwrap()).unwrap();
+    let a = analyze(&open, tracer(&open).as_ref(), &cfg).unwrap();
+    assert_all_finite(&a, "open box");
+    let env = a.environment_area.expect("enclosed");
+    let expected = sphere - 5.0;
+    assert!(
+        (env.value - expected).abs() < 4.5 * env.stderr.unwrap(),
+        "{env:?} vs {expected}"
+    );
+    let (t, _) = enclosed(&open, &a.tally);
+    let counts = t.counts.as_ref().unwrap();
+    let rows = row_totals(6, counts, &t.escapes_by_patch);
+    let mut f = vec![vec![0.0; 6]; 6];
+    scene_complexity::measure::visibility::for_each_form_factor(counts, &rows, |i, j, v| {
+        f[i][j] = v
+    });
+    for (i, row) in f.iter().enumerate() {
+        assert!((row.iter().sum::<f64>() - 1.0).abs() < 1e-12, "row {i}");
+    }
+    let exact = ff_parallel_rectangles(1.0, 1.0, 1.0);
+    let sigma = (exact * (1.0 - exact) / rows[4]).sqrt();
+    assert!(
+        (f[4][5] - exact).abs() < 4.5 * sigma,
+        "F(floor -> env) = {}, closed form {exact}",
+        f[4][5]
+    );
+
+    let closed = scene::load("@cube:2").unwrap();
+    let a = analyze(&closed, tracer(&closed).as_ref(), &cfg).unwrap();
+    assert!(
+        a.environment_area.is_none(),
+        "nothing escapes a closed scene"
+    );
+}
+
+/// The open box through the binary: the report gives the fraction of escaping segments and warns.
+///
+/// Expected: a line through the opening (area 1) escapes once; the inside front area is 5 and a pair has
+/// two front ends, an escape one; so escapes / (pairs + escapes) = 1 / (1 + (5 - 1) / 2) = 1/3 (Crofton).
+/// With `--enclose` the warning says the escapes became pairs with the environment, and the JSON gives
+/// its area.
+#[test]
+fn open_scenes_report_their_escapes_and_can_be_enclosed() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("open_box.obj");
+    std::fs::write(&path, OPEN_BOX).unwrap();
+    let scx = |extra: &[&str]| {
+        let mut args = vec![
+            "analyze",
+            path.to_str().unwrap(),
+            "--lines",
+            "1e5",
+            "--format",
+            "json",
+        ];
+        args.extend_from_slice(extra);
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_scx"))
+            .args(&args)
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        (doc, String::from_utf8_lossy(&out.stderr).into_owned())
+    };
+    let (doc, stderr) = scx(&[]);
+    let fraction = doc["escape_fraction"].as_f64().unwrap();
+    let segments = doc["pairs"].as_f64().unwrap() + doc["escapes"].as_f64().unwrap();
+    let sigma = (2.0 / 9.0 / segments).sqrt();
+    assert!((fraction - 1.0 / 3.0).abs() < 4.5 * sigma, "{fraction}");
+    assert!(
+        stderr.contains("the scene is open") && stderr.contains("--enclose closes"),
+        "{stderr}"
+    );
+    assert!(doc["environment_area"].is_null());
+    let (doc, stderr) = scx(&["--enclose"]);
+    assert!(
+        stderr.contains("pairs with the environment patch"),
+        "{stderr}"
+    );
+    let env = doc["environment_area"]["value"].as_f64().unwrap();
+    assert!((env - (3.0 * PI - 5.0)).abs() < 0.1, "{env}");
 }
