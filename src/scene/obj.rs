@@ -8,7 +8,7 @@ use std::path::Path;
 
 use super::{Material, Scene, SceneBuilder, SceneError};
 
-/// Loads an OBJ file (and its MTL library, if any) as a scene.
+/// Loads an OBJ file (and its MTL library, if any, beside it) as a scene.
 pub fn load(path: &Path) -> Result<Scene, SceneError> {
     let shown = path.display().to_string();
     let file_error = |message: String| SceneError::File {
@@ -18,14 +18,46 @@ pub fn load(path: &Path) -> Result<Scene, SceneError> {
     if !path.exists() {
         return Err(file_error("no such file".into()));
     }
+    if path.is_dir() {
+        return Err(file_error("is a directory, not an OBJ file".into()));
+    }
+    let bytes =
+        std::fs::read(path).map_err(|e| file_error(format!("cannot read the file: {e}")))?;
+    let text = String::from_utf8(bytes).map_err(|e| {
+        file_error(format!(
+            "not a text file (invalid UTF-8 at byte {})",
+            e.utf8_error().valid_up_to()
+        ))
+    })?;
+    let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
+    load_text(&shown, &text, &|mtl: &Path| tobj::load_mtl(base.join(mtl)))
+}
+
+/// Loads OBJ text as a scene called `shown` (messages name it), with `materials` loading an MTL library
+/// from the name given in the text (a missing one is a warning).
+pub fn load_text(
+    shown: &str,
+    text: &str,
+    materials: &dyn Fn(&Path) -> tobj::MTLLoadResult,
+) -> Result<Scene, SceneError> {
+    let shown = shown.to_string();
+    let file_error = |message: String| SceneError::File {
+        path: shown.clone(),
+        message,
+    };
+    let face_lines = super::obj_check::scan(&shown, text)?;
     let options = tobj::LoadOptions {
         single_index: false,
         triangulate: false,
         ignore_points: true,
         ignore_lines: true,
     };
-    let (models, materials) =
-        tobj::load_obj(path, &options).map_err(|e| file_error(describe_tobj_error(&e)))?;
+    let (models, materials) = tobj::load_obj_buf(&mut text.as_bytes(), &options, materials)
+        .map_err(|e| file_error(describe_tobj_error(&e)))?;
+    let total_faces: usize = models.iter().map(|m| face_count(&m.mesh)).sum();
+    // Faces as tobj gives them are the `f` statements in file order; name their lines when that holds.
+    let face_line = |k: usize| (total_faces == face_lines.len()).then(|| face_lines[k]);
+    let mut global_face = 0usize;
 
     let mut b = SceneBuilder::new(shown.clone());
     let material_base = match materials {
@@ -95,15 +127,29 @@ pub fn load(path: &Path) -> Result<Scene, SceneError> {
                     })
                 })
                 .collect();
-            b.polygon(
-                &verts?,
-                material,
-                format!("{shown}: object `{}` face {}", model.name, face + 1),
-            );
+            let origin = match face_line(global_face) {
+                Some(line) => format!(
+                    "line {line}: face {} (object `{}`)",
+                    global_face + 1,
+                    model.name
+                ),
+                None => format!("object `{}` face {}", model.name, face + 1),
+            };
+            b.polygon(&verts?, material, origin);
+            global_face += 1;
             at += arity;
         }
     }
     b.build()
+}
+
+/// Faces of a tobj mesh (triangles when it gives no arities).
+fn face_count(mesh: &tobj::Mesh) -> usize {
+    if mesh.face_arities.is_empty() {
+        mesh.indices.len() / 3
+    } else {
+        mesh.face_arities.len()
+    }
 }
 
 fn convert_material(m: &tobj::Material) -> Material {
