@@ -192,7 +192,10 @@ fn bad_arguments_and_built_in_names_are_errors() {
         &["analyze", "@cube", "--lines", "0"],
         &["--lines", "whole number from 1"],
     );
-    assert_rejected(&["analyze", "@cube", "--lines=-5"], &["--lines", "whole number from 1"]);
+    assert_rejected(
+        &["analyze", "@cube", "--lines=-5"],
+        &["--lines", "whole number from 1"],
+    );
     assert_rejected(
         &["analyze", "@nosuch"],
         &["@nosuch", "unknown built-in scene"],
@@ -206,4 +209,21 @@ fn bad_arguments_and_built_in_names_are_errors() {
     ] {
         assert_rejected(&["analyze", spec], &[spec, what]);
     }
+}
+
+/// Fuzzing findings, kept as regression tests (fuzz/README.md).
+///
+/// 1. An MTL colour with fewer than three values (`Kd 02 4`) made tobj 4.0.5 panic (an unwrap in its
+///    `parse_float3`): now an error naming the MTL file and line.
+#[test]
+fn fuzzing_findings_stay_fixed() {
+    let dir = tempfile::tempdir().unwrap();
+    write(dir.path(), "short.mtl", b"newmtl m\nKd 02 4\n");
+    let obj = format!("mtllib short.mtl\n{TRIANGLE}usemtl m\nf 1 2 3\n");
+    let path = write(dir.path(), "short.obj", obj.as_bytes());
+    let mtl = dir.path().join("short.mtl").display().to_string();
+    assert_rejected(
+        &["analyze", &path, "--lines", "1000", "--tracer", "rust"],
+        &[&format!("{mtl}:2:"), "`Kd` needs three numbers"],
+    );
 }

@@ -30,16 +30,20 @@ pub fn load(path: &Path) -> Result<Scene, SceneError> {
         ))
     })?;
     let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
-    load_text(&shown, &text, &|mtl: &Path| tobj::load_mtl(base.join(mtl)))
+    load_text(&shown, &text, &|mtl: &Path| {
+        let full = base.join(mtl);
+        let text = std::fs::read_to_string(&full).map_err(|e| e.to_string())?;
+        Ok((full.display().to_string(), text))
+    })
 }
 
-/// Loads OBJ text as a scene called `shown` (messages name it), with `materials` loading an MTL library
-/// from the name given in the text (a missing one is a warning).
-pub fn load_text(
-    shown: &str,
-    text: &str,
-    materials: &dyn Fn(&Path) -> tobj::MTLLoadResult,
-) -> Result<Scene, SceneError> {
+/// Where an OBJ's MTL library comes from: given the name in `mtllib`, the library's name for messages
+/// and its text, or why it cannot be read.
+pub type MaterialSource<'a> = dyn Fn(&Path) -> Result<(String, String), String> + 'a;
+
+/// Loads OBJ text as a scene called `shown` (messages name it), with `materials` giving the text of an
+/// MTL library from the name in the OBJ (a missing library is a warning, a malformed one an error).
+pub fn load_text(shown: &str, text: &str, materials: &MaterialSource) -> Result<Scene, SceneError> {
     let shown = shown.to_string();
     let file_error = |message: String| SceneError::File {
         path: shown.clone(),
@@ -52,8 +56,24 @@ pub fn load_text(
         ignore_points: true,
         ignore_lines: true,
     };
-    let (models, materials) = tobj::load_obj_buf(&mut text.as_bytes(), &options, materials)
-        .map_err(|e| file_error(describe_tobj_error(&e)))?;
+    // tobj panics on some malformed MTL statements: the pre-scan refuses those first, and its error
+    // (with the line) comes out of tobj's callback this way.
+    let mtl_error: std::cell::RefCell<Option<SceneError>> = std::cell::RefCell::new(None);
+    let load_mtl = |name: &Path| match materials(name) {
+        Err(_) => Err(tobj::LoadError::OpenFileFailed),
+        Ok((mtl_shown, mtl_text)) => match super::obj_check::scan_mtl(&mtl_shown, &mtl_text) {
+            Err(e) => {
+                mtl_error.borrow_mut().get_or_insert(e);
+                Err(tobj::LoadError::MaterialParseError)
+            }
+            Ok(()) => tobj::load_mtl_buf(&mut mtl_text.as_bytes()),
+        },
+    };
+    let loaded = tobj::load_obj_buf(&mut text.as_bytes(), &options, load_mtl);
+    if let Some(e) = mtl_error.take() {
+        return Err(e);
+    }
+    let (models, materials) = loaded.map_err(|e| file_error(describe_tobj_error(&e)))?;
     let total_faces: usize = models.iter().map(|m| face_count(&m.mesh)).sum();
     // Faces as tobj gives them are the `f` statements in file order; name their lines when that holds.
     let face_line = |k: usize| (total_faces == face_lines.len()).then(|| face_lines[k]);

@@ -93,8 +93,44 @@ fn check_face<'a>(
     Ok(())
 }
 
+/// Checks the colour statements of MTL text (`Ka`, `Kd`, `Ks`, `Ke`: three numbers), which `tobj` would
+/// panic on with fewer than three values.
+pub(crate) fn scan_mtl(shown: &str, text: &str) -> Result<(), SceneError> {
+    for (k, raw) in text.lines().enumerate() {
+        let mut tokens = raw.split_whitespace();
+        let Some(key @ ("Ka" | "Kd" | "Ks" | "Ke")) = tokens.next() else {
+            continue;
+        };
+        let values: Vec<&str> = tokens.take(3).collect();
+        let numbers = values.iter().filter(|v| v.parse::<f64>().is_ok()).count();
+        if values.len() < 3 || numbers < 3 {
+            return Err(SceneError::File {
+                path: format!("{shown}:{}", k + 1),
+                message: format!(
+                    "`{key}` needs three numbers (red, green, blue), it has `{}`",
+                    values.join(" ")
+                ),
+            });
+        }
+    }
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
+    /// Found by fuzzing: tobj 4.0.5 panics on `Kd 02 4` (two values).
+    #[test]
+    fn short_colours_in_an_mtl_are_refused() {
+        assert!(scan_mtl("m.mtl", "newmtl m\nKd 0.5 0.5 0.5\nKe 1 1 1\n").is_ok());
+        for text in ["newmtl m\nKd 02 4\n", "Ke 1\n", "Ka\n", "Ks 1 x 1\n"] {
+            let e = scan_mtl("m.mtl", text).unwrap_err().to_string();
+            assert!(
+                e.starts_with("m.mtl:") && e.contains("needs three numbers"),
+                "{e}"
+            );
+        }
+    }
+
     use super::*;
 
     #[test]
