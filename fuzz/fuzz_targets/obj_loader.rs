@@ -24,9 +24,7 @@ fuzz_target!(|data: &[u8]| {
     } else {
         let (obj_text, mtl_text) = text.split_once("\n#MTL\n").unwrap_or((text, ""));
         let mtl = mtl_text.to_string();
-        obj::load_text("fuzz.obj", obj_text, &move |_| {
-            tobj::load_mtl_buf(&mut mtl.as_bytes())
-        })
+        obj::load_text("fuzz.obj", obj_text, &move |_| Ok(("fuzz.mtl".into(), mtl.clone())))
     };
     if let Ok(scene) = scene {
         trace_a_little(&scene);
