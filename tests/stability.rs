@@ -686,8 +686,8 @@ fn grazing_lines_give_finite_exact_pairs() {
     let h = 1.0 / 3f64.sqrt();
     let (floor, east, west) = (4u32, 1u32, 0u32);
     for tracer in support::all_tracers(&scene) {
-        for alpha in [1e-1, 1e-3, 1e-5, 1e-7, 1e-9, 0.0] {
-            let (s, c) = (alpha as f64).sin_cos();
+        for alpha in [1e-1f64, 1e-3, 1e-5, 1e-7, 1e-9, 0.0] {
+            let (s, c) = alpha.sin_cos();
             let dir = [c as f32, 0.0, s as f32];
             // Cross the floor's plane at x = -0.2, y = 0.1, starting 3 units before.
             let origin = [
@@ -1154,8 +1154,8 @@ fn enclose_closes_open_scenes_consistently() {
     for (i, row) in f.iter().enumerate() {
         assert!((row.iter().sum::<f64>() - 1.0).abs() < 1e-12, "row {i}");
     }
-    for face in 0..6 {
-        assert_eq!(f[face][6], 1.0, "a convex object sees only the environment");
+    for row in &f[..6] {
+        assert_eq!(row[6], 1.0, "a convex object sees only the environment");
     }
     let to_cube: f64 = f[6][..6].iter().sum();
     let exact = 6.0 / sphere;
