@@ -17,6 +17,7 @@ use crate::measure::visibility::{self, ContinuousValues, DiscreteValues};
 use crate::measure::Estimate;
 use rayon::prelude::*;
 
+use crate::sample::environment;
 use crate::sample::lines::LineSource;
 use crate::sample::tally::{trace_batches, BatchPlan, Tally, TracedBatches, Wanted};
 use crate::scene::Scene;
@@ -50,6 +51,10 @@ pub struct AnalysisConfig {
     /// Independent lines, or bundles of parallel lines ([`LineSource`]); a bundle never straddles two
     /// batches, so the group spread includes the correlation within a bundle.
     pub source: LineSource,
+    /// Close an open scene with the environment patch ([`crate::sample::environment`]): escapes become
+    /// pairs with it, and every measure is that of the enclosed scene. Changes nothing when nothing
+    /// escapes.
+    pub enclose: bool,
 }
 
 impl AnalysisConfig {
@@ -66,6 +71,7 @@ impl AnalysisConfig {
             estimator: DEFAULT_ESTIMATOR,
             budget: Budget::default(),
             source: LineSource::Independent,
+            enclose: false,
         }
     }
 }
@@ -235,6 +241,9 @@ pub struct Analysis {
     pub distinct_pairs: Option<usize>,
     /// Patches no segment left from, and their area fraction (when counted).
     pub unsampled: Option<(usize, f64)>,
+    /// With `--enclose` when something escaped: the environment patch's area in scene units (see
+    /// [`crate::sample::environment`]); `None` otherwise.
+    pub environment_area: Option<Estimate>,
     /// The measures.
     pub visibility: VisibilityEstimates,
     /// The full-run counts, for form factors (when counted).
@@ -247,15 +256,31 @@ struct GroupValues {
     discrete: Option<DiscreteValues>,
     corrected: Option<CorrectedValues>,
     continuous: Option<ContinuousValues>,
+    /// The environment patch's area (tracing space), when enclosed.
+    environment_area: Option<f64>,
 }
 
 impl GroupValues {
-    fn of(areas: &[f64], t: &Tally, estimator: EntropyEstimator) -> Self {
+    /// The values of a tally; of the enclosed scene when `enclose` ([`environment::enclosed`]).
+    fn of(scene: &Scene, t: &Tally, estimator: EntropyEstimator, enclose: bool) -> Self {
+        if enclose {
+            let (enclosed, areas) = environment::enclosed(scene, t);
+            return GroupValues {
+                environment_area: Some(environment::environment_area(scene, t)),
+                ..GroupValues::plain(&areas, &enclosed, estimator)
+            };
+        }
+        let areas: Vec<f64> = scene.patches.iter().map(|p| p.area).collect();
+        GroupValues::plain(&areas, t, estimator)
+    }
+
+    fn plain(areas: &[f64], t: &Tally, estimator: EntropyEstimator) -> Self {
         let counted = t.counts.as_ref().filter(|_| t.lines > 0);
         GroupValues {
             discrete: counted.map(|c| visibility::discrete(areas, c, &t.escapes_by_patch)),
             corrected: counted.map(|c| bias::corrected(areas, c, &t.escapes_by_patch, estimator)),
             continuous: ContinuousValues::from_sum(t.cmi_sum, t.cmi_pairs),
+            environment_area: None,
         }
     }
 
@@ -376,9 +401,9 @@ pub fn analyze_observed(
         round = round.min(max_round);
     };
 
-    let (total, per_group) = run.finish(&areas, cfg.estimator, each_group);
-    let all = GroupValues::of(&areas, &total, cfg.estimator);
-    let visibility = if total.lines == 0 {
+    let (total, per_group, enclosed) = run.finish(cfg.estimator, each_group);
+    let all = GroupValues::of(scene, &total, cfg.estimator, enclosed);
+    let mut visibility = if total.lines == 0 {
         VisibilityEstimates {
             positional_entropy: Some(Estimate::exact(positional_entropy(&areas))),
             ..VisibilityEstimates::default()
@@ -386,6 +411,28 @@ pub fn analyze_observed(
     } else {
         estimates(&areas, &all, &per_group, cfg.wanted)
     };
+    let mut environment_area = None;
+    if enclosed {
+        // The environment's area is counted, so H_p has a spread over the groups too.
+        visibility.positional_entropy = all.discrete.map(|d| {
+            let per: Vec<f64> = per_group
+                .iter()
+                .filter_map(|g| Some(g.discrete?.positional_entropy))
+                .collect();
+            Estimate::from_groups(d.positional_entropy, &per)
+        });
+        let scale2 = scene.normalization.scale.powi(2);
+        environment_area = all.environment_area.map(|a| {
+            let per: Vec<f64> = per_group
+                .iter()
+                .filter_map(|g| g.environment_area)
+                .collect();
+            Estimate::from_groups(
+                a * scale2,
+                &per.iter().map(|a| a * scale2).collect::<Vec<_>>(),
+            )
+        });
+    }
     Ok(Analysis {
         lines: total.lines,
         seed: cfg.seed,
@@ -398,6 +445,7 @@ pub fn analyze_observed(
         escapes: total.escapes,
         unpaired: total.unpaired,
         degenerate_pairs: total.degenerate_pairs,
+        environment_area,
         distinct_pairs: total.counts.as_ref().map(|c| c.distinct_pairs()),
         unsampled: all
             .discrete
@@ -411,6 +459,7 @@ pub fn analyze_observed(
 struct GroupedRun<'a> {
     scene: &'a Scene,
     wanted: Wanted,
+    enclose: bool,
     groups: Vec<Option<Tally>>,
     batches_done: u64,
 }
@@ -422,6 +471,7 @@ impl<'a> GroupedRun<'a> {
         GroupedRun {
             scene,
             wanted: cfg.wanted,
+            enclose: cfg.enclose,
             groups: vec![None; groups],
             batches_done: 0,
         }
@@ -459,9 +509,10 @@ impl<'a> GroupedRun<'a> {
         measure: TargetMeasure,
     ) -> Option<f64> {
         let filled: Vec<&Tally> = self.groups.iter().flatten().collect();
+        let enclose = self.enclose && filled.iter().any(|t| t.escapes > 0);
         let values: Vec<GroupValues> = filled
             .par_iter()
-            .map(|t| GroupValues::of(areas, t, cfg.estimator))
+            .map(|t| GroupValues::of(self.scene, t, cfg.estimator, enclose))
             .collect();
         // The total's value does not change the spread of the groups; any stand-in does.
         let stand_in = values.first()?;
@@ -470,21 +521,22 @@ impl<'a> GroupedRun<'a> {
             .stderr
     }
 
-    /// The merged total and every non-empty group's values.
+    /// The merged total, every non-empty group's values, and whether they are those of the enclosed
+    /// scene (`--enclose`, and something escaped).
     fn finish(
         self,
-        areas: &[f64],
         estimator: EntropyEstimator,
         each_group: &mut dyn FnMut(&Tally),
-    ) -> (Tally, Vec<GroupValues>) {
+    ) -> (Tally, Vec<GroupValues>, bool) {
         let filled: Vec<Tally> = self.groups.into_iter().flatten().collect();
         filled.iter().for_each(&mut *each_group);
+        let enclose = self.enclose && filled.iter().any(|t| t.escapes > 0);
         let per_group = filled
             .par_iter()
-            .map(|t| GroupValues::of(areas, t, estimator))
+            .map(|t| GroupValues::of(self.scene, t, estimator, enclose))
             .collect();
         let total = merge_tree(filled).unwrap_or_else(|| Tally::empty(self.scene, self.wanted));
-        (total, per_group)
+        (total, per_group, enclose)
     }
 }
 

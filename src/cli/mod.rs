@@ -170,6 +170,12 @@ struct AnalyzeArgs {
     /// packets); 0 casts independent lines. The standard errors include the correlation within a bundle.
     #[arg(long, default_value_t = 0, value_parser = parse_bundle)]
     bundle: u32,
+    /// Close an open scene with a virtual, absorbing environment patch (the bounding sphere, facing
+    /// inwards): escaping segments become pairs with it, rows of F sum to 1, and every visibility measure
+    /// is that of the enclosed scene. Its area is counted: the part of the sphere that sees the scene's
+    /// front sides or itself (4 pi R^2 for objects in open space). Changes nothing in a closed scene.
+    #[arg(long)]
+    enclose: bool,
     /// Output format.
     #[arg(long, value_enum, default_value_t = Format::Table)]
     format: Format,
@@ -453,6 +459,7 @@ fn try_analyze(args: &AnalyzeArgs) -> Result<(), Failure> {
         wanted,
         budget,
         source: LineSource::bundles(args.bundle).map_err(bad_input)?,
+        enclose: args.enclose,
         ..runner.config(&args.run, lines, args.run.seed)
     };
     let want_radiosity = args

@@ -106,13 +106,26 @@ pub(super) fn measures(a: &Analysis) -> Vec<Row> {
 /// Warnings a user must see about a run's numbers.
 pub fn warnings(scene: &Scene, a: &Analysis) -> Vec<String> {
     let mut w = Vec::new();
-    let segments = a.pairs + a.escapes;
-    if a.escapes > 0 && segments > 0 {
+    if let Some(fraction) = escape_fraction(a).filter(|&f| f > 0.0) {
+        let effect = match a.environment_area {
+            Some(env) => format!(
+                "with --enclose they are pairs with the environment patch (area {:.6} scene units^2), and \
+                 the measures are those of the enclosed scene",
+                env.value
+            ),
+            None => "so form-factor rows sum to less than 1 (--enclose closes the scene)".into(),
+        };
         w.push(format!(
-            "{}: the scene is open: {:.3}% of the segments leaving a front side escape the scene, so form-factor \
-             rows sum to less than 1",
+            "{}: the scene is open: {:.3}% of the segments leaving a front side escape the scene; {effect}",
             scene.name,
-            100.0 * a.escapes as f64 / segments as f64
+            100.0 * fraction
+        ));
+    }
+    if a.tally.coincident_crossings > 0 {
+        w.push(format!(
+            "{}: {} line crossing(s) met coplanar overlapping faces facing the same way; only the face first \
+             in the scene is seen there (remove duplicated faces and decals)",
+            scene.name, a.tally.coincident_crossings
         ));
     }
     if let Some((n, frac)) = a.unsampled {
@@ -131,6 +144,12 @@ pub fn warnings(scene: &Scene, a: &Analysis) -> Vec<String> {
         ));
     }
     w
+}
+
+/// The fraction of the segments leaving a front side that escape the scene (`None` without segments).
+fn escape_fraction(a: &Analysis) -> Option<f64> {
+    let segments = a.pairs + a.escapes;
+    (segments > 0).then(|| a.escapes as f64 / segments as f64)
 }
 
 fn estimate_json(e: Option<Estimate>) -> Value {
@@ -180,7 +199,10 @@ pub fn json(run: &RunInfo, a: &Analysis) -> String {
         "pairs": a.pairs,
         "escapes": a.escapes,
         "unpaired": a.unpaired,
+        "escape_fraction": escape_fraction(a),
         "degenerate_pairs": a.degenerate_pairs,
+        "coincident_crossings": a.tally.coincident_crossings,
+        "environment_area": estimate_json(a.environment_area),
         "distinct_pairs": a.distinct_pairs,
         "unsampled_patches": a.unsampled.map(|u| u.0),
         "unsampled_area_fraction": a.unsampled.map(|u| u.1),
@@ -341,6 +363,17 @@ pub fn table(run: &RunInfo, a: &Analysis) -> String {
             .map(|d| format!("; {d} distinct patch pairs"))
             .unwrap_or_default()
     );
+    if let Some(env) = a.environment_area {
+        let r = scene.normalization.scale;
+        let _ = writeln!(
+            s,
+            "enclosed by the environment patch (--enclose): area {:.6} +- {} scene units^2 of the bounding \
+             sphere's {:.6}",
+            env.value,
+            stderr_text(env),
+            4.0 * std::f64::consts::PI * r * r
+        );
+    }
     let _ = writeln!(s);
     let _ = writeln!(
         s,

@@ -10,6 +10,7 @@
 //! Facing is decided from our own f64 patch normals, identically for every tracer; a line exactly in a
 //! patch's plane faces neither side and makes its segments unpaired.
 
+use super::order::{self, Crossing};
 use crate::scene::Scene;
 use crate::trace::{Hit, Line};
 
@@ -60,49 +61,81 @@ impl From<&Line> for LineF64 {
 }
 
 /// Calls `visit` for every segment of a line's canonical hit list, in order along the line.
-pub fn segments(scene: &Scene, line: &Line, hits: &[Hit], mut visit: impl FnMut(Segment)) {
+pub fn segments(scene: &Scene, line: &Line, hits: &[Hit], visit: impl FnMut(Segment)) {
+    segments_counting_overlaps(scene, line, hits, visit);
+}
+
+/// [`segments`], also returning how many crossings met two coplanar overlapping surfaces facing the same
+/// way (of which only the first in the scene is seen; see [`super::order`]).
+///
+/// Hits too close for their f32 order to be trusted (surfaces almost or exactly touching) are first put
+/// in their true order ([`super::order`]); other lines pair their hits as they come.
+pub fn segments_counting_overlaps(
+    scene: &Scene,
+    line: &Line,
+    hits: &[Hit],
+    mut visit: impl FnMut(Segment),
+) -> u64 {
     if hits.is_empty() {
-        return;
+        return 0;
     }
     let l = LineF64::from(line);
-    let patch_of = |h: &Hit| scene.triangle_patch[h.triangle as usize];
-    let cos_of = |p: u32| {
-        let n = scene.patches[p as usize].normal;
-        n[0] * l.dir[0] + n[1] * l.dir[1] + n[2] * l.dir[2]
-    };
-
-    let first = patch_of(&hits[0]);
-    if cos_of(first) < 0.0 {
-        visit(Segment::Escape { patch: first });
+    let crossing = |h: &Hit| crossing(scene, &l, h);
+    if !order::has_close_hits(hits) {
+        pair_crossings(hits.iter().map(crossing), &mut visit);
+        return 0;
     }
-    for w in hits.windows(2) {
-        let (p, q) = (patch_of(&w[0]), patch_of(&w[1]));
-        let (cp, cq) = (cos_of(p), cos_of(q));
-        // Leaving p's front side: moving along its normal. Arriving at q's front: moving against it.
-        if cp > 0.0 && cq < 0.0 {
-            let tp = plane_t(scene, p, &l, cp);
-            let tq = plane_t(scene, q, &l, cq);
+    let mut crossings: Vec<Crossing> = hits.iter().map(crossing).collect();
+    let overlaps = order::reorder(&mut crossings, hits);
+    pair_crossings(crossings.into_iter(), &mut visit);
+    overlaps
+}
+
+/// A hit as a crossing: its patch, the facing and the f64 distance to the patch's plane.
+fn crossing(scene: &Scene, l: &LineF64, h: &Hit) -> Crossing {
+    let patch = scene.triangle_patch[h.triangle as usize];
+    let p = &scene.patches[patch as usize];
+    let n = p.normal;
+    let cos = n[0] * l.dir[0] + n[1] * l.dir[1] + n[2] * l.dir[2];
+    let t = if cos != 0.0 {
+        (p.offset - (n[0] * l.origin[0] + n[1] * l.origin[1] + n[2] * l.origin[2])) / cos
+    } else {
+        // In the plane: no plane distance; the traced one orders it.
+        f64::from(h.t)
+    };
+    Crossing {
+        patch,
+        triangle: h.triangle,
+        cos,
+        t,
+    }
+}
+
+/// Pairs consecutive crossings (see the module documentation).
+fn pair_crossings(mut crossings: impl Iterator<Item = Crossing>, visit: &mut impl FnMut(Segment)) {
+    let Some(first) = crossings.next() else {
+        return;
+    };
+    if first.cos < 0.0 {
+        visit(Segment::Escape { patch: first.patch });
+    }
+    let mut prev = first;
+    for next in crossings {
+        // Leaving prev's front side: moving along its normal. Arriving at next's front: moving against it.
+        if prev.cos > 0.0 && next.cos < 0.0 {
             visit(Segment::Pair {
-                from: p,
-                to: q,
-                distance: (tq - tp).abs(),
-                cos_from: cp,
-                cos_to: -cq,
+                from: prev.patch,
+                to: next.patch,
+                distance: (next.t - prev.t).abs(),
+                cos_from: prev.cos,
+                cos_to: -next.cos,
             });
         } else {
             visit(Segment::Unpaired);
         }
+        prev = next;
     }
-    let last = patch_of(&hits[hits.len() - 1]);
-    if cos_of(last) > 0.0 {
-        visit(Segment::Escape { patch: last });
+    if prev.cos > 0.0 {
+        visit(Segment::Escape { patch: prev.patch });
     }
-}
-
-/// Where the f64 line crosses patch `p`'s plane (`cos` = normal . dir, non-zero).
-fn plane_t(scene: &Scene, p: u32, l: &LineF64, cos: f64) -> f64 {
-    let patch = &scene.patches[p as usize];
-    let n = patch.normal;
-    let no = n[0] * l.origin[0] + n[1] * l.origin[1] + n[2] * l.origin[2];
-    (patch.offset - no) / cos
 }

@@ -9,8 +9,9 @@ use std::ops::Range;
 use rayon::prelude::*;
 
 use super::counts::{pair_key, PairCounts};
+use super::environment;
 use super::lines::LineSource;
-use super::pairs::{segments, Segment};
+use super::pairs::{segments_counting_overlaps, Segment};
 use crate::scene::Scene;
 use crate::trace::{LineHits, RawHit, TraceError, Tracer};
 
@@ -98,6 +99,16 @@ pub struct Tally {
     pub cmi_sum: f64,
     /// Pairs that entered `cmi_sum`.
     pub cmi_pairs: u64,
+    /// Crossings of two coplanar overlapping surfaces facing the same way (only the first is seen there).
+    pub coincident_crossings: u64,
+    /// Lines that hit nothing (for `--enclose`: a chord of the environment sphere).
+    pub misses: u64,
+    /// Over the segments joining a surface, or the sphere itself, to the environment sphere (escapes and
+    /// misses): the sum of log2(cos cos / d^2), for eq. (27) with `--enclose`
+    /// ([`super::environment`]).
+    pub env_log2_sum: f64,
+    /// How many segments entered `env_log2_sum`.
+    pub env_pairs: u64,
 }
 
 impl Tally {
@@ -120,6 +131,10 @@ impl Tally {
                 .then(|| PairCounts::new(scene.patch_count())),
             cmi_sum: 0.0,
             cmi_pairs: 0,
+            coincident_crossings: 0,
+            misses: 0,
+            env_log2_sum: 0.0,
+            env_pairs: 0,
         }
     }
 
@@ -143,6 +158,10 @@ impl Tally {
         }
         self.cmi_sum += other.cmi_sum;
         self.cmi_pairs += other.cmi_pairs;
+        self.coincident_crossings += other.coincident_crossings;
+        self.misses += other.misses;
+        self.env_log2_sum += other.env_log2_sum;
+        self.env_pairs += other.env_pairs;
     }
 }
 
@@ -159,6 +178,10 @@ struct BatchTally {
     escape_patches: Vec<u32>,
     cmi_sum: f64,
     cmi_pairs: u64,
+    coincident_crossings: u64,
+    misses: u64,
+    env_log2_sum: f64,
+    env_pairs: u64,
 }
 
 /// Per-thread scratch buffers, reused from batch to batch.
@@ -307,6 +330,10 @@ impl TracedBatches {
             tally.degenerate_pairs += b.degenerate_pairs;
             tally.cmi_sum += b.cmi_sum;
             tally.cmi_pairs += b.cmi_pairs;
+            tally.coincident_crossings += b.coincident_crossings;
+            tally.misses += b.misses;
+            tally.env_log2_sum += b.env_log2_sum;
+            tally.env_pairs += b.env_pairs;
             for &p in &b.escape_patches {
                 tally.escapes_by_patch[p as usize] += 1;
             }
@@ -348,39 +375,55 @@ fn tally_batch(
 
     let mut keys = Vec::new();
     let mut log2_sum = Log2Sum::default();
+    let mut env_sum = Log2Sum::default();
     let mut t = BatchTally {
         lines: count as u64,
         hits: scratch.hits.hits.len() as u64,
         ..BatchTally::default()
     };
     for (k, line) in scratch.lines.iter().enumerate() {
-        segments(scene, line, scratch.hits.of_line(k), |s| match s {
-            Segment::Pair {
-                from,
-                to,
-                distance,
-                cos_from,
-                cos_to,
-            } => {
-                t.pairs += 1;
-                if wanted.discrete {
-                    keys.push(pair_key(from, to));
+        let hits = scratch.hits.of_line(k);
+        if hits.is_empty() {
+            t.misses += 1;
+            env_sum.add(1.0, 2.0);
+            continue;
+        }
+        let mut at_start = true;
+        let overlaps = segments_counting_overlaps(scene, line, hits, |s| {
+            // Only the first segment can be the escape from the first hit.
+            let first = std::mem::replace(&mut at_start, false);
+            match s {
+                Segment::Pair {
+                    from,
+                    to,
+                    distance,
+                    cos_from,
+                    cos_to,
+                } => {
+                    t.pairs += 1;
+                    if wanted.discrete {
+                        keys.push(pair_key(from, to));
+                    }
+                    if wanted.continuous && !log2_sum.add(cos_from * cos_to, distance) {
+                        t.degenerate_pairs += 1;
+                    }
                 }
-                if wanted.continuous && !log2_sum.add(cos_from * cos_to, distance) {
-                    t.degenerate_pairs += 1;
+                Segment::Escape { patch } => {
+                    t.escapes += 1;
+                    if wanted.discrete {
+                        t.escape_patches.push(patch);
+                    }
+                    let (cos_product, distance) = environment::escape(scene, line, patch, first);
+                    env_sum.add(cos_product, distance);
                 }
+                Segment::Unpaired => t.unpaired += 1,
             }
-            Segment::Escape { patch } => {
-                t.escapes += 1;
-                if wanted.discrete {
-                    t.escape_patches.push(patch);
-                }
-            }
-            Segment::Unpaired => t.unpaired += 1,
         });
+        t.coincident_crossings += overlaps;
     }
     let log2_area_over_pi = (scene.total_area() / std::f64::consts::PI).log2();
     (t.cmi_sum, t.cmi_pairs) = log2_sum.finish(log2_area_over_pi);
+    (t.env_log2_sum, t.env_pairs) = env_sum.finish(0.0);
     t.pair_keys = keys;
     Ok(t)
 }

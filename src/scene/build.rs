@@ -93,6 +93,7 @@ impl SceneBuilder {
         // Vertices that round to the same f32 point are one vertex for the tracers: weld them, so that
         // triangles meeting there share the index (the hit rules merge a crossing of a shared vertex).
         let remap = weld_f32(&traced, &mut self.polygons);
+        drop_duplicates(&self.name, &mut self.polygons, &mut self.warnings);
         let vertices: Vec<[f64; 3]> = remap.iter().map(|&v| self.vertices[v as usize]).collect();
         let traced: Vec<[f64; 3]> = remap.iter().map(|&v| traced[v as usize]).collect();
 
@@ -270,6 +271,43 @@ fn weld_f32(traced: &[[f64; 3]], polygons: &mut [Polygon]) -> Vec<u32> {
         }
     }
     old_of_new
+}
+
+/// Drops, with a warning, faces with the same corners in the same cyclic order as an earlier face: they
+/// coincide with it and face the same way, so they could never be seen (of overlapping faces the first
+/// in the scene is the one seen, see `sample::order`). The same corners in the opposite order are the
+/// two sides of a thin panel, which stay.
+fn drop_duplicates(name: &str, polygons: &mut Vec<Polygon>, warnings: &mut Vec<String>) {
+    let mut seen: HashMap<Vec<u32>, usize> = HashMap::new();
+    let mut duplicates = Vec::new();
+    for (k, poly) in polygons.iter().enumerate() {
+        let v = &poly.vertices;
+        let Some(lowest) = (0..v.len()).min_by_key(|&i| v[i]) else {
+            continue;
+        };
+        let key: Vec<u32> = (0..v.len()).map(|i| v[(lowest + i) % v.len()]).collect();
+        if let Some(&first) = seen.get(&key) {
+            duplicates.push((first, k));
+        } else {
+            seen.insert(key, k);
+        }
+    }
+    let Some(&(first, again)) = duplicates.first() else {
+        return;
+    };
+    warnings.push(format!(
+        "{name}: dropped {} face(s) repeating an earlier face (same corners, facing the same way: never \
+         seen), first: {} repeats {}",
+        duplicates.len(),
+        polygons[again].origin,
+        polygons[first].origin
+    ));
+    let drop: std::collections::HashSet<usize> = duplicates.iter().map(|&(_, k)| k).collect();
+    let mut k = 0;
+    polygons.retain(|_| {
+        k += 1;
+        !drop.contains(&(k - 1))
+    });
 }
 
 fn to_tracing_space(p: [f64; 3], n: &Normalization) -> [f64; 3] {

@@ -10,6 +10,7 @@ pub mod builtin;
 pub mod clutter;
 pub mod cornell;
 pub mod obj;
+mod obj_check;
 
 pub use build::SceneBuilder;
 

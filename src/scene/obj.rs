@@ -8,7 +8,7 @@ use std::path::Path;
 
 use super::{Material, Scene, SceneBuilder, SceneError};
 
-/// Loads an OBJ file (and its MTL library, if any) as a scene.
+/// Loads an OBJ file (and its MTL library, if any, beside it) as a scene.
 pub fn load(path: &Path) -> Result<Scene, SceneError> {
     let shown = path.display().to_string();
     let file_error = |message: String| SceneError::File {
@@ -18,14 +18,66 @@ pub fn load(path: &Path) -> Result<Scene, SceneError> {
     if !path.exists() {
         return Err(file_error("no such file".into()));
     }
+    if path.is_dir() {
+        return Err(file_error("is a directory, not an OBJ file".into()));
+    }
+    let bytes =
+        std::fs::read(path).map_err(|e| file_error(format!("cannot read the file: {e}")))?;
+    let text = String::from_utf8(bytes).map_err(|e| {
+        file_error(format!(
+            "not a text file (invalid UTF-8 at byte {})",
+            e.utf8_error().valid_up_to()
+        ))
+    })?;
+    let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
+    load_text(&shown, &text, &|mtl: &Path| {
+        let full = base.join(mtl);
+        let text = std::fs::read_to_string(&full).map_err(|e| e.to_string())?;
+        Ok((full.display().to_string(), text))
+    })
+}
+
+/// Where an OBJ's MTL library comes from: given the name in `mtllib`, the library's name for messages
+/// and its text, or why it cannot be read.
+pub type MaterialSource<'a> = dyn Fn(&Path) -> Result<(String, String), String> + 'a;
+
+/// Loads OBJ text as a scene called `shown` (messages name it), with `materials` giving the text of an
+/// MTL library from the name in the OBJ (a missing library is a warning, a malformed one an error).
+pub fn load_text(shown: &str, text: &str, materials: &MaterialSource) -> Result<Scene, SceneError> {
+    let shown = shown.to_string();
+    let file_error = |message: String| SceneError::File {
+        path: shown.clone(),
+        message,
+    };
+    let face_lines = super::obj_check::scan(&shown, text)?;
     let options = tobj::LoadOptions {
         single_index: false,
         triangulate: false,
         ignore_points: true,
         ignore_lines: true,
     };
-    let (models, materials) =
-        tobj::load_obj(path, &options).map_err(|e| file_error(describe_tobj_error(&e)))?;
+    // tobj panics on some malformed MTL statements: the pre-scan refuses those first, and its error
+    // (with the line) comes out of tobj's callback this way.
+    let mtl_error: std::cell::RefCell<Option<SceneError>> = std::cell::RefCell::new(None);
+    let load_mtl = |name: &Path| match materials(name) {
+        Err(_) => Err(tobj::LoadError::OpenFileFailed),
+        Ok((mtl_shown, mtl_text)) => match super::obj_check::scan_mtl(&mtl_shown, &mtl_text) {
+            Err(e) => {
+                mtl_error.borrow_mut().get_or_insert(e);
+                Err(tobj::LoadError::MaterialParseError)
+            }
+            Ok(()) => tobj::load_mtl_buf(&mut mtl_text.as_bytes()),
+        },
+    };
+    let loaded = tobj::load_obj_buf(&mut text.as_bytes(), &options, load_mtl);
+    if let Some(e) = mtl_error.take() {
+        return Err(e);
+    }
+    let (models, materials) = loaded.map_err(|e| file_error(describe_tobj_error(&e)))?;
+    let total_faces: usize = models.iter().map(|m| face_count(&m.mesh)).sum();
+    // Faces as tobj gives them are the `f` statements in file order; name their lines when that holds.
+    let face_line = |k: usize| (total_faces == face_lines.len()).then(|| face_lines[k]);
+    let mut global_face = 0usize;
 
     let mut b = SceneBuilder::new(shown.clone());
     let material_base = match materials {
@@ -95,15 +147,29 @@ pub fn load(path: &Path) -> Result<Scene, SceneError> {
                     })
                 })
                 .collect();
-            b.polygon(
-                &verts?,
-                material,
-                format!("{shown}: object `{}` face {}", model.name, face + 1),
-            );
+            let origin = match face_line(global_face) {
+                Some(line) => format!(
+                    "line {line}: face {} (object `{}`)",
+                    global_face + 1,
+                    model.name
+                ),
+                None => format!("object `{}` face {}", model.name, face + 1),
+            };
+            b.polygon(&verts?, material, origin);
+            global_face += 1;
             at += arity;
         }
     }
     b.build()
+}
+
+/// Faces of a tobj mesh (triangles when it gives no arities).
+fn face_count(mesh: &tobj::Mesh) -> usize {
+    if mesh.face_arities.is_empty() {
+        mesh.indices.len() / 3
+    } else {
+        mesh.face_arities.len()
+    }
 }
 
 fn convert_material(m: &tobj::Material) -> Material {

@@ -12,7 +12,7 @@
 //! * `Bvh2`, a binary BVH;
 //! * `CwBvh`, the 8-wide compressed BVH of Ylitie, Karras and Laine (HPG 2017), traversed with SSE.
 //!
-//! Measured (`cargo run --release --example bvh_layouts`: 10^6 global lines on one thread, every
+//! Measured (`cargo bench --bench bvh_layouts`: 10^6 global lines on one thread, every
 //! candidate decided by the watertight test, shared machine), M lines/s:
 //!
 //! | scene       | CWBVH, leaves <= 3 | CWBVH, leaves <= 1 | Bvh2, leaves <= 3 | Bvh2, leaves <= 1 |

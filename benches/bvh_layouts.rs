@@ -3,11 +3,11 @@
 //! the same inflated boxes and 10^6 global lines, each candidate decided by the watertight test. Prints
 //! lines per second on one thread and candidates per line.
 //!
-//! `cargo run --release --example bvh_layouts [-- SCENE...]`, default `@cube:30 @cubes512`.
+//! `cargo bench --bench bvh_layouts [-- SCENE...]`, default `@cube:30 @cubes512`.
 
 use std::time::{Duration, Instant};
 
-use glam_bvh::Vec3A;
+use glam::Vec3A;
 use obvhs::{aabb::Aabb, ray::Ray, BvhBuildParams};
 use scene_complexity::sample::lines::batch_lines;
 use scene_complexity::scene::{self, Scene};
@@ -15,7 +15,10 @@ use scene_complexity::trace::rust::{bvh::margin, watertight::ShearedRay};
 use scene_complexity::trace::Line;
 
 fn main() -> anyhow::Result<()> {
-    let mut specs: Vec<String> = std::env::args().skip(1).collect();
+    let mut specs: Vec<String> = std::env::args()
+        .skip(1)
+        .filter(|a| !a.starts_with("--"))
+        .collect();
     if specs.is_empty() {
         specs = vec!["@cube:30".into(), "@cubes512".into()];
     }

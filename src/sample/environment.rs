@@ -1,0 +1,118 @@
+//! `--enclose`: the bounding sphere as a virtual, absorbing environment patch that closes an open scene.
+//!
+//! Without it, a segment from a front side out of the scene is an *escape*: form-factor rows of an open
+//! scene sum to less than 1 and the channel of the paper (sec. 2.2) is not closed. With it, the sphere
+//! bounding the scene (radius R, the unit sphere of tracing space) is one more patch whose front side
+//! faces inwards: an escape becomes a pair between its patch and the environment, at the point where the
+//! line meets the sphere, and a line that meets nothing is a pair of the environment with itself (a chord
+//! of the sphere, whose kernel cos cos / (pi d^2) is the constant 1 / (4 pi R^2)). Rows then sum to 1.
+//!
+//! **Its area.** For the channel to be consistent (reciprocity A_i F_ij = A_j F_ji, the areas being the
+//! stationary distribution of F), a patch's area must be proportional to the segment ends on its front
+//! side: 1 / (2 pi R^2) per line and unit area for every real patch (Crofton). The environment's area is
+//! therefore `2 pi R^2 (escapes + 2 misses) / lines`: the part of the sphere's 4 pi R^2 whose view into
+//! the scene ends at a front side or at the sphere itself. For objects in open space (every surface
+//! seen from outside is a front side) that is the whole sphere, 4 pi R^2 exactly in expectation; for an
+//! open enclosure (one-sided walls whose outsides are back sides) it is smaller, because the segments
+//! from the sphere to the walls' backs join nothing (they stay unpaired, as without `--enclose`). Being
+//! counted, it carries a statistical error, so H_p does too.
+//!
+//! **Effects.** H_p gains the environment's share of the area; H_s, I_s and their corrections count the
+//! environment's row and column instead of dropping the escaping mass; I_s^c (eq. 27) gets the terms of
+//! the environment pairs, with A_T including the environment. A closed scene (nothing escapes) has no
+//! environment: the sphere would only see the scene's back sides and itself, a separate channel, so
+//! `--enclose` then changes nothing.
+
+use super::counts::{pair_key, PairCounts};
+use super::pairs::LineF64;
+use super::tally::Tally;
+use crate::scene::Scene;
+use crate::trace::Line;
+
+/// `(cos cos, d)` of the segment from an escaping patch to the environment sphere: at the sphere's entry
+/// (`at_start`: the escape from the line's first hit) or exit (from its last hit).
+pub(crate) fn escape(scene: &Scene, line: &Line, patch: u32, at_start: bool) -> (f64, f64) {
+    let l = LineF64::from(line);
+    let p = &scene.patches[patch as usize];
+    let n = p.normal;
+    let cos = n[0] * l.dir[0] + n[1] * l.dir[1] + n[2] * l.dir[2];
+    let t = (p.offset - (n[0] * l.origin[0] + n[1] * l.origin[1] + n[2] * l.origin[2])) / cos;
+    let (t_in, t_out, cos_sphere) = sphere_chord(&l, scene.bounding_radius());
+    let distance = if at_start { t - t_in } else { t_out - t };
+    (cos.abs() * cos_sphere, distance)
+}
+
+/// Where the line enters and leaves the sphere of radius `r` about the origin, and the cosine between
+/// the line and the sphere's normal there (the same at both ends).
+fn sphere_chord(l: &LineF64, r: f64) -> (f64, f64, f64) {
+    let (o, d) = (l.origin, l.dir);
+    let centre_t = -(o[0] * d[0] + o[1] * d[1] + o[2] * d[2]);
+    let b2 = o[0] * o[0] + o[1] * o[1] + o[2] * o[2] - centre_t * centre_t;
+    let half = (r * r - b2).max(0.0).sqrt();
+    (centre_t - half, centre_t + half, half / r)
+}
+
+/// The environment's area in tracing space: 2 pi R^2 per segment end on it per line (see the module
+/// documentation); 0 without lines.
+pub fn environment_area(scene: &Scene, tally: &Tally) -> f64 {
+    if tally.lines == 0 {
+        return 0.0;
+    }
+    let r = scene.bounding_radius();
+    let ends = tally.escapes as f64 + 2.0 * tally.misses as f64;
+    2.0 * std::f64::consts::PI * r * r * ends / tally.lines as f64
+}
+
+/// The tally of the enclosed scene, whose patch `n_p` is the environment, and the patch areas with the
+/// environment's last. Needs the discrete counts for the pair counts (without them only eq. (27) is
+/// enclosed).
+pub fn enclosed(scene: &Scene, tally: &Tally) -> (Tally, Vec<f64>) {
+    let n = scene.patch_count();
+    let env = n as u32;
+    let mut areas: Vec<f64> = scene.patches.iter().map(|p| p.area).collect();
+    let a_scene: f64 = areas.iter().sum();
+    let a_env = environment_area(scene, tally);
+    areas.push(a_env);
+
+    let mut t = tally.clone();
+    t.counts = tally.counts.as_ref().map(|c| {
+        let mut entries: Vec<(u64, u64)> = Vec::new();
+        c.for_each(|i, j, k| entries.push((pair_key(i, j), k)));
+        for (i, &e) in tally.escapes_by_patch.iter().enumerate() {
+            if e > 0 {
+                entries.push((pair_key(i as u32, env), e));
+            }
+        }
+        if tally.misses > 0 {
+            entries.push((pair_key(env, env), tally.misses));
+        }
+        counts_from_entries(n + 1, entries)
+    });
+    t.escapes_by_patch = vec![0; if tally.counts.is_some() { n + 1 } else { 0 }];
+    t.pairs += tally.escapes + tally.misses;
+    t.escapes = 0;
+
+    // Eq. (27) with A_T' = A_T + A_env: take the scene's log2(A_T / pi) back out of each term.
+    let log2_over_pi = |a: f64| (a / std::f64::consts::PI).log2();
+    let raw = tally.cmi_sum - tally.cmi_pairs as f64 * log2_over_pi(a_scene);
+    t.cmi_pairs = tally.cmi_pairs + tally.env_pairs;
+    t.cmi_sum = raw + tally.env_log2_sum + t.cmi_pairs as f64 * log2_over_pi(a_scene + a_env);
+    (t, areas)
+}
+
+/// Pair counts of `patches` patches from `(key, count)` entries, each key once.
+fn counts_from_entries(patches: usize, mut entries: Vec<(u64, u64)>) -> PairCounts {
+    match PairCounts::new(patches) {
+        PairCounts::Dense(mut m) => {
+            for (k, c) in entries {
+                let (i, j) = super::counts::split_key(k);
+                m[[i as usize, j as usize]] += c;
+            }
+            PairCounts::Dense(m)
+        }
+        PairCounts::Sparse(_) => {
+            entries.sort_unstable();
+            PairCounts::Sparse(entries)
+        }
+    }
+}

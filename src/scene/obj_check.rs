@@ -1,0 +1,172 @@
+//! A light pre-scan of OBJ text: the problems `tobj` reports without a line number (or not at all), found
+//! with their line, before `tobj` parses the file.
+//!
+//! `tobj` drops faces of one or two vertices without a word (as points and lines) and says only
+//! "malformed face" or "malformed vertex position" for the rest; a scene missing faces would be a silent
+//! partial result, and a message without a line leaves the user searching. The scan checks the `v` and
+//! `f` statements only (what scx uses) and remembers the line of every face, so that later messages about
+//! a face (non-planar, zero area) can name its line too.
+
+use super::SceneError;
+
+/// The line numbers (1-based) of the `f` statements, in file order; or the first problem found.
+pub(crate) fn scan(shown: &str, text: &str) -> Result<Vec<usize>, SceneError> {
+    let error = |line: usize, message: String| SceneError::File {
+        path: format!("{shown}:{line}"),
+        message,
+    };
+    let vertices = text.lines().filter(|l| keyword(l) == Some("v")).count();
+    let mut seen = 0usize;
+    let mut faces = Vec::new();
+    for (k, raw) in text.lines().enumerate() {
+        let line = k + 1;
+        let mut tokens = raw.split_whitespace();
+        match tokens.next() {
+            Some("v") => {
+                seen += 1;
+                check_vertex(tokens, seen).map_err(|m| error(line, m))?;
+            }
+            Some("f") => {
+                check_face(tokens, seen, vertices).map_err(|m| error(line, m))?;
+                faces.push(line);
+            }
+            _ => {}
+        }
+    }
+    Ok(faces)
+}
+
+fn keyword(line: &str) -> Option<&str> {
+    line.split_whitespace().next()
+}
+
+/// A `v` statement: three finite numbers (a fourth, or colours, may follow).
+fn check_vertex<'a>(mut tokens: impl Iterator<Item = &'a str>, index: usize) -> Result<(), String> {
+    let mut xyz = [0.0f64; 3];
+    for (a, c) in xyz.iter_mut().enumerate() {
+        let token = tokens.next().ok_or_else(|| {
+            format!("vertex {index} (`v`) has {a} coordinate(s); a vertex needs x, y and z")
+        })?;
+        *c = token
+            .parse()
+            .map_err(|_| format!("vertex {index} (`v`): `{token}` is not a number"))?;
+    }
+    if xyz.iter().any(|c| !c.is_finite()) {
+        return Err(format!(
+            "vertex {index} has a non-finite coordinate ({}, {}, {})",
+            xyz[0], xyz[1], xyz[2]
+        ));
+    }
+    Ok(())
+}
+
+/// An `f` statement: at least 3 corners, each `v`, `v/vt`, `v//vn` or `v/vt/vn` with a vertex index that
+/// exists (positive: from the start of the file; negative: back from the last vertex read).
+fn check_face<'a>(
+    tokens: impl Iterator<Item = &'a str>,
+    seen: usize,
+    total: usize,
+) -> Result<(), String> {
+    let corners: Vec<&str> = tokens.collect();
+    if corners.len() < 3 {
+        return Err(format!(
+            "a face (`f`) needs at least 3 vertices, it has {}",
+            corners.len()
+        ));
+    }
+    for corner in corners {
+        let first = corner.split('/').next().unwrap_or("");
+        let index: i64 = first
+            .parse()
+            .map_err(|_| format!("face corner `{corner}`: `{first}` is not a vertex index"))?;
+        let resolved = if index < 0 {
+            seen as i64 + index + 1
+        } else {
+            index
+        };
+        if resolved < 1 || resolved > total as i64 {
+            return Err(format!(
+                "face corner `{corner}` refers to vertex {resolved}, but the file has {total} vertices"
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Checks the colour statements of MTL text (`Ka`, `Kd`, `Ks`, `Ke`: three numbers), which `tobj` would
+/// panic on with fewer than three values.
+pub(crate) fn scan_mtl(shown: &str, text: &str) -> Result<(), SceneError> {
+    for (k, raw) in text.lines().enumerate() {
+        let mut tokens = raw.split_whitespace();
+        let Some(key @ ("Ka" | "Kd" | "Ks" | "Ke")) = tokens.next() else {
+            continue;
+        };
+        let values: Vec<&str> = tokens.take(3).collect();
+        let numbers = values.iter().filter(|v| v.parse::<f64>().is_ok()).count();
+        if values.len() < 3 || numbers < 3 {
+            return Err(SceneError::File {
+                path: format!("{shown}:{}", k + 1),
+                message: format!(
+                    "`{key}` needs three numbers (red, green, blue), it has `{}`",
+                    values.join(" ")
+                ),
+            });
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    /// Found by fuzzing: tobj 4.0.5 panics on `Kd 02 4` (two values).
+    #[test]
+    fn short_colours_in_an_mtl_are_refused() {
+        assert!(scan_mtl("m.mtl", "newmtl m\nKd 0.5 0.5 0.5\nKe 1 1 1\n").is_ok());
+        for text in ["newmtl m\nKd 02 4\n", "Ke 1\n", "Ka\n", "Ks 1 x 1\n"] {
+            let e = scan_mtl("m.mtl", text).unwrap_err().to_string();
+            assert!(
+                e.starts_with("m.mtl:") && e.contains("needs three numbers"),
+                "{e}"
+            );
+        }
+    }
+
+    use super::*;
+
+    #[test]
+    fn problems_are_found_on_their_line() {
+        let ok = "# a triangle\nv 0 0 0\nv 1 0 0 1\nv 0 1 0\nf 1 2/1 -1//3\n";
+        assert_eq!(scan("t.obj", ok).unwrap(), vec![5]);
+        for (text, line, what) in [
+            ("v 0 0\n", 1, "has 2 coordinate(s)"),
+            ("v 0 0 0\nv 1 x 0\n", 2, "`x` is not a number"),
+            ("v 0 0 0\nv 1 NaN 0\n", 2, "non-finite"),
+            (
+                "v 0 0 0\nv 1 0 0\n\nf 1 2\n",
+                4,
+                "at least 3 vertices, it has 2",
+            ),
+            (
+                "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n",
+                4,
+                "refers to vertex 4",
+            ),
+            (
+                "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 -4\n",
+                4,
+                "refers to vertex 0",
+            ),
+            (
+                "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 a\n",
+                4,
+                "not a vertex index",
+            ),
+        ] {
+            let e = scan("t.obj", text).unwrap_err().to_string();
+            assert!(
+                e.starts_with(&format!("t.obj:{line}: ")) && e.contains(what),
+                "{e}"
+            );
+        }
+    }
+}
