@@ -9,7 +9,10 @@ mod build;
 pub mod builtin;
 pub mod clutter;
 pub mod cornell;
+pub mod furniture;
+pub mod labyrinth;
 pub mod obj;
+pub mod paper;
 
 pub use build::SceneBuilder;
 
