@@ -10,6 +10,7 @@ pub mod analysis;
 pub mod measure;
 pub mod radiosity;
 pub mod refine;
+pub mod reproduce;
 pub mod sample;
 pub mod scene;
 pub mod trace;
