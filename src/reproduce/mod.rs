@@ -251,6 +251,10 @@ struct Run {
     seconds: f64,
     v: VisibilityEstimates,
     radiosity: Option<RadiosityEstimates>,
+    /// Segments leaving a front side out of the scene (0 in a closed scene but for grazing hits).
+    escapes: u64,
+    /// Segments joining two patches.
+    pairs: u64,
     /// `2 pi R^2 / A_T` (tracing space, R = 1): eq. (22)'s `n_p - sum F^2` times this is the area-weighted
     /// form-factor MSE per line, `sum_i a_i sum_j Var(F_ij) N`.
     area_weight: f64,
@@ -319,6 +323,8 @@ impl Session<'_> {
             seconds,
             v: a.visibility,
             radiosity,
+            escapes: a.escapes,
+            pairs: a.pairs,
             area_weight: 2.0 * std::f64::consts::PI / scene.total_area(),
         })
     }
