@@ -143,6 +143,8 @@ pub struct TableReport {
     pub findings: Vec<Finding>,
     /// Lines cast for this table (refinement rounds included; runs reused from the cache count 0).
     pub lines: u64,
+    /// Runs taken from an earlier table instead of being cast again.
+    pub reused: usize,
     /// Wall-clock seconds spent on this table.
     pub seconds: f64,
 }
@@ -164,9 +166,13 @@ impl TableReport {
             let verdict = if f.holds { "holds" } else { "does NOT hold" };
             let _ = writeln!(s, "- *{}*: **{verdict}** ({})", f.claim, f.detail);
         }
+        let reused = match self.reused {
+            0 => String::new(),
+            n => format!(" ({n} run(s) shared with an earlier table, not cast again)"),
+        };
         let _ = writeln!(
             s,
-            "\n{} lines cast for this table in {:.1} s.\n",
+            "\n{} lines cast for this table in {:.1} s{reused}.\n",
             self.lines, self.seconds
         );
         s
@@ -217,14 +223,16 @@ pub fn reproduce(
         cfg,
         cache: HashMap::new(),
         lines_cast: 0,
+        reused: 0,
         log,
     };
     let mut reports = Vec::new();
     for &t in &cfg.tables {
         let start = Instant::now();
-        let before = session.lines_cast;
+        let (before, reused) = (session.lines_cast, session.reused);
         let mut report = tables::table(&mut session, t)?;
         report.lines = session.lines_cast - before;
+        report.reused = session.reused - reused;
         report.seconds = start.elapsed().as_secs_f64();
         on_table(&report);
         reports.push(report);
@@ -265,6 +273,7 @@ struct Session<'a> {
     cfg: &'a ReproduceConfig,
     cache: HashMap<(String, u64, Want), Run>,
     lines_cast: u64,
+    reused: usize,
     log: &'a mut dyn FnMut(&str),
 }
 
@@ -279,6 +288,7 @@ impl Session<'_> {
         let lines = self.lines(paper);
         let key = (spec.to_string(), lines, want);
         if let Some(r) = self.cache.get(&key) {
+            self.reused += 1;
             return Ok(r.clone());
         }
         let scene = scene::load(spec)?;

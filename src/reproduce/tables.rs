@@ -34,6 +34,7 @@ fn report(number: u8, title: &str, header: &[&str]) -> TableReport {
         notes: Vec::new(),
         findings: Vec::new(),
         lines: 0,
+        reused: 0,
         seconds: 0.0,
     }
 }
