@@ -11,6 +11,7 @@ pub mod crosscheck;
 pub mod measure;
 pub mod radiosity;
 pub mod refine;
+pub mod reproduce;
 pub mod sample;
 pub mod scene;
 pub mod trace;

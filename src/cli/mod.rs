@@ -4,6 +4,7 @@ mod convergence;
 mod plot;
 mod progress;
 mod report;
+mod reproduce;
 
 use std::sync::Arc;
 
@@ -48,6 +49,8 @@ enum Command {
     /// Trace the same lines with Embree and the pure-Rust tracer, compare them hit for hit and measure
     /// for measure; exit 1 when a line differs beyond the tolerance.
     Crosscheck(CrosscheckArgs),
+    /// Regenerate the paper's Tables 1 to 9 and print each beside the published values (Markdown).
+    Reproduce(reproduce::ReproduceArgs),
 }
 
 #[derive(clap::Args, Debug)]
@@ -294,6 +297,7 @@ pub fn main() -> ExitCode {
         Command::Convergence(args) => finish(convergence::run(&args)),
         Command::Refine(args) => finish(try_refine(&args)),
         Command::Crosscheck(args) => finish(try_crosscheck(&args)),
+        Command::Reproduce(args) => finish(reproduce::run(&args)),
     }
 }
 

@@ -9,10 +9,12 @@
 //!   triangles) and `@dodecahedron` (one pentagon patch per face; `:N` cuts each pentagon into 5 triangles
 //!   from its centre, then each into N^2): the interiors of the regular solids, circumradius 1.
 //! * `@cornell[:N]` and `@cornell-open[:N]`: the Cornell box, see [`super::cornell`].
+//! * The scenes of the paper's figures: `@fig2:a|b|c`, `@fig5:S` and `@fig6:S` ([`super::paper`]),
+//!   `@fig4:a..f` ([`super::furniture`]) and `@labyrinth[:N]` ([`super::labyrinth`]).
 //!
-//! Materials: every built-in but the Cornell box has one material, `wall`, with reflectance R = 0.5 and
+//! Materials: every built-in but the Cornell box and the labyrinth has one material, `wall`, with reflectance R = 0.5 and
 //! no emission (an even grey; nothing emits, so these scenes have no radiosity measures). The Cornell box
-//! has its published materials and a light.
+//! has its published materials and a light; the labyrinth has materials with R + E = 1.
 
 use super::build::{cross, dot, norm, sub};
 use super::{Material, Scene, SceneBuilder, SceneError};
@@ -65,6 +67,36 @@ pub const BUILTINS: &[BuiltinInfo] = &[
         usage: "@cubes512",
         description: "unit cube room holding 512 small cubes (side 1/16, one per cell of an 8^3 grid, fixed random offsets)",
     },
+    BuiltinInfo {
+        usage: "@fig2:a|b|c",
+        description: "paper fig. 2: unit cube room with 512 cubes of side 1/20, walls 10 x 10 patches, cube \
+                      faces 1 (3672 patches, H_p 11.5407); a: one cube at random in each cell of an 8^3 \
+                      grid; b: 64 clusters of 2^3 cubes, c: 8 clusters of 4^3 (gaps 1/200) at random in \
+                      their blocks",
+    },
+    BuiltinInfo {
+        usage: "@fig4:a..f",
+        description: "paper fig. 4: 10 x 10 x 3 m room; a: a 0.9 m table with four chairs in the middle; \
+                      b: 2 x 2 of them; c: 4 x 4 in the middle, d: 4 x 4 spread evenly, e: four 2 x 2 \
+                      blocks in the corners, f: 16 along the walls (e, f: 0.1 m from the walls)",
+    },
+    BuiltinInfo {
+        usage: "@fig5:a..f|T",
+        description: "paper fig. 5: 64 cubes of side 1/8 on a 4^3 lattice in the unit room, from gaps of \
+                      1/80 between them (a) to 1/64 from the walls (f), or at fraction T in [0, 1] of the \
+                      way; cubes finer: faces 2 x 2, walls 8 x 8 (1536 + 384 patches)",
+    },
+    BuiltinInfo {
+        usage: "@fig6:a..f|T",
+        description: "paper fig. 6: the scenes of @fig5 with walls finer: cube faces 1, walls 16 x 16 \
+                      (384 + 1536 patches)",
+    },
+    BuiltinInfo {
+        usage: "@labyrinth[:N]",
+        description: "paper fig. 9: perfect maze of N x N cells (default 11) with unit-high wall blocks \
+                      in a hall 2 high, unit-square patches (1634 for N = 11); every material has R + E = 1, \
+                      so the radiosity is 1 everywhere",
+    },
 ];
 
 /// Builds a built-in scene from its name (`@cube:10`).
@@ -84,6 +116,13 @@ pub fn build(spec: &str) -> Result<Scene, SceneError> {
         "cornell" => super::cornell::build(spec, parse_count(spec, param, 1, 100)?, true),
         "cornell-open" => super::cornell::build(spec, parse_count(spec, param, 1, 100)?, false),
         "cubes512" => super::clutter::cubes512(spec, param),
+        "fig2" => super::paper::fig2(spec, param),
+        "fig4" => super::furniture::fig4(spec, param),
+        "fig5" => super::paper::fig56(spec, param, super::paper::Fig56Mesh::CubesFiner),
+        "fig6" => super::paper::fig56(spec, param, super::paper::Fig56Mesh::WallsFiner),
+        "labyrinth" => {
+            super::labyrinth::build(spec, parse_count(spec, param.or(Some("11")), 1, 100)?)
+        }
         _ => Err(SceneError::Builtin(format!(
             "{spec}: unknown built-in scene; `scx scenes` lists them ({})",
             BUILTINS

@@ -9,8 +9,11 @@ mod build;
 pub mod builtin;
 pub mod clutter;
 pub mod cornell;
+pub mod furniture;
+pub mod labyrinth;
 pub mod obj;
 mod obj_check;
+pub mod paper;
 
 pub use build::SceneBuilder;
 
