@@ -3,6 +3,7 @@
 use std::time::Instant;
 
 use super::{est, lines_text, paper, Finding, ReproduceError, Run, Session, TableReport, Want};
+use crate::analysis::VisibilityEstimates;
 use crate::measure::radiosity::SolveOptions;
 use crate::measure::Estimate;
 use crate::refine::{refine, RefineConfig, Strategy};
@@ -46,6 +47,12 @@ fn finding(claim: &str, holds: bool, detail: String) -> Finding {
         detail,
     }
 }
+
+/// Picks one measure of a run.
+type Pick = fn(&VisibilityEstimates) -> Option<Estimate>;
+
+/// A fig. 2 run of Table 1: placement, the paper's line count, the paper's E(MSE), the run.
+type Fig2Run = (char, u64, f64, Run);
 
 /// The value of an estimate (NaN when missing, which fails every comparison).
 fn val(e: Option<Estimate>) -> f64 {
@@ -185,17 +192,19 @@ fn table1(s: &mut Session) -> Result<TableReport, ReproduceError> {
         ratios.join(", ")
     ));
     t.notes.extend(capped_note(s, &[1_000_000, 10_000_000]));
+    t.findings = table1_findings(s, &runs);
+    Ok(t)
+}
+
+/// Table 1's claims: clustering lowers H_s and raises I_s; E(MSE) follows H_s; more lines raise H_s.
+fn table1_findings(s: &Session, runs: &[Fig2Run]) -> Vec<Finding> {
     let counts = distinct(runs.iter().map(|x| x.1));
     let at = |p: char, l: u64| &runs.iter().find(|x| x.0 == p && x.1 == l).expect("ran").3;
-    let mut plug = true;
-    let mut corr = true;
-    let mut mse_order = true;
+    let (mut plug, mut corr, mut mse_order) = (true, true, true);
     let mut detail = Vec::new();
     for &l in &counts {
         let [a, b, c] = ['a', 'b', 'c'].map(|p| &at(p, l).v);
-        let h = |f: fn(&crate::analysis::VisibilityEstimates) -> Option<Estimate>| {
-            [f(a), f(b), f(c)].map(val)
-        };
+        let h = |f: Pick| [f(a), f(b), f(c)].map(val);
         let (hs, is) = (h(|v| v.entropy), h(|v| v.mutual_information));
         let (hc, ic) = (
             h(|v| v.entropy_corrected),
@@ -217,34 +226,37 @@ fn table1(s: &mut Session) -> Result<TableReport, ReproduceError> {
             mse.map(|m| format!("{m:.0}")).join("/")
         ));
     }
-    t.findings.push(finding(
-        "clustered configurations (b, c) have lower H_s and higher I_s than the random one (a)",
-        plug && corr,
-        format!(
-            "plug-in: {}, corrected: {}; {}",
-            yes(plug),
-            yes(corr),
-            detail.join("; ")
+    let mut findings = vec![
+        finding(
+            "clustered configurations (b, c) have lower H_s and higher I_s than the random one (a)",
+            plug && corr,
+            format!(
+                "plug-in: {}, corrected: {}; {}",
+                yes(plug),
+                yes(corr),
+                detail.join("; ")
+            ),
         ),
-    ));
-    t.findings.push(finding(
-        "the larger the entropy, the larger the E(MSE)",
-        mse_order,
-        "see the E(MSE) above".into(),
-    ));
+        finding(
+            "the larger the entropy, the larger the E(MSE)",
+            mse_order,
+            "see the E(MSE) above".into(),
+        ),
+    ];
+    // Only meaningful when the two line counts still differ after `--lines`.
     if counts.len() > 1 && s.lines(counts[0]) != s.lines(counts[1]) {
         let more = ['a', 'b', 'c'].iter().all(|&p| {
             let (lo, hi) = (&at(p, counts[0]).v, &at(p, counts[1]).v);
             val(hi.entropy) > val(lo.entropy)
                 && val(hi.mutual_information) < val(lo.mutual_information)
         });
-        t.findings.push(finding(
+        findings.push(finding(
             "more lines increase the (plug-in) H_s and decrease I_s",
             more,
             "each scene, 10x the lines".into(),
         ));
     }
-    Ok(t)
+    findings
 }
 
 fn table2(s: &mut Session) -> Result<TableReport, ReproduceError> {
@@ -286,13 +298,20 @@ fn table2(s: &mut Session) -> Result<TableReport, ReproduceError> {
         runs.push((n, lines, r));
     }
     t.notes.extend(capped_note(s, &paper::TABLE2.map(|r| r.1)));
+    t.findings = table2_findings(s, &runs);
+    Ok(t)
+}
+
+/// Table 2's claims: I_s^c ignores the mesh and bounds I_s; more lines raise H_s and lower I_s.
+fn table2_findings(s: &Session, runs: &[(usize, u64, Run)]) -> Vec<Finding> {
+    let mut findings = Vec::new();
     let counts = distinct(runs.iter().map(|x| x.1));
     let at = |n: usize, l: u64| &runs.iter().find(|x| x.0 == n && x.1 == l).expect("ran").2.v;
     let same_isc = counts.iter().all(|&l| {
         let c = [10, 20, 30].map(|n| at(n, l).continuous_mutual_information);
         agree(c[0], c[1]) && agree(c[1], c[2]) && agree(c[0], c[2])
     });
-    t.findings.push(finding(
+    findings.push(finding(
         "I_s^c does not depend on the discretisation (the three meshes agree at every line count)",
         same_isc,
         "within 3 combined standard errors".into(),
@@ -310,7 +329,7 @@ fn table2(s: &mut Session) -> Result<TableReport, ReproduceError> {
             )
         })
         .collect();
-    let below = |f: fn(&crate::analysis::VisibilityEstimates) -> Option<Estimate>| {
+    let below = |f: Pick| {
         [10, 20, 30]
             .iter()
             .all(|&n| val(f(at(n, last))) < val(at(n, last).continuous_mutual_information))
@@ -319,7 +338,7 @@ fn table2(s: &mut Session) -> Result<TableReport, ReproduceError> {
         below(|v| v.mutual_information),
         below(|v| v.mutual_information_corrected),
     );
-    t.findings.push(finding(
+    findings.push(finding(
         "I_s^c is an upper bound of I_s (Proposition 2), checked at the most lines",
         corr,
         format!(
@@ -329,6 +348,7 @@ fn table2(s: &mut Session) -> Result<TableReport, ReproduceError> {
             bound.join(", ")
         ),
     ));
+    // Only meaningful when the line counts still differ after `--lines`.
     if distinct(counts.iter().map(|&l| s.lines(l))).len() == counts.len() {
         let more = [10, 20, 30].iter().all(|&n| {
             let h: Vec<f64> = counts.iter().map(|&l| val(at(n, l).entropy)).collect();
@@ -338,13 +358,13 @@ fn table2(s: &mut Session) -> Result<TableReport, ReproduceError> {
                 .collect();
             decreasing(&i) && h.windows(2).all(|w| w[0] < w[1])
         });
-        t.findings.push(finding(
-            "more lines increase the (plug-in) H_s and decrease I_s, more so on finer meshes",
+        findings.push(finding(
+            "more lines increase the (plug-in) H_s and decrease I_s",
             more,
             "each mesh, over its three line counts".into(),
         ));
     }
-    Ok(t)
+    findings
 }
 
 fn table3(s: &mut Session) -> Result<TableReport, ReproduceError> {
@@ -611,9 +631,7 @@ fn table67(s: &mut Session, number: u8) -> Result<TableReport, ReproduceError> {
 fn compare_meshes(s: &mut Session, fig6: &[Run]) -> Result<Finding, ReproduceError> {
     let a5 = s.run("@fig5:a", paper::TABLE67_LINES, Want::Visibility)?;
     let f5 = s.run("@fig5:f", paper::TABLE67_LINES, Want::Visibility)?;
-    let wins = |f: fn(&crate::analysis::VisibilityEstimates) -> Option<Estimate>| {
-        val(f(&a5.v)) > val(f(&fig6[0].v)) && val(f(&fig6[5].v)) > val(f(&f5.v))
-    };
+    let wins = |f: Pick| val(f(&a5.v)) > val(f(&fig6[0].v)) && val(f(&fig6[5].v)) > val(f(&f5.v));
     let (plug, corr) = (wins(|v| v.accuracy), wins(|v| v.accuracy_corrected));
     Ok(finding(
         "5a (cubes finer) is more accurate than 6a, and 6f (walls finer) more accurate than 5f",

@@ -10,17 +10,18 @@
 //!
 //! * Discretisation: each room wall cut into 10 x 10 patches, each cube face one patch: 600 + 3072 =
 //!   3672 patches of areas 1/100 and 1/400, so `H_p = 11.5407` (Table 1: 11.541), the same for the three
-//!   placements. [`fig2_positional_entropy`] gives the closed form. We searched side lengths of the form
-//!   1/k and wall grids m x m for this: side 1/20 with 10 x 10 walls is the only choice within 0.005 bits
-//!   (the next best, walls 4 x 4 and cubes 2 x 2, gives 11.504), and it also gives Table 3's continuous
-//!   mutual information (I_s^c = 5.621 against 5.632; side 1/16 gives 6.94, side 1/25 4.57).
+//!   placements. [`fig2_positional_entropy`] gives the closed form. Of the cube sides 1/8 .. 1/64, wall
+//!   grids up to 40 x 40 and cube faces cut up to 4 x 4, two choices round to 11.541: this one and side
+//!   1/56 with 14 x 14 walls and 4 x 4 faces. Only side 1/20 also gives Table 3's continuous mutual
+//!   information (I_s^c = 5.63 against 5.632; side 1/16 gives 6.94, side 1/25 already 4.57).
 //! * `a` (random): the room cut into 8 x 8 x 8 cells of side 1/8; each cube at a uniformly random
 //!   position in its cell, at least 1/128 from the cell's walls (as `@cubes512`, with smaller cubes).
 //! * `b`, `c` (progressively clustered): the cells grouped into blocks of 2 x 2 x 2 (`b`: 64 clusters of
 //!   8 cubes) or 4 x 4 x 4 (`c`: 8 clusters of 64 cubes); a block's cubes form a lattice with gaps of
 //!   1/10 of a side between neighbours ([`FIG2_CLUSTER_GAP`]), placed at a uniformly random position in
-//!   the block, at least 1/128 from its walls. The paper gives no rule; with this one `c` matches Table
-//!   1's H_s and I_s at 10^6 lines within 0.01 and `b` within 0.2 (we read higher H_s there).
+//!   the block, at least 1/128 from its walls. The paper gives no rule; of the few we tried (gaps of a
+//!   fifth to a twentieth of a side, clusters centred or at random) this one brings `c` within 0.08 of
+//!   Table 1's H_s and I_s and `b` within 0.25 (we read higher H_s there).
 //!
 //! Positions come from PCG-64 with fixed seeds: the scenes are the same on every machine and version.
 //!
@@ -29,7 +30,9 @@
 //! together in the center" (stage `a`: gaps of 1/10 of a side between neighbouring cubes) to "almost
 //! touch the walls" (stage `f`: the outer faces 1/8 of a side from the walls). The two gaps were chosen so
 //! that I_s^c at stages `a` and `f` is Table 6's (6.43 and 6.06; I_s^c depends on the geometry only,
-//! not on the patches); with side 1/8 the cubes and the walls both have area 6, so the two
+//! not on the patches), not by the accuracies of Tables 6 and 7 (a first guess, both gaps 1/64, tied
+//! the accuracies of fig. 5's stages a and e); side 1/8 (of 1/10, 1/8 and 3/20) is the closest to Table
+//! 6's I_s^c at the middle stages. With side 1/8 the cubes and the walls both have area 6, so the two
 //! discretisations have the same H_p. `@fig5` cuts every cube face into 2 x 2 patches and every wall into
 //! 8 x 8 (1536 + 384 patches, "the discretisation of the cubes is finer"); `@fig6` cuts cube faces into 1
 //! and walls into 16 x 16 (384 + 1536, "the discretisation of the walls is finer"). The stage may also be
