@@ -2,15 +2,11 @@
 //! the line where it is known) and the problem, exit code 2, no panic and no report on stdout. A missing
 //! MTL library is the one warning-only case.
 
-use std::path::Path;
-use std::process::{Command, Output};
+mod support;
 
-fn scx(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_scx"))
-        .args(args)
-        .output()
-        .expect("scx runs")
-}
+use support::scx;
+
+use std::path::Path;
 
 /// Runs `scx analyze` on `path` (a few lines, the pure-Rust tracer) and checks the one-error contract.
 fn assert_rejected(args: &[&str], expected: &[&str]) {

@@ -1,13 +1,10 @@
 //! The `scx` binary: JSON report fields, CSV, errors with exit code 2.
 
-use std::process::Command;
+mod support;
 
-fn scx(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_scx"))
-        .args(args)
-        .output()
-        .expect("scx runs")
-}
+use support::{json_of, scx};
+
+use std::process::Command;
 
 #[test]
 fn json_report_parses_and_carries_the_documented_fields() {
@@ -120,15 +117,6 @@ fn bad_input_is_one_clear_error_with_exit_code_2() {
     let zero = scx(&["analyze", "@cube", "--lines", "0"]);
     assert_eq!(zero.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&zero.stderr).contains("whole number from 1"));
-}
-
-fn json_of(out: &std::process::Output) -> serde_json::Value {
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    serde_json::from_slice(&out.stdout).expect("valid JSON")
 }
 
 #[test]

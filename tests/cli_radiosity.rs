@@ -1,23 +1,10 @@
 //! The `scx` binary's radiosity report, `scx refine`, and its errors (exit code 2 naming file and material).
 
+mod support;
+
+use support::{json_of, scx};
+
 use std::path::Path;
-use std::process::{Command, Output};
-
-fn scx(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_scx"))
-        .args(args)
-        .output()
-        .expect("scx runs")
-}
-
-fn json_of(out: &Output) -> serde_json::Value {
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    serde_json::from_slice(&out.stdout).expect("valid JSON")
-}
 
 #[test]
 fn cornell_json_has_the_radiosity_object() {

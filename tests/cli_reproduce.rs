@@ -1,14 +1,9 @@
 //! `scx reproduce` and the paper's scenes on the command line: the tables print beside the paper's
 //! values; bad tables, line plans and scene parameters are clear errors with exit code 2.
 
-use std::process::Command;
+mod support;
 
-fn scx(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_scx"))
-        .args(args)
-        .output()
-        .expect("scx runs")
-}
+use support::scx;
 
 #[test]
 fn a_table_prints_beside_the_papers_values_with_lines_and_seconds() {

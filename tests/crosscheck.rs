@@ -3,6 +3,7 @@
 //! exactly the lines it spoils, by the right kind; the `scx crosscheck` command exits accordingly.
 
 mod support;
+use support::scx;
 
 use scene_complexity::crosscheck::{
     compare_hits, crosscheck, CrossCheckConfig, DifferenceKind, Tolerance,
@@ -149,13 +150,6 @@ fn embree_and_the_rust_bvh_agree_on_small_scenes() {
             assert!(m.gap_in_stderrs() < 1e-6, "{spec}: {}", m.name);
         }
     }
-}
-
-fn scx(args: &[&str]) -> std::process::Output {
-    std::process::Command::new(env!("CARGO_BIN_EXE_scx"))
-        .args(args)
-        .output()
-        .expect("scx runs")
 }
 
 #[cfg(feature = "embree")]

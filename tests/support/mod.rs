@@ -248,3 +248,21 @@ pub fn cube_exact_measures(n: usize) -> (f64, f64) {
     let h_s = entropy_sum / face0.len() as f64;
     (h_s, n_p.log2() - h_s)
 }
+
+/// Runs the `scx` binary with `args`.
+pub fn scx(args: &[&str]) -> std::process::Output {
+    std::process::Command::new(env!("CARGO_BIN_EXE_scx"))
+        .args(args)
+        .output()
+        .expect("scx runs")
+}
+
+/// The JSON document a successful `scx ... --format json` printed.
+pub fn json_of(out: &std::process::Output) -> serde_json::Value {
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).expect("valid JSON")
+}
