@@ -13,10 +13,12 @@ use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::time::{Duration, Instant};
 
 use crate::measure::bias::{self, CorrectedValues, EntropyEstimator};
+use crate::measure::rows::Rows;
 use crate::measure::visibility::{self, ContinuousValues, DiscreteValues};
 use crate::measure::Estimate;
 use rayon::prelude::*;
 
+use crate::sample::counts::PairCounts;
 use crate::sample::environment;
 use crate::sample::lines::LineSource;
 use crate::sample::tally::{trace_batches, BatchPlan, Tally, TracedBatches, Wanted};
@@ -276,9 +278,21 @@ impl GroupValues {
 
     fn plain(areas: &[f64], t: &Tally, estimator: EntropyEstimator) -> Self {
         let counted = t.counts.as_ref().filter(|_| t.lines > 0);
+        // One pass over the counts serves both the plug-in and the corrected measures.
+        let (discrete, corrected) = counted
+            .map(|c| {
+                let a = visibility::area_distribution(areas);
+                let a = a.as_slice().expect("a fresh array is contiguous");
+                let rows = Rows::gather(a, c, &t.escapes_by_patch, estimator);
+                (
+                    visibility::discrete_from_rows(a, &rows.sums),
+                    bias::corrected_from_rows(a, &rows, c, &t.escapes_by_patch),
+                )
+            })
+            .unzip();
         GroupValues {
-            discrete: counted.map(|c| visibility::discrete(areas, c, &t.escapes_by_patch)),
-            corrected: counted.map(|c| bias::corrected(areas, c, &t.escapes_by_patch, estimator)),
+            discrete,
+            corrected,
             continuous: ContinuousValues::from_sum(t.cmi_sum, t.cmi_pairs),
             environment_area: None,
         }
@@ -401,8 +415,7 @@ pub fn analyze_observed(
         round = round.min(max_round);
     };
 
-    let (total, per_group, enclosed) = run.finish(cfg.estimator, each_group);
-    let all = GroupValues::of(scene, &total, cfg.estimator, enclosed);
+    let (total, all, per_group, enclosed) = run.finish(cfg.estimator, each_group);
     let mut visibility = if total.lines == 0 {
         VisibilityEstimates {
             positional_entropy: Some(Estimate::exact(positional_entropy(&areas))),
@@ -461,6 +474,9 @@ struct GroupedRun<'a> {
     wanted: Wanted,
     enclose: bool,
     groups: Vec<Option<Tally>>,
+    /// With sparse counts, those of all the groups together (counted with the groups', so that the
+    /// total needs no merging of the groups at the end).
+    total_counts: Option<PairCounts>,
     batches_done: u64,
 }
 
@@ -473,6 +489,7 @@ impl<'a> GroupedRun<'a> {
             wanted: cfg.wanted,
             enclose: cfg.enclose,
             groups: vec![None; groups],
+            total_counts: None,
             batches_done: 0,
         }
     }
@@ -485,19 +502,23 @@ impl<'a> GroupedRun<'a> {
     /// parallel.
     fn add(&mut self, traced: TracedBatches) {
         let batches = traced.len() as u64;
-        let (scene, wanted) = (self.scene, self.wanted);
-        let pieces = traced.split_into_groups(self.groups());
-        self.groups
-            .par_iter_mut()
-            .zip(pieces)
-            .filter(|(_, piece)| !piece.is_empty())
-            .for_each(|(slot, piece)| {
-                let tally = piece.into_tally(scene, wanted);
-                match slot {
-                    Some(t) => t.merge(&tally),
-                    None => *slot = Some(tally),
-                }
-            });
+        let (tallies, total_counts) =
+            traced.into_group_tallies(self.scene, self.wanted, self.groups());
+        let merge_total = || match (&mut self.total_counts, total_counts) {
+            (Some(t), Some(new)) => t.merge(&new),
+            (slot, new) => *slot = slot.take().or(new),
+        };
+        let merge_groups = || {
+            self.groups
+                .par_iter_mut()
+                .zip(tallies)
+                .for_each(|(slot, tally)| match (slot.as_mut(), tally) {
+                    (Some(t), Some(new)) => t.merge(&new),
+                    (None, new) => *slot = new,
+                    (Some(_), None) => {}
+                });
+        };
+        rayon::join(merge_total, merge_groups);
         self.batches_done += batches;
     }
 
@@ -521,22 +542,35 @@ impl<'a> GroupedRun<'a> {
             .stderr
     }
 
-    /// The merged total, every non-empty group's values, and whether they are those of the enclosed
-    /// scene (`--enclose`, and something escaped).
+    /// The merged total and its values, every non-empty group's values, and whether they are those of
+    /// the enclosed scene (`--enclose`, and something escaped).
     fn finish(
         self,
         estimator: EntropyEstimator,
         each_group: &mut dyn FnMut(&Tally),
-    ) -> (Tally, Vec<GroupValues>, bool) {
+    ) -> (Tally, GroupValues, Vec<GroupValues>, bool) {
         let filled: Vec<Tally> = self.groups.into_iter().flatten().collect();
         filled.iter().for_each(&mut *each_group);
         let enclose = self.enclose && filled.iter().any(|t| t.escapes > 0);
-        let per_group = filled
-            .par_iter()
-            .map(|t| GroupValues::of(self.scene, t, estimator, enclose))
-            .collect();
-        let total = merge_tree(filled).unwrap_or_else(|| Tally::empty(self.scene, self.wanted));
-        (total, per_group, enclose)
+        let scene = self.scene;
+        let values_of = |t: &Tally| GroupValues::of(scene, t, estimator, enclose);
+        let empty = || Tally::empty(scene, self.wanted);
+        let Some(counts) = self.total_counts else {
+            // Dense (or no) counts: the groups' are merged too.
+            let per_group: Vec<GroupValues> = filled.par_iter().map(values_of).collect();
+            let total = merge_tree(filled).unwrap_or_else(empty);
+            let all = values_of(&total);
+            return (total, all, per_group, enclose);
+        };
+        // The total's counts are at hand: its values and the groups' are computed side by side.
+        let sums = filled.iter().map(Tally::without_counts).collect();
+        let mut total = merge_tree(sums).unwrap_or_else(empty);
+        total.counts = Some(counts);
+        let (all, per_group) = rayon::join(
+            || values_of(&total),
+            || filled.par_iter().map(values_of).collect(),
+        );
+        (total, all, per_group, enclose)
     }
 }
 

@@ -21,6 +21,7 @@
 
 use ndarray::Array1;
 
+use super::rows::Rows;
 use super::visibility::{area_distribution, row_totals};
 use crate::sample::counts::PairCounts;
 
@@ -126,24 +127,34 @@ pub fn corrected(
     escapes: &[u64],
     estimator: EntropyEstimator,
 ) -> CorrectedValues {
-    let n_p = areas.len();
     let a = area_distribution(areas);
-    let stats = row_stats(n_p, counts, escapes);
-    let log2_a: Array1<f64> = a.mapv(|x| if x > 0.0 { x.log2() } else { 0.0 });
-    let rows = row_entropies(counts, escapes, estimator, &stats);
+    let a = a.as_slice().expect("a fresh array is contiguous");
+    corrected_from_rows(
+        a,
+        &Rows::gather(a, counts, escapes, estimator),
+        counts,
+        escapes,
+    )
+}
 
-    let mut cross = 0.0;
-    counts.for_each(|i, j, c| {
-        let (i, j, c) = (i as usize, j as usize, c as f64);
-        if i == j {
-            cross -= a[i] * (2.0 * c / stats.total[i]) * log2_a[i];
-        } else {
-            cross -= a[i] * (c / stats.total[i]) * log2_a[j];
-            cross -= a[j] * (c / stats.total[j]) * log2_a[i];
-        }
+/// The bias-corrected H_s and I_s from the area fractions `a_i` and the rows' sums; the counts and
+/// escapes they were gathered from are read again only by Chao–Shen.
+pub fn corrected_from_rows(
+    a: &[f64],
+    rows: &Rows,
+    counts: &PairCounts,
+    escapes: &[u64],
+) -> CorrectedValues {
+    let entropies = rows.corrected_entropies().unwrap_or_else(|| {
+        let stats = row_stats(rows.sums.len(), counts, escapes);
+        row_entropies(counts, escapes, rows.estimator, &stats).to_vec()
     });
-
-    let entropy = a.dot(&rows);
+    let entropy: f64 = a.iter().zip(&entropies).map(|(a, h)| a * h).sum();
+    let cross: f64 = a
+        .iter()
+        .zip(&rows.sums)
+        .map(|(a, r)| a * r.cross_entropy_with_areas())
+        .sum();
     CorrectedValues {
         entropy,
         mutual_information: cross - entropy,
@@ -192,9 +203,18 @@ pub fn row_corrections(
     escapes: &[u64],
     estimator: EntropyEstimator,
 ) -> Array1<f64> {
-    let stats = row_stats(escapes.len().max(row_count(counts)), counts, escapes);
-    row_entropies(counts, escapes, estimator, &stats)
-        - row_entropies(counts, escapes, EntropyEstimator::PlugIn, &stats)
+    let n = escapes.len().max(row_count(counts));
+    // The areas do not enter a row's entropy.
+    let rows = Rows::gather(&vec![0.0; n], counts, escapes, estimator);
+    let corrected = rows.corrected_entropies().map_or_else(
+        || {
+            let stats = row_stats(n, counts, escapes);
+            row_entropies(counts, escapes, estimator, &stats)
+        },
+        Array1::from,
+    );
+    let plug_in: Array1<f64> = rows.sums.iter().map(|r| r.plug_in_entropy()).collect();
+    corrected - plug_in
 }
 
 /// The number of rows the counts need (largest patch index + 1).
@@ -251,7 +271,7 @@ fn row_term(estimator: EntropyEstimator, n: f64, seen: f64, f1: f64, f2: f64) ->
 }
 
 /// Grassberger's G(n) = psi(n) + (-1)^n / 2 (psi((n+1)/2) - psi(n/2)).
-fn grassberger_g(n: f64) -> f64 {
+pub(crate) fn grassberger_g(n: f64) -> f64 {
     let sign = if n % 2.0 == 0.0 { 1.0 } else { -1.0 };
     digamma(n) + 0.5 * sign * (digamma((n + 1.0) / 2.0) - digamma(n / 2.0))
 }
@@ -261,7 +281,7 @@ fn grassberger_g(n: f64) -> f64 {
 /// `A = 2 f2 / ((N-1) f1 + 2 f2)` (or its f2 = 0 form). Written as the tail `sum_{m>=1} x^m / (m + N - 1)`,
 /// `x = 1 - A`, which needs no cancellation: summed directly when it converges fast, otherwise from the
 /// complement.
-fn chao_wang_jost_unseen(n: f64, f1: f64, f2: f64) -> f64 {
+pub(crate) fn chao_wang_jost_unseen(n: f64, f1: f64, f2: f64) -> f64 {
     if f1 == 0.0 || n < 2.0 {
         return 0.0;
     }
@@ -351,6 +371,42 @@ mod tests {
         // psi(n) = -gamma + H_{n-1}
         let h: f64 = (1..100).map(|k| 1.0 / k as f64).sum();
         assert!((digamma(100.0) - (-euler + h)).abs() < 1e-12);
+    }
+
+    /// The one-pass row sums ([`Rows`]) give every estimator's row entropies as the per-outcome
+    /// definitions do, on rows of every size (singletons, doubletons, counts beyond the tables, self
+    /// pairs, escapes, an empty row).
+    #[test]
+    fn row_sums_equal_the_per_outcome_definitions() {
+        use rand::{Rng, SeedableRng};
+        let patches = 60;
+        let mut rng = rand_pcg::Pcg64::seed_from_u64(9);
+        let mut keys = Vec::new();
+        for _ in 0..3000 {
+            let i = rng.gen_range(0..patches - 1);
+            // Skewed partners: some pairs gather thousands of counts, most a few.
+            let j = (i + rng.gen_range(0..patches - 1) * rng.gen_range(0..2)) % (patches - 1);
+            keys.push(pair_key(i as u32, j as u32));
+        }
+        keys.extend(std::iter::repeat_n(pair_key(3, 4), 1500));
+        let counts = PairCounts::from_keys(patches, &mut keys);
+        let mut escapes = vec![0u64; patches];
+        escapes[2] = 1;
+        escapes[5] = 2;
+        escapes[7] = 2000;
+        for estimator in EntropyEstimator::ALL {
+            let rows = Rows::gather(&vec![0.0; patches], &counts, &escapes, estimator);
+            let stats = row_stats(patches, &counts, &escapes);
+            let reference = row_entropies(&counts, &escapes, estimator, &stats);
+            let ours = rows.corrected_entropies();
+            if estimator == EntropyEstimator::ChaoShen {
+                assert!(ours.is_none(), "Chao-Shen needs its second pass");
+                continue;
+            }
+            for (i, (a, b)) in ours.unwrap().iter().zip(&reference).enumerate() {
+                assert!((a - b).abs() < 1e-12, "{estimator:?} row {i}: {a} vs {b}");
+            }
+        }
     }
 
     /// With every outcome seen many times the corrections vanish: all estimators agree with the plug-in.

@@ -6,6 +6,7 @@ pub mod bias;
 pub mod entropy;
 pub mod estimate;
 pub mod radiosity;
+pub mod rows;
 pub mod visibility;
 
 pub use estimate::Estimate;

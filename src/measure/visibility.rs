@@ -8,7 +8,9 @@
 
 use ndarray::Array1;
 
+use super::bias::EntropyEstimator;
 use super::entropy::xlog2x;
+use super::rows::{RowSums, Rows};
 use crate::sample::counts::PairCounts;
 
 /// The discrete measures of one set of counts (paper sec. 3.1).
@@ -88,66 +90,40 @@ pub fn for_each_form_factor(
 /// The discrete measures from the patch areas, the pair counts and the escapes per patch.
 pub fn discrete(areas: &[f64], counts: &PairCounts, escapes: &[u64]) -> DiscreteValues {
     let a = area_distribution(areas);
-    let n = row_totals(areas.len(), counts, escapes);
+    let a = a.as_slice().expect("a fresh array is contiguous");
+    discrete_from_rows(
+        a,
+        &Rows::gather(a, counts, escapes, EntropyEstimator::PlugIn).sums,
+    )
+}
+
+/// The discrete measures from the area fractions `a_i` and the rows' sums ([`Rows::gather`], any
+/// estimator).
+pub fn discrete_from_rows(a: &[f64], rows: &[RowSums]) -> DiscreteValues {
     let positional_entropy = -a.iter().map(|&x| xlog2x(x)).sum::<f64>();
-
-    // log2 F_ij = log2 c - log2 N_i: a log2 per patch and per count value instead of three per form
-    // factor (this runs once per standard-error group, over every distinct pair).
-    let log_a: Vec<f64> = a.iter().map(|x| x.log2()).collect();
-    let log_n: Vec<f64> = n.iter().map(|x| x.log2()).collect();
-    let log_count = SmallLog2::new();
-    let (mut entropy, mut joint, mut mi, mut sum_f2) = (0.0, 0.0, 0.0, 0.0);
-    let mut add = |i: usize, j: usize, c: f64, log_c: f64| {
-        let f = c / n[i];
-        let log_f = log_c - log_n[i];
-        sum_f2 += f * f;
-        if a[i] > 0.0 {
-            let af = a[i] * f;
-            entropy -= af * log_f;
-            joint -= af * (log_a[i] + log_f);
-            mi += af * (log_f - log_a[j]);
+    let (mut entropy, mut cross, mut area_term, mut sum_f2) = (0.0, 0.0, 0.0, 0.0);
+    let mut unsampled_patches = 0;
+    let mut unsampled_area_fraction = 0.0;
+    for (&a_i, row) in a.iter().zip(rows) {
+        if row.segments == 0 {
+            unsampled_patches += 1;
+            unsampled_area_fraction += a_i;
+            continue;
         }
-    };
-    counts.for_each(|i, j, c| {
-        let (i, j) = (i as usize, j as usize);
-        if i == j {
-            // One segment from a patch back to itself enters N_ii twice (i -> j and j -> i).
-            add(i, i, 2.0 * c as f64, 1.0 + log_count.of(c));
-        } else {
-            let log_c = log_count.of(c);
-            add(i, j, c as f64, log_c);
-            add(j, i, c as f64, log_c);
-        }
-    });
-
-    let unsampled: Vec<usize> = (0..areas.len()).filter(|&i| n[i] == 0.0).collect();
+        entropy += a_i * row.plug_in_entropy();
+        cross += a_i * row.cross_entropy_with_areas();
+        // -sum_j a_i F_ij log2 a_i: the rows' mass on patches (escapes are no patch of eq. 17).
+        area_term -= xlog2x(a_i) * (row.segments - row.escapes) as f64 / row.n();
+        sum_f2 += row.sum_of_squares();
+    }
     DiscreteValues {
         positional_entropy,
         entropy,
-        joint_entropy: joint,
-        mutual_information: mi,
-        mse_per_line: areas.len() as f64 - sum_f2,
-        unsampled_patches: unsampled.len(),
-        unsampled_area_fraction: unsampled.iter().fold(0.0, |acc, &i| acc + a[i]),
-    }
-}
-
-/// log2 of small whole numbers from a table (pair counts are mostly small), else computed.
-struct SmallLog2(Vec<f64>);
-
-impl SmallLog2 {
-    const SIZE: u64 = 1024;
-
-    fn new() -> Self {
-        SmallLog2((0..Self::SIZE).map(|c| (c as f64).log2()).collect())
-    }
-
-    fn of(&self, c: u64) -> f64 {
-        if c < Self::SIZE {
-            self.0[c as usize]
-        } else {
-            (c as f64).log2()
-        }
+        joint_entropy: entropy + area_term,
+        mutual_information: cross - entropy,
+        mse_per_line: a.len() as f64 - sum_f2,
+        unsampled_patches,
+        unsampled_area_fraction,
     }
 }
 

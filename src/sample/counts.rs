@@ -5,6 +5,7 @@
 //! scene has at most [`DENSE_MAX_PATCHES`] patches, a sorted sparse list otherwise.
 
 use ndarray::Array2;
+use rayon::prelude::*;
 
 /// Scenes with at most this many patches keep their counts in a dense matrix (32 MiB at most).
 pub const DENSE_MAX_PATCHES: usize = 2048;
@@ -119,38 +120,200 @@ impl PairCounts {
     }
 }
 
-/// Sorts pair keys of a scene of `patches` patches. Below 2^16 patches a key is first packed into
-/// `i * patches + j < 2^32` and sorted by an LSD radix sort in passes of 11 bits (3 passes at most,
-/// linear time: a group's keys are mostly distinct, so a comparison sort or a merge of sorted batches
-/// would cost log n times more); larger scenes fall back to a comparison sort.
+/// Sorts pair keys of a scene of `patches` patches: packed into as few bits as the scene needs
+/// ([`TagLayout`]) and radix sorted (linear time: a group's keys are mostly distinct, so a comparison
+/// sort would cost log n times more).
 fn sort_keys(patches: usize, keys: &mut [u64]) {
-    let n = patches as u64;
-    if n == 0 || n >= 1 << 16 {
-        keys.sort_unstable();
-        return;
-    }
-    let mut packed: Vec<u32> = keys
-        .iter()
-        .map(|&k| {
-            let (i, j) = split_key(k);
-            (u64::from(i) * n + u64::from(j)) as u32
-        })
-        .collect();
-    let bits = 64 - (n * n - 1).max(1).leading_zeros();
-    radix_sort_u32(&mut packed, bits);
+    let layout = TagLayout::new(patches, 1);
+    let mut packed: Vec<u64> = keys.iter().map(|&k| layout.tag(k, 0)).collect();
+    radix_sort_u64(&mut packed, layout.bits, &mut Vec::new());
     for (k, &p) in keys.iter_mut().zip(&packed) {
-        *k = pair_key((u64::from(p) / n) as u32, (u64::from(p) % n) as u32);
+        *k = layout.untag(p).0;
     }
 }
 
-/// Least-significant-digit radix sort of values below 2^bits, 11 bits per pass.
-fn radix_sort_u32(values: &mut Vec<u32>, bits: u32) {
+/// Sparse pair counts of each standard-error group and of all the groups together.
+#[derive(Clone, Debug, Default)]
+pub struct GroupedCounts {
+    /// `(pair key, count)` sorted by key, one list per group.
+    pub groups: Vec<Vec<(u64, u64)>>,
+    /// The same over all groups.
+    pub total: Vec<(u64, u64)>,
+}
+
+/// Counts the pair keys of `batches` (each `(group, keys)`, groups below `groups`) per group and in
+/// all, for a scene of `patches` patches, in one sort.
+///
+/// Each key is tagged with its group in its lowest bits, so that after sorting the entries of one patch
+/// pair lie together, group by group: one pass then yields every group's counts and their sum, where
+/// counting the groups apart and merging them would touch every count once per level of a merge tree.
+/// The sort is a radix sort in two stages that both run in parallel: the keys are first dealt by their
+/// top bits into buckets of a few thousand (one pass, per chunk of batches), then each bucket is sorted
+/// in cache on the remaining bits and writes its runs into its own stretch of every list. The result
+/// does not depend on the order of the batches nor on the threads (integer counts of sorted keys).
+pub fn count_by_group(patches: usize, groups: usize, batches: &[(usize, &[u64])]) -> GroupedCounts {
+    let layout = TagLayout::new(patches, groups);
+    let keys: usize = batches.iter().map(|(_, k)| k.len()).sum();
+    // Buckets of ~4096 keys on average.
+    let top_bits = (usize::BITS - (keys >> 12).leading_zeros()).clamp(1, layout.bits.min(12));
+    let low_bits = layout.bits - top_bits;
+
+    // Stage 1: deal the tagged keys into buckets, a few chunks of batches in parallel.
+    let chunk = batches
+        .len()
+        .div_ceil(4 * rayon::current_num_threads())
+        .max(1);
+    let dealt: Vec<Vec<Vec<u64>>> = batches
+        .par_chunks(chunk)
+        .map(|chunk| {
+            let mut out = vec![Vec::new(); 1 << top_bits];
+            for &(group, keys) in chunk {
+                for &k in keys {
+                    let t = layout.tag(k, group);
+                    out[(t >> low_bits) as usize].push(t);
+                }
+            }
+            out
+        })
+        .collect();
+
+    // Stage 2: sort each bucket on its low bits, and count its runs per group and in all.
+    let sorted: Vec<(Vec<u64>, Vec<usize>)> = (0..1usize << top_bits)
+        .into_par_iter()
+        .map_init(Vec::new, |scratch, b| {
+            let mut values = Vec::with_capacity(dealt.iter().map(|d| d[b].len()).sum());
+            dealt.iter().for_each(|d| values.extend_from_slice(&d[b]));
+            radix_sort_u64(&mut values, low_bits, scratch);
+            let runs = layout.run_counts(&values, groups);
+            (values, runs)
+        })
+        .collect();
+    drop(dealt);
+
+    // Stage 3: every bucket writes its runs into its own stretch of each list (buckets hold consecutive
+    // key ranges, so the lists come out sorted).
+    let mut out = GroupedCounts {
+        groups: (0..groups)
+            .map(|g| vec![(0, 0); sorted.iter().map(|(_, r)| r[g]).sum()])
+            .collect(),
+        total: vec![(0, 0); sorted.iter().map(|(_, r)| r[groups]).sum()],
+    };
+    let mut rest: Vec<&mut [(u64, u64)]> = out
+        .groups
+        .iter_mut()
+        .chain(std::iter::once(&mut out.total))
+        .map(|l| l.as_mut_slice())
+        .collect();
+    let mut stretches = Vec::with_capacity(sorted.len());
+    for (_, runs) in &sorted {
+        let mine: Vec<&mut [(u64, u64)]> = rest
+            .iter_mut()
+            .zip(runs)
+            .map(|(list, &n)| {
+                let (head, tail) = std::mem::take(list).split_at_mut(n);
+                *list = tail;
+                head
+            })
+            .collect();
+        stretches.push(mine);
+    }
+    sorted
+        .par_iter()
+        .zip(stretches)
+        .for_each(|((values, _), mut lists)| layout.write_runs(values, &mut lists));
+    out
+}
+
+/// How pair keys are packed for sorting: `(lo << p | hi) << g | group`, with `p` bits for a patch index
+/// and `g` for a group (0 when there is one).
+#[derive(Clone, Copy, Debug)]
+struct TagLayout {
+    patch_bits: u32,
+    group_bits: u32,
+    /// Bits of a tagged key.
+    bits: u32,
+}
+
+impl TagLayout {
+    fn new(patches: usize, groups: usize) -> Self {
+        let bits_for = |n: usize| usize::BITS - n.saturating_sub(1).leading_zeros();
+        let (patch_bits, group_bits) = (bits_for(patches).max(1), bits_for(groups));
+        TagLayout {
+            patch_bits,
+            group_bits,
+            bits: 2 * patch_bits + group_bits,
+        }
+    }
+
+    fn tag(&self, key: u64, group: usize) -> u64 {
+        let (lo, hi) = split_key(key);
+        (((u64::from(lo) << self.patch_bits) | u64::from(hi)) << self.group_bits) | group as u64
+    }
+
+    /// The pair key and the group of a tagged key.
+    fn untag(&self, tagged: u64) -> (u64, usize) {
+        let group = (tagged & ((1 << self.group_bits) - 1)) as usize;
+        let pair = tagged >> self.group_bits;
+        let hi = pair & ((1 << self.patch_bits) - 1);
+        (pair_key((pair >> self.patch_bits) as u32, hi as u32), group)
+    }
+
+    /// Calls `f(tagged key, count)` for each run of equal tagged keys in `sorted`.
+    fn for_each_run(sorted: &[u64], mut f: impl FnMut(u64, u64)) {
+        let mut k = 0;
+        while k < sorted.len() {
+            let tagged = sorted[k];
+            let run = sorted[k..].iter().take_while(|&&t| t == tagged).count();
+            f(tagged, run as u64);
+            k += run;
+        }
+    }
+
+    /// How many entries sorted tagged keys make in each group's list, and (last) in the total's.
+    fn run_counts(&self, sorted: &[u64], groups: usize) -> Vec<usize> {
+        let mut runs = vec![0; groups + 1];
+        let mut last_pair = None;
+        Self::for_each_run(sorted, |tagged, _| {
+            runs[(tagged & ((1 << self.group_bits) - 1)) as usize] += 1;
+            let pair = tagged >> self.group_bits;
+            if last_pair != Some(pair) {
+                runs[groups] += 1;
+                last_pair = Some(pair);
+            }
+        });
+        runs
+    }
+
+    /// Writes the runs of sorted tagged keys into `lists` (one per group, then the total), each exactly
+    /// as long as [`TagLayout::run_counts`] said.
+    fn write_runs(&self, sorted: &[u64], lists: &mut [&mut [(u64, u64)]]) {
+        let total = lists.len() - 1;
+        let mut next = vec![0usize; lists.len()];
+        Self::for_each_run(sorted, |tagged, count| {
+            let (pair, group) = self.untag(tagged);
+            lists[group][next[group]] = (pair, count);
+            next[group] += 1;
+            let t = next[total];
+            if t > 0 && lists[total][t - 1].0 == pair {
+                lists[total][t - 1].1 += count;
+            } else {
+                lists[total][t] = (pair, count);
+                next[total] += 1;
+            }
+        });
+    }
+}
+
+/// Least-significant-digit radix sort of values below 2^bits, 11 bits per pass; `scratch` is reused
+/// between calls.
+fn radix_sort_u64(values: &mut Vec<u64>, bits: u32, scratch: &mut Vec<u64>) {
     const DIGIT: u32 = 11;
-    let mut scratch = vec![0u32; values.len()];
+    scratch.clear();
+    scratch.resize(values.len(), 0);
     let mut shift = 0;
     while shift < bits {
         let mut offsets = [0usize; 1 << DIGIT];
-        let digit = |v: u32| ((v >> shift) & ((1 << DIGIT) - 1)) as usize;
+        let digit = |v: u64| ((v >> shift) & ((1 << DIGIT) - 1)) as usize;
         for &v in values.iter() {
             offsets[digit(v)] += 1;
         }
@@ -163,7 +326,7 @@ fn radix_sort_u32(values: &mut Vec<u32>, bits: u32) {
             scratch[offsets[d]] = v;
             offsets[d] += 1;
         }
-        std::mem::swap(values, &mut scratch);
+        std::mem::swap(values, scratch);
         shift += DIGIT;
     }
 }
@@ -262,5 +425,56 @@ mod tests {
         let mut dtwice = dense.clone();
         dtwice.merge(&dense);
         assert_eq!(entries(&dtwice), entries(&twice));
+    }
+
+    /// Counting tagged keys in one sort gives each group the counts it would have alone, and the total
+    /// the counts of all keys; with many groups, buckets, self pairs, repeats, an empty group, and a
+    /// scene size that is no power of two.
+    #[test]
+    fn grouped_counting_equals_counting_each_group() {
+        let patches = 3001;
+        let mut rng = 99u64;
+        let mut next = |m: u64| {
+            rng = rng
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (rng >> 24) % m
+        };
+        let groups = 5;
+        let batches: Vec<(usize, Vec<u64>)> = (0..40)
+            .map(|b| {
+                // Group 3 gets no batch; skewed patches so that some pairs repeat often.
+                let group = [0, 1, 2, 4][b % 4];
+                let keys = (0..(b * 997 % 5000))
+                    .map(|_| {
+                        let i = next(patches) * next(2) + next(8);
+                        let j = if next(10) == 0 { i } else { next(patches) };
+                        pair_key(i as u32, j as u32)
+                    })
+                    .collect();
+                (group, keys)
+            })
+            .collect();
+        let refs: Vec<(usize, &[u64])> = batches.iter().map(|(g, k)| (*g, k.as_slice())).collect();
+        let counted = count_by_group(patches as usize, groups, &refs);
+        let sparse = |list: &Vec<(u64, u64)>| PairCounts::Sparse(list.clone());
+        for g in 0..groups {
+            let mut keys: Vec<u64> = batches
+                .iter()
+                .filter(|b| b.0 == g)
+                .flat_map(|b| b.1.iter().copied())
+                .collect();
+            let alone = PairCounts::from_keys(patches as usize, &mut keys);
+            assert_eq!(
+                entries(&sparse(&counted.groups[g])),
+                entries(&alone),
+                "group {g}"
+            );
+            assert!(counted.groups[g].windows(2).all(|w| w[0].0 < w[1].0));
+        }
+        assert!(counted.groups[3].is_empty());
+        let mut all: Vec<u64> = batches.iter().flat_map(|b| b.1.iter().copied()).collect();
+        let total = PairCounts::from_keys(patches as usize, &mut all);
+        assert_eq!(entries(&sparse(&counted.total)), entries(&total));
     }
 }

@@ -8,7 +8,7 @@ use std::ops::Range;
 
 use rayon::prelude::*;
 
-use super::counts::{pair_key, PairCounts};
+use super::counts::{count_by_group, pair_key, PairCounts, DENSE_MAX_PATCHES};
 use super::environment;
 use super::lines::LineSource;
 use super::pairs::{segments_counting_overlaps, Segment};
@@ -135,6 +135,26 @@ impl Tally {
             misses: 0,
             env_log2_sum: 0.0,
             env_pairs: 0,
+        }
+    }
+
+    /// A copy of everything but the pair counts.
+    pub fn without_counts(&self) -> Tally {
+        Tally {
+            lines: self.lines,
+            hits: self.hits,
+            pairs: self.pairs,
+            escapes: self.escapes,
+            unpaired: self.unpaired,
+            degenerate_pairs: self.degenerate_pairs,
+            escapes_by_patch: self.escapes_by_patch.clone(),
+            counts: None,
+            cmi_sum: self.cmi_sum,
+            cmi_pairs: self.cmi_pairs,
+            coincident_crossings: self.coincident_crossings,
+            misses: self.misses,
+            env_log2_sum: self.env_log2_sum,
+            env_pairs: self.env_pairs,
         }
     }
 
@@ -319,8 +339,73 @@ impl TracedBatches {
     /// Adds the batches up in batch order (so f64 sums are the same whatever the threads) and counts
     /// their pairs.
     pub(crate) fn into_tally(self, scene: &Scene, wanted: Wanted) -> Tally {
-        let mut tally = Tally::empty(scene, wanted);
-        let mut batch_counts = Vec::with_capacity(self.batches.len());
+        let (mut tally, keys) = self.into_sums(scene, wanted);
+        if wanted.discrete {
+            tally.counts = Some(PairCounts::from_batches(scene.patch_count(), keys));
+        }
+        tally
+    }
+
+    /// Deals the batches into `groups` groups by batch index modulo `groups` (the standard-error groups
+    /// of [`crate::analysis`]) and tallies each (`None` for a group without batches). With sparse counts
+    /// also returns the counts of all the groups together, from the same sort ([`count_by_group`]).
+    pub(crate) fn into_group_tallies(
+        self,
+        scene: &Scene,
+        wanted: Wanted,
+        groups: u64,
+    ) -> (Vec<Option<Tally>>, Option<PairCounts>) {
+        let patches = scene.patch_count();
+        if !wanted.discrete || patches <= DENSE_MAX_PATCHES {
+            let tallies = self
+                .split_into_groups(groups)
+                .into_par_iter()
+                .map(|piece| (!piece.is_empty()).then(|| piece.into_tally(scene, wanted)))
+                .collect();
+            return (tallies, None);
+        }
+        let keyed: Vec<(usize, &[u64])> = self
+            .batches
+            .iter()
+            .enumerate()
+            .map(|(k, b)| {
+                let group = (self.first + k as u64) % groups;
+                (group as usize, b.pair_keys.as_slice())
+            })
+            .collect();
+        let counted = count_by_group(patches, groups as usize, &keyed);
+        let tallies = self
+            .split_into_groups(groups)
+            .into_par_iter()
+            .zip(counted.groups)
+            .map(|(piece, counts)| {
+                (!piece.is_empty()).then(|| {
+                    let (mut tally, _) = piece.into_sums(scene, wanted);
+                    tally.counts = Some(PairCounts::Sparse(counts));
+                    tally
+                })
+            })
+            .collect();
+        (tallies, Some(PairCounts::Sparse(counted.total)))
+    }
+
+    /// Everything but the pair counts, added up in batch order; and the batches' pair keys.
+    fn into_sums(self, scene: &Scene, wanted: Wanted) -> (Tally, Vec<Vec<u64>>) {
+        // No count matrix yet: the caller makes it from the keys.
+        let mut tally = Tally {
+            counts: None,
+            ..Tally::empty(
+                scene,
+                Wanted {
+                    discrete: false,
+                    ..wanted
+                },
+            )
+        };
+        if wanted.discrete {
+            tally.escapes_by_patch = vec![0; scene.patch_count()];
+        }
+        let mut batch_keys = Vec::with_capacity(self.batches.len());
         for b in self.batches {
             tally.lines += b.lines;
             tally.hits += b.hits;
@@ -337,12 +422,9 @@ impl TracedBatches {
             for &p in &b.escape_patches {
                 tally.escapes_by_patch[p as usize] += 1;
             }
-            batch_counts.push(b.pair_keys);
+            batch_keys.push(b.pair_keys);
         }
-        if wanted.discrete {
-            tally.counts = Some(PairCounts::from_batches(scene.patch_count(), batch_counts));
-        }
-        tally
+        (tally, batch_keys)
     }
 }
 
