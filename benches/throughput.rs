@@ -1,7 +1,9 @@
-//! A throughput table for notes and the README: million lines per second of the all-hits kernel (raw and
-//! canonical hits), of first-hit queries, and of the whole analysis on the same number of lines, per
-//! tracer (Embree single lines and native packets, the pure-Rust BVH) and thread count. Best of three runs
-//! (the machine is shared).
+//! A throughput table for notes and the README: million lines per second of the all-hits kernel (canonical
+//! hits of lines drawn beforehand), of first-hit queries, of drawing the lines and tracing them (what an
+//! analysis does before pairing and counting), and of the whole analysis on the same lines, per tracer
+//! (Embree single lines and native packets, the pure-Rust BVH) and thread count. Best of three runs (the
+//! machine is shared). The last two columns are the analysis's share of the kernel's rate, against the
+//! kernel alone and against drawing plus kernel (so that what remains is pairing and counting).
 //!
 //! `cargo bench --bench throughput [-- SCENE... [LINES]]`, default `@cube:30 @cubes512` and 10^6 lines;
 //! `SCX_BENCH_TRACERS=rust,single` keeps only the tracers whose names contain one of the words.
@@ -11,6 +13,7 @@ use std::time::Instant;
 use rayon::prelude::*;
 use scene_complexity::analysis::{analyze, AnalysisConfig, DEFAULT_GROUPS};
 use scene_complexity::sample::lines::batch_lines;
+use scene_complexity::sample::tally::BatchPlan;
 use scene_complexity::scene;
 use scene_complexity::trace::{make_tracer, Backend, Line, LineHits, Query, Tracer};
 
@@ -34,12 +37,20 @@ fn main() -> anyhow::Result<()> {
         "M lines/s: wall clock, and per CPU-second of all threads (robust when the machine is shared)"
     );
     println!(
-        "{:<11} {:<16} {:>3}  {:>14}  {:>14}  {:>14}  {:>10}",
-        "scene", "tracer", "thr", "all-hits", "first-hit", "analyze", "an./all"
+        "{:<11} {:<16} {:>3}  {:>14}  {:>14}  {:>14}  {:>14}  {:>10}  {:>10}",
+        "scene",
+        "tracer",
+        "thr",
+        "all-hits",
+        "first-hit",
+        "draw+all-hits",
+        "analyze",
+        "an./all",
+        "an./draw+all"
     );
     println!(
-        "{:<11} {:<16} {:>3}  {:>6} {:>7}  {:>6} {:>7}  {:>6} {:>7}  {:>4} {:>5}",
-        "", "", "", "wall", "cpu", "wall", "cpu", "wall", "cpu", "wall", "cpu"
+        "{:<11} {:<16} {:>3}  {:>6} {:>7}  {:>6} {:>7}  {:>6} {:>7}  {:>6} {:>7}  {:>4} {:>5}  {:>4} {:>5}",
+        "", "", "", "wall", "cpu", "wall", "cpu", "wall", "cpu", "wall", "cpu", "wall", "cpu", "wall", "cpu"
     );
     // The pools live for the whole run: a thread that exits during a measurement would take its CPU time
     // out of the sum.
@@ -79,6 +90,7 @@ fn bench_scene(spec: &str, count: u64, pools: &[rayon::ThreadPool]) -> anyhow::R
             let t = tracer.as_ref();
             let all = pool.install(|| best(|| all_hits_pass(t, &lines)));
             let first = pool.install(|| best(|| first_hit_pass(t, &lines)));
+            let drawn = pool.install(|| best(|| draw_and_trace_pass(t, count)));
             let end_to_end = pool.install(|| {
                 best(|| {
                     analyze(&scene, t, &cfg).unwrap();
@@ -86,15 +98,19 @@ fn bench_scene(spec: &str, count: u64, pools: &[rayon::ThreadPool]) -> anyhow::R
             });
             let rate = |s: f64| count as f64 / s / 1e6;
             println!(
-                "{spec:<11} {name:<16} {threads:>3}  {:>6.2} {:>7.2}  {:>6.2} {:>7.2}  {:>6.2} {:>7.2}  {:>4.2} {:>5.2}",
+                "{spec:<11} {name:<16} {threads:>3}  {:>6.2} {:>7.2}  {:>6.2} {:>7.2}  {:>6.2} {:>7.2}  {:>6.2} {:>7.2}  {:>4.2} {:>5.2}  {:>4.2} {:>5.2}",
                 rate(all.wall),
                 rate(all.cpu),
                 rate(first.wall),
                 rate(first.cpu),
+                rate(drawn.wall),
+                rate(drawn.cpu),
                 rate(end_to_end.wall),
                 rate(end_to_end.cpu),
                 all.wall / end_to_end.wall,
                 all.cpu / end_to_end.cpu,
+                drawn.wall / end_to_end.wall,
+                drawn.cpu / end_to_end.cpu,
             );
         }
     }
@@ -160,6 +176,20 @@ fn first_hit_pass(tracer: &dyn Tracer, lines: &[Line]) {
         .for_each_init(Vec::new, |first, chunk| {
             tracer.first_hits(chunk, first).unwrap()
         });
+}
+
+/// Draws the lines of an analysis of `count` lines (seed 1, its batches) and traces them, batch by batch
+/// in parallel, as the analysis does before pairing.
+fn draw_and_trace_pass(tracer: &dyn Tracer, count: u64) {
+    let plan = BatchPlan::new(count);
+    (0..plan.batches()).into_par_iter().for_each_init(
+        || (Vec::new(), Vec::new(), LineHits::default()),
+        |(lines, raw, hits), b| {
+            lines.clear();
+            batch_lines(1, b, plan.batch_len(b), 1.0, lines);
+            tracer.all_hits(lines, raw, hits).unwrap();
+        },
+    );
 }
 
 fn all_hits_pass(tracer: &dyn Tracer, lines: &[Line]) {

@@ -158,11 +158,8 @@ pub fn count_by_group(patches: usize, groups: usize, batches: &[(usize, &[u64])]
     let top_bits = (usize::BITS - (keys >> 12).leading_zeros()).clamp(1, layout.bits.min(12));
     let low_bits = layout.bits - top_bits;
 
-    // Stage 1: deal the tagged keys into buckets, a few chunks of batches in parallel.
-    let chunk = batches
-        .len()
-        .div_ceil(4 * rayon::current_num_threads())
-        .max(1);
+    // Stage 1: deal the tagged keys into buckets, one chunk of batches per thread in parallel.
+    let chunk = batches.len().div_ceil(rayon::current_num_threads()).max(1);
     let dealt: Vec<Vec<Vec<u64>>> = batches
         .par_chunks(chunk)
         .map(|chunk| {
@@ -176,19 +173,27 @@ pub fn count_by_group(patches: usize, groups: usize, batches: &[(usize, &[u64])]
             out
         })
         .collect();
+    let mut buckets: Vec<Vec<Vec<u64>>> = (0..1usize << top_bits).map(|_| Vec::new()).collect();
+    for chunk in dealt {
+        for (bucket, piece) in buckets.iter_mut().zip(chunk) {
+            bucket.push(piece);
+        }
+    }
 
     // Stage 2: sort each bucket on its low bits, and count its runs per group and in all.
-    let sorted: Vec<(Vec<u64>, Vec<usize>)> = (0..1usize << top_bits)
+    let sorted: Vec<(Vec<u64>, Vec<usize>)> = buckets
         .into_par_iter()
-        .map_init(Vec::new, |scratch, b| {
-            let mut values = Vec::with_capacity(dealt.iter().map(|d| d[b].len()).sum());
-            dealt.iter().for_each(|d| values.extend_from_slice(&d[b]));
+        .map_init(Vec::new, |scratch, mut pieces| {
+            let mut values = if pieces.len() == 1 {
+                pieces.pop().unwrap_or_default()
+            } else {
+                pieces.concat()
+            };
             radix_sort_u64(&mut values, low_bits, scratch);
             let runs = layout.run_counts(&values, groups);
             (values, runs)
         })
         .collect();
-    drop(dealt);
 
     // Stage 3: every bucket writes its runs into its own stretch of each list (buckets hold consecutive
     // key ranges, so the lists come out sorted).
