@@ -144,6 +144,16 @@ impl BvhTracer {
     ///
     /// Errors when the scene has more triangles than a leaf reference can address (2^28).
     pub fn new(scene: &Scene) -> Result<Self, TraceError> {
+        Self::with_params(scene, build_params())
+    }
+
+    /// [`BvhTracer::new`] with other obvhs build parameters (for benchmarks); `pre_split` is ignored, spatial
+    /// splits are never used.
+    pub fn with_params(scene: &Scene, params: BvhBuildParams) -> Result<Self, TraceError> {
+        let params = BvhBuildParams {
+            pre_split: false,
+            ..params
+        };
         if scene.triangles.len() > LEAF_START as usize {
             return Err(error(format!(
                 "{}: {} triangles, more than the {LEAF_START} the BVH can address",
@@ -160,7 +170,7 @@ impl BvhTracer {
         let cw = if boxes.is_empty() {
             CwBvh::default()
         } else {
-            build_cwbvh(&boxes, build_params(), &mut Duration::default())
+            build_cwbvh(&boxes, params, &mut Duration::default())
         };
         let ids = cw.primitive_indices.clone();
         let triangles = ids
@@ -320,21 +330,31 @@ fn inflated_box(tri: [[f32; 3]; 3], margin: f32) -> Aabb {
     Aabb::new(lo, hi)
 }
 
-/// Lines the BVH can trace: finite numbers, a non-zero direction and `t_max >= 0` (obvhs assumes them).
-fn check_lines(lines: &[Line]) -> Result<(), TraceError> {
+/// Whether a line can be traced: finite numbers, a non-zero direction and `t_max >= 0` (the slab tests
+/// assume them). Without short-circuits: branch-free for the common case.
+fn traceable(l: &Line) -> bool {
+    let finite = l
+        .origin
+        .iter()
+        .chain(&l.dir)
+        .fold(l.t_max.is_finite(), |ok, c| ok & c.is_finite());
+    finite & (l.t_max >= 0.0) & (l.dir != [0.0; 3])
+}
+
+/// The error for line `k`, which is not [`traceable`].
+fn bad_line(k: usize, l: &Line) -> TraceError {
+    error(format!(
+        "line {k} cannot be traced: {l:?} (needs finite values, a direction and t_max >= 0)"
+    ))
+}
+
+/// Batches whose line indices fit a [`RawHit`].
+fn check_batch(lines: &[Line]) -> Result<(), TraceError> {
     if lines.len() > u32::MAX as usize {
         return Err(error(format!(
             "{} lines in one batch; at most 2^32 - 1 fit",
             lines.len()
         )));
-    }
-    for (k, l) in lines.iter().enumerate() {
-        let finite = l.origin.iter().chain(&l.dir).all(|c| c.is_finite()) && l.t_max.is_finite();
-        if !finite || l.t_max < 0.0 || l.dir == [0.0; 3] {
-            return Err(error(format!(
-                "line {k} cannot be traced: {l:?} (needs finite values, a direction and t_max >= 0)"
-            )));
-        }
     }
     Ok(())
 }
@@ -356,10 +376,16 @@ impl Tracer for BvhTracer {
     }
 
     fn raw_hits(&self, lines: &[Line], out: &mut Vec<RawHit>) -> Result<(), TraceError> {
-        check_lines(lines)?;
+        check_batch(lines)?;
         out.clear();
         let mut stack = Vec::new();
+        // Each line is checked as it is traced, rather than in a pass of its own: the lines are then
+        // read from memory once.
         for (k, line) in lines.iter().enumerate() {
+            if !traceable(line) {
+                out.clear();
+                return Err(bad_line(k, line));
+            }
             self.line_hits(line, &mut stack, |t, triangle| {
                 out.push(RawHit {
                     t,
@@ -372,10 +398,15 @@ impl Tracer for BvhTracer {
     }
 
     fn first_hits(&self, lines: &[Line], out: &mut Vec<Option<Hit>>) -> Result<(), TraceError> {
-        check_lines(lines)?;
         out.clear();
         let mut stack = Vec::new();
-        out.extend(lines.iter().map(|l| self.line_first_hit(l, &mut stack)));
+        for (k, line) in lines.iter().enumerate() {
+            if !traceable(line) {
+                out.clear();
+                return Err(bad_line(k, line));
+            }
+            out.push(self.line_first_hit(line, &mut stack));
+        }
         Ok(())
     }
 }
@@ -407,7 +438,7 @@ mod tests {
             dir: [0.0, 0.0, 1.0],
             t_max: 1.0,
         };
-        assert!(check_lines(&[ok]).is_ok());
+        assert!(traceable(&ok));
         for bad in [
             Line { t_max: -1.0, ..ok },
             Line {
@@ -419,7 +450,7 @@ mod tests {
                 ..ok
             },
         ] {
-            assert!(check_lines(&[bad]).is_err(), "{bad:?}");
+            assert!(!traceable(&bad), "{bad:?}");
         }
     }
 }
