@@ -1,37 +1,39 @@
-//! The pure-Rust tracer: a compressed wide BVH from the `obvhs` crate proposes candidate triangles, our
+//! The pure-Rust tracer: an 8-wide BVH built by the `obvhs` crate proposes candidate triangles, our
 //! watertight test ([`super::watertight`]) decides each of them.
 //!
-//! # Why obvhs, and its CWBVH
+//! # Why obvhs's build, and our own traversal
 //!
-//! We need a well-kept BVH crate with an *all-hits* traversal, since a global line keeps every
-//! intersection. `obvhs` (0.4, MIT/Apache-2.0, maintained, edition 2024: it needs Rust >= 1.85 and builds
-//! on our 1.95; pure Rust, no `unsafe` needed on our side) has `ray_traverse_anyhit`, which calls a
-//! closure for every primitive whose box the ray crosses and never shortens the ray: exactly "propose
-//! candidates, let us decide". It builds two layouts from the same boxes:
+//! We need a well-kept BVH builder. `obvhs` (0.4, MIT/Apache-2.0, maintained, edition 2024: it needs
+//! Rust >= 1.85 and builds on our 1.95; pure Rust, no `unsafe` needed on our side) builds a binary BVH
+//! (`Bvh2`) and from it the 8-wide compressed BVH of Ylitie, Karras and Laine (HPG 2017, `CwBvh`), and traverses
+//! both with `ray_traverse_anyhit`, which offers every primitive whose box the ray crosses. That
+//! traversal is made for nearest hits: at every node it decodes 8-bit quantized child boxes and orders
+//! the children by the ray's octant. A global line keeps every intersection, so order is worthless to us;
+//! we keep obvhs's CWBVH *topology* (its SAH collapse into 8-wide nodes and leaves of up to 3 triangles)
+//! but store exact f32 child boxes in SSE lanes and traverse with a plain unordered stack.
 //!
-//! * `Bvh2`, a binary BVH;
-//! * `CwBvh`, the 8-wide compressed BVH of Ylitie, Karras and Laine (HPG 2017), traversed with SSE.
+//! Measured (`cargo bench --bench bvh_layouts`: 10^6 global lines on one thread, every candidate decided
+//! by the watertight test, M lines per CPU-second, shared machine):
 //!
-//! Measured (`cargo bench --bench bvh_layouts`: 10^6 global lines on one thread, every
-//! candidate decided by the watertight test, shared machine), M lines/s:
-//!
-//! | scene       | CWBVH, leaves <= 3 | CWBVH, leaves <= 1 | Bvh2, leaves <= 3 | Bvh2, leaves <= 1 |
-//! |-------------|-------------------:|-------------------:|------------------:|------------------:|
-//! | `@cube:30`  | 3.83               | 3.48               | 2.81              | 2.82              |
-//! | `@cubes512` | 2.66               | 2.14               | 2.06              | 1.95              |
+//! | scene       | obvhs CWBVH, leaves <= 3 | obvhs Bvh2, leaves <= 3 | ours, leaves <= 1 | ours, leaves <= 3 |
+//! |-------------|-------------------------:|------------------------:|------------------:|------------------:|
+//! | `@cube:30`  | 3.69                     | 2.95                    | 5.98              | 6.45              |
+//! | `@cubes512` | 2.44                     | 2.02                    | 3.27              | 4.12              |
 //!
 //! with about 2.6 (`@cube:30`) and 7.7 (`@cubes512`) candidates per line whatever the layout: traversal,
-//! not the triangle test, is the cost, and the CWBVH with leaves of up to 3 triangles traverses fastest,
-//! so that is what we use. The `bvh` crate (nalgebra-based) was the other candidate; it offers only a
+//! not the triangle test, is the cost. Leaves of up to 3 triangles traverse fastest, so that is what we
+//! use; leaves of 2, and obvhs's fast and slow build presets instead of the medium one, were within the
+//! noise (+-5%). The `bvh` crate (nalgebra-based) was the other candidate builder; it offers only a
 //! binary BVH, the layout that loses here, so it was not measured.
 //!
 //! # Exactness
 //!
 //! A box test in f32 can miss a triangle that a line grazes (a wall is a box of zero thickness), so each
 //! triangle's box is inflated by [`margin`] on every side before the build, far beyond f32 rounding of the
-//! slab test, as the Embree backend inflates its triangles: the candidates are then a superset of the true
-//! hits, and every hit (and its `t`) comes from the watertight test on the original triangle, in the same
-//! operations as the brute-force tracer and the Embree filter. No spatial splits are used, so a triangle is
+//! slab test, as the Embree backend inflates its triangles; a node's boxes are exact f32 unions of these
+//! (min and max round nothing): the candidates are then a superset of the true hits, and every hit (and
+//! its `t`) comes from the watertight test on the original triangle, in the same operations as the
+//! brute-force tracer and the Embree filter. No spatial splits are used, so a triangle is
 //! proposed at most once per line; repeats would be harmless anyway ([`crate::trace::HitRules`] removes
 //! exact `(t, triangle)` repeats).
 
@@ -127,7 +129,9 @@ impl BoxRay {
         }
     }
 
-    /// Which of the 4 boxes of `half` the ray crosses within `[0, t_max]`: bit `k` for box `k`.
+    /// Which of the 4 boxes of `half` the ray crosses within `[0, t_max]`: bit `k` for box `k`. A line
+    /// starting on a triangle starts inside its inflated box, so the box's interval reaches below 0 and the
+    /// triangle is still proposed.
     #[inline(always)]
     fn crossed(&self, half: &[[Vec4; 2]; 3], t_max: Vec4) -> u32 {
         let t =
