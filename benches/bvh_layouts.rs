@@ -1,18 +1,24 @@
-//! The evaluation behind the pure-Rust tracer's choice of BVH (see `src/trace/rust/bvh.rs`): obvhs's
-//! compressed 8-wide BVH (CWBVH) against its binary BVH (`Bvh2`), leaves of at most 1 or 3 triangles, on
-//! the same inflated boxes and 10^6 global lines, each candidate decided by the watertight test. Prints
-//! lines per second on one thread and candidates per line.
+//! The evaluation behind the pure-Rust tracer's BVH (see `src/trace/rust/bvh.rs`), on the same inflated
+//! boxes and 10^6 global lines, each candidate decided by the watertight test, one thread:
+//!
+//! * obvhs's own all-hits traversals (`ray_traverse_anyhit`) of its compressed 8-wide BVH (CWBVH) and of
+//!   its binary BVH (`Bvh2`), leaves of at most 1 or 3 triangles;
+//! * our tracer ([`BvhTracer::raw_hits`]: obvhs's CWBVH topology with exact f32 boxes, unordered
+//!   traversal) from several obvhs build presets and leaf sizes.
+//!
+//! Prints M lines per CPU-second of this thread (robust when the machine is shared) and, for obvhs's
+//! traversals, candidates per line.
 //!
 //! `cargo bench --bench bvh_layouts [-- SCENE...]`, default `@cube:30 @cubes512`.
 
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use glam::Vec3A;
 use obvhs::{aabb::Aabb, ray::Ray, BvhBuildParams};
 use scene_complexity::sample::lines::batch_lines;
 use scene_complexity::scene::{self, Scene};
-use scene_complexity::trace::rust::{bvh::margin, watertight::ShearedRay};
-use scene_complexity::trace::Line;
+use scene_complexity::trace::rust::{bvh::margin, watertight::ShearedRay, BvhTracer};
+use scene_complexity::trace::{Line, Tracer};
 
 fn main() -> anyhow::Result<()> {
     let mut specs: Vec<String> = std::env::args()
@@ -28,24 +34,58 @@ fn main() -> anyhow::Result<()> {
     }
     for spec in &specs {
         let scene = scene::load(spec)?;
-        let tris: Vec<[[f32; 3]; 3]> = scene
-            .triangles
-            .iter()
-            .map(|t| t.map(|v| scene.positions[v as usize]))
-            .collect();
-        let boxes = inflated_boxes(&scene, &tris);
-        for leaf in [1u32, 3] {
-            let params = BvhBuildParams {
-                pre_split: false,
-                max_prims_per_leaf: leaf,
-                ..BvhBuildParams::medium_build()
-            };
-            let cw = obvhs::cwbvh::builder::build_cwbvh(&boxes, params, &mut Duration::default());
-            let b2 = obvhs::bvh2::builder::build_bvh2(&boxes, params, &mut Duration::default());
-            for layout in ["cwbvh", "bvh2"] {
-                let t0 = Instant::now();
-                let (mut hits, mut candidates) = (0usize, 0usize);
-                for l in &lines {
+        obvhs_traversals(spec, &scene, &lines);
+        let presets = [
+            ("fast", BvhBuildParams::fast_build()),
+            ("medium", BvhBuildParams::medium_build()),
+            ("slow", BvhBuildParams::slow_build()),
+        ];
+        for (preset, params) in presets {
+            for leaf in [1u32, 2, 3] {
+                let params = BvhBuildParams {
+                    max_prims_per_leaf: leaf,
+                    ..params
+                };
+                let tracer = BvhTracer::with_params(&scene, params)?;
+                let mut raw = Vec::new();
+                let mut hits = 0;
+                let seconds = best_cpu_seconds(|| {
+                    for chunk in lines.chunks(4096) {
+                        tracer.raw_hits(chunk, &mut raw).unwrap();
+                        hits += raw.len();
+                    }
+                });
+                println!(
+                    "{spec:<10} leaves <= {leaf}  ours, {preset:<6} build  {:5.2} M lines/s  {} raw hits",
+                    lines.len() as f64 / seconds / 1e6,
+                    hits / 3
+                );
+            }
+        }
+    }
+    Ok(())
+}
+
+/// obvhs's `ray_traverse_anyhit` on its CWBVH and Bvh2 (medium build).
+fn obvhs_traversals(spec: &str, scene: &Scene, lines: &[Line]) {
+    let tris: Vec<[[f32; 3]; 3]> = scene
+        .triangles
+        .iter()
+        .map(|t| t.map(|v| scene.positions[v as usize]))
+        .collect();
+    let boxes = inflated_boxes(scene, &tris);
+    for leaf in [1u32, 3] {
+        let params = BvhBuildParams {
+            pre_split: false,
+            max_prims_per_leaf: leaf,
+            ..BvhBuildParams::medium_build()
+        };
+        let cw = obvhs::cwbvh::builder::build_cwbvh(&boxes, params, &mut Duration::default());
+        let b2 = obvhs::bvh2::builder::build_bvh2(&boxes, params, &mut Duration::default());
+        for layout in ["cwbvh", "bvh2"] {
+            let (mut hits, mut candidates) = (0usize, 0usize);
+            let seconds = best_cpu_seconds(|| {
+                for l in lines {
                     let sheared = ShearedRay::new(l.origin, l.dir);
                     let mut decide = |slot: usize, ids: &[u32]| {
                         candidates += 1;
@@ -58,15 +98,37 @@ fn main() -> anyhow::Result<()> {
                         b2.ray_traverse_anyhit(ray(l), |_, id| decide(id, &b2.primitive_indices));
                     }
                 }
-                let rate = lines.len() as f64 / t0.elapsed().as_secs_f64() / 1e6;
-                println!(
-                    "{spec:<10} leaves <= {leaf}  {layout:<5}  {rate:5.2} M lines/s  {hits} raw hits  {:.2} candidates/line",
-                    candidates as f64 / lines.len() as f64
-                );
-            }
+            });
+            println!(
+                "{spec:<10} leaves <= {leaf}  obvhs {layout:<5} anyhit  {:5.2} M lines/s  {} raw hits  {:.2} candidates/line",
+                lines.len() as f64 / seconds / 1e6,
+                hits / 3,
+                candidates as f64 / lines.len() as f64 / 3.0
+            );
         }
     }
-    Ok(())
+}
+
+/// The least CPU time of this thread over 3 runs of `f`.
+fn best_cpu_seconds(mut f: impl FnMut()) -> f64 {
+    (0..3)
+        .map(|_| {
+            let t0 = thread_cpu_seconds();
+            f();
+            thread_cpu_seconds() - t0
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// CPU time of this thread so far (Linux: the first field of `/proc/thread-self/schedstat`, ns on a CPU).
+fn thread_cpu_seconds() -> f64 {
+    let stat = std::fs::read_to_string("/proc/thread-self/schedstat").unwrap_or_default();
+    let ns: u64 = stat
+        .split_whitespace()
+        .next()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(0);
+    ns as f64 * 1e-9
 }
 
 fn inflated_boxes(scene: &Scene, tris: &[[[f32; 3]; 3]]) -> Vec<Aabb> {

@@ -1,46 +1,48 @@
-//! The pure-Rust tracer: a compressed wide BVH from the `obvhs` crate proposes candidate triangles, our
+//! The pure-Rust tracer: an 8-wide BVH built by the `obvhs` crate proposes candidate triangles, our
 //! watertight test ([`super::watertight`]) decides each of them.
 //!
-//! # Why obvhs, and its CWBVH
+//! # Why obvhs's build, and our own traversal
 //!
-//! We need a well-kept BVH crate with an *all-hits* traversal, since a global line keeps every
-//! intersection. `obvhs` (0.4, MIT/Apache-2.0, maintained, edition 2024: it needs Rust >= 1.85 and builds
-//! on our 1.95; pure Rust, no `unsafe` needed on our side) has `ray_traverse_anyhit`, which calls a
-//! closure for every primitive whose box the ray crosses and never shortens the ray: exactly "propose
-//! candidates, let us decide". It builds two layouts from the same boxes:
+//! We need a well-kept BVH builder. `obvhs` (0.4, MIT/Apache-2.0, maintained, edition 2024: it needs
+//! Rust >= 1.85 and builds on our 1.95; pure Rust, no `unsafe` needed on our side) builds a binary BVH
+//! (`Bvh2`) and from it the 8-wide compressed BVH of Ylitie, Karras and Laine (HPG 2017, `CwBvh`), and traverses
+//! both with `ray_traverse_anyhit`, which offers every primitive whose box the ray crosses. That
+//! traversal is made for nearest hits: at every node it decodes 8-bit quantized child boxes and orders
+//! the children by the ray's octant. A global line keeps every intersection, so order is worthless to us;
+//! we keep obvhs's CWBVH *topology* (its SAH collapse into 8-wide nodes and leaves of up to 3 triangles)
+//! but store exact f32 child boxes in SSE lanes and traverse with a plain unordered stack.
 //!
-//! * `Bvh2`, a binary BVH;
-//! * `CwBvh`, the 8-wide compressed BVH of Ylitie, Karras and Laine (HPG 2017), traversed with SSE.
+//! Measured (`cargo bench --bench bvh_layouts`: 10^6 global lines on one thread, every candidate decided
+//! by the watertight test, M lines per CPU-second, shared machine):
 //!
-//! Measured (`cargo bench --bench bvh_layouts`: 10^6 global lines on one thread, every
-//! candidate decided by the watertight test, shared machine), M lines/s:
-//!
-//! | scene       | CWBVH, leaves <= 3 | CWBVH, leaves <= 1 | Bvh2, leaves <= 3 | Bvh2, leaves <= 1 |
-//! |-------------|-------------------:|-------------------:|------------------:|------------------:|
-//! | `@cube:30`  | 3.83               | 3.48               | 2.81              | 2.82              |
-//! | `@cubes512` | 2.66               | 2.14               | 2.06              | 1.95              |
+//! | scene       | obvhs CWBVH, leaves <= 3 | obvhs Bvh2, leaves <= 3 | ours, leaves <= 1 | ours, leaves <= 3 |
+//! |-------------|-------------------------:|------------------------:|------------------:|------------------:|
+//! | `@cube:30`  | 3.69                     | 2.95                    | 5.98              | 6.45              |
+//! | `@cubes512` | 2.44                     | 2.02                    | 3.27              | 4.12              |
 //!
 //! with about 2.6 (`@cube:30`) and 7.7 (`@cubes512`) candidates per line whatever the layout: traversal,
-//! not the triangle test, is the cost, and the CWBVH with leaves of up to 3 triangles traverses fastest,
-//! so that is what we use. The `bvh` crate (nalgebra-based) was the other candidate; it offers only a
+//! not the triangle test, is the cost. Leaves of up to 3 triangles traverse fastest, so that is what we
+//! use; leaves of 2, and obvhs's fast and slow build presets instead of the medium one, were within the
+//! noise (+-5%). The `bvh` crate (nalgebra-based) was the other candidate builder; it offers only a
 //! binary BVH, the layout that loses here, so it was not measured.
 //!
 //! # Exactness
 //!
 //! A box test in f32 can miss a triangle that a line grazes (a wall is a box of zero thickness), so each
 //! triangle's box is inflated by [`margin`] on every side before the build, far beyond f32 rounding of the
-//! slab test, as the Embree backend inflates its triangles: the candidates are then a superset of the true
-//! hits, and every hit (and its `t`) comes from the watertight test on the original triangle, in the same
-//! operations as the brute-force tracer and the Embree filter. No spatial splits are used, so a triangle is
+//! slab test, as the Embree backend inflates its triangles; a node's boxes are exact f32 unions of these
+//! (min and max round nothing): the candidates are then a superset of the true hits, and every hit (and
+//! its `t`) comes from the watertight test on the original triangle, in the same operations as the
+//! brute-force tracer and the Embree filter. No spatial splits are used, so a triangle is
 //! proposed at most once per line; repeats would be harmless anyway ([`crate::trace::HitRules`] removes
 //! exact `(t, triangle)` repeats).
 
 use std::time::Duration;
 
-use glam::Vec3A;
+use glam::{Vec3A, Vec4};
 use obvhs::aabb::Aabb;
 use obvhs::cwbvh::{builder::build_cwbvh, CwBvh};
-use obvhs::ray::{Ray, RayHit};
+use obvhs::ray::safe_inverse;
 use obvhs::BvhBuildParams;
 
 use super::watertight::ShearedRay;
@@ -52,9 +54,9 @@ const BACKEND: &str = "rust";
 
 /// Every triangle's box grows by this fraction of the scene's extent on each side (the Embree backend
 /// inflates its triangles by the same amount). In tracing space (unit bounding sphere) that is ~3e-5,
-/// a few hundred f32 ulps: the slab test can never round a crossed box into a missed one. Also, obvhs
-/// replaces a direction component below f32 epsilon by +-1/epsilon in the slab test; a line parallel to a
-/// wall then sees the wall's box only within `margin * 2^23 > 2 * t_max` of its origin when it passes
+/// a few hundred f32 ulps: the slab test can never round a crossed box into a missed one. Also, the slab
+/// test replaces a direction component below f32 epsilon by +-1/epsilon (as obvhs does); a line parallel
+/// to a wall then sees the wall's box only within `margin * 2^23 > 2 * t_max` of its origin when it passes
 /// inside the margin, so no true candidate is lost.
 pub fn margin(scene: &Scene) -> f32 {
     let (lo, hi) = extent(scene);
@@ -74,120 +76,243 @@ fn extent(scene: &Scene) -> ([f32; 3], [f32; 3]) {
     (lo, hi)
 }
 
-/// All hits (the [`Tracer`] trait) and first hits through an obvhs CWBVH, decided by the watertight test.
+/// All hits (the [`Tracer`] trait) and first hits through an 8-wide BVH, decided by the watertight test.
 ///
 /// Queries take `&self` and run on any number of threads at once.
 pub struct BvhTracer {
-    bvh: CwBvh,
-    /// Triangles in BVH primitive order (`bvh.primitive_indices`), for locality during traversal.
+    /// The tree; the root is `nodes[0]`.
+    nodes: Vec<Node>,
+    /// Triangles in BVH primitive order (leaves refer to runs of them).
     triangles: Vec<[[f32; 3]; 3]>,
     /// The scene's index of each triangle in `triangles`.
     ids: Vec<u32>,
     rules: HitRules,
 }
 
+/// Children per node.
+const WIDTH: usize = 8;
+
+/// A child reference with this bit set is a leaf: `LEAF_COUNT` bits of triangle count above
+/// `LEAF_START` bits of its first triangle. Otherwise it is a node index.
+const LEAF: u32 = 1 << 31;
+const LEAF_START_BITS: u32 = 28;
+const LEAF_START: u32 = (1 << LEAF_START_BITS) - 1;
+
+/// One node of the tree: the f32 boxes of up to 8 children, in lanes of 4 for SSE slab tests.
+#[derive(Clone, Copy, Debug)]
+struct Node {
+    /// `bounds[half][axis][side]`: the lower (`side` 0) or upper (1) bound along `axis` of children
+    /// `4 * half..4 * half + 4`. An unused slot holds the empty box (lower +inf, upper -inf), whose slab
+    /// interval is empty whatever the ray, so it is never entered.
+    bounds: [[[Vec4; 2]; 3]; 2],
+    /// Child references (see [`LEAF`]); unused slots are never read.
+    children: [u32; WIDTH],
+    /// Whether children 4..8 exist (else their half is not tested).
+    wide: bool,
+}
+
+/// A line prepared for the slab tests of [`Node`]s.
+struct BoxRay {
+    origin: [Vec4; 3],
+    inv_dir: [Vec4; 3],
+    /// Per axis, whether the direction is negative: the upper bound is then met first.
+    negative: [bool; 3],
+}
+
+impl BoxRay {
+    fn new(line: &Line) -> Self {
+        let inv = line.dir.map(safe_inverse);
+        BoxRay {
+            origin: line.origin.map(Vec4::splat),
+            inv_dir: inv.map(Vec4::splat),
+            negative: inv.map(f32::is_sign_negative),
+        }
+    }
+
+    /// Which of the 4 boxes of `half` the ray crosses within `[0, t_max]`: bit `k` for box `k`. A line
+    /// starting on a triangle starts inside its inflated box, so the box's interval reaches below 0 and the
+    /// triangle is still proposed.
+    #[inline(always)]
+    fn crossed(&self, half: &[[Vec4; 2]; 3], t_max: Vec4) -> u32 {
+        let t =
+            |a: usize, upper: bool| (half[a][upper as usize] - self.origin[a]) * self.inv_dir[a];
+        let [nx, ny, nz] = self.negative;
+        let near = t(0, nx).max(t(1, ny)).max(t(2, nz)).max(Vec4::ZERO);
+        let far = t(0, !nx).min(t(1, !ny)).min(t(2, !nz)).min(t_max);
+        near.cmple(far).bitmask()
+    }
+}
+
 impl BvhTracer {
     /// Builds the BVH of `scene`'s triangles (inflated boxes, see the module documentation).
     ///
-    /// Errors when the tree is too deep for obvhs's fixed traversal stack ([`MAX_DEPTH`]), which would
-    /// silently drop candidates: only degenerate geometry (thousands of triangles piled in one place) does
-    /// that.
+    /// Errors when the scene has more triangles than a leaf reference can address (2^28).
     pub fn new(scene: &Scene) -> Result<Self, TraceError> {
+        Self::with_params(scene, build_params())
+    }
+
+    /// [`BvhTracer::new`] with other obvhs build parameters (for benchmarks); `pre_split` is ignored, spatial
+    /// splits are never used.
+    pub fn with_params(scene: &Scene, params: BvhBuildParams) -> Result<Self, TraceError> {
+        let params = BvhBuildParams {
+            pre_split: false,
+            ..params
+        };
+        if scene.triangles.len() > LEAF_START as usize {
+            return Err(error(format!(
+                "{}: {} triangles, more than the {LEAF_START} the BVH can address",
+                scene.name,
+                scene.triangles.len()
+            )));
+        }
         let m = margin(scene);
         let boxes: Vec<Aabb> = scene
             .triangles
             .iter()
             .map(|t| inflated_box(t.map(|v| scene.positions[v as usize]), m))
             .collect();
-        let bvh = if boxes.is_empty() {
+        let cw = if boxes.is_empty() {
             CwBvh::default()
         } else {
-            build_cwbvh(&boxes, build_params(), &mut Duration::default())
+            build_cwbvh(&boxes, params, &mut Duration::default())
         };
-        let depth = tree_depth(&bvh);
-        if depth > MAX_DEPTH {
-            return Err(error(format!(
-                "{}: the BVH is {depth} levels deep, more than the {MAX_DEPTH} its traversal can hold; \
-                 the scene has too many triangles piled in one place",
-                scene.name
-            )));
-        }
-        let ids = bvh.primitive_indices.clone();
+        let ids = cw.primitive_indices.clone();
         let triangles = ids
             .iter()
             .map(|&i| scene.triangles[i as usize].map(|v| scene.positions[v as usize]))
             .collect();
+        let ordered_boxes: Vec<Aabb> = ids.iter().map(|&i| boxes[i as usize]).collect();
+        let mut nodes = Vec::with_capacity(cw.nodes.len());
+        if !cw.nodes.is_empty() {
+            convert(&cw, 0, &ordered_boxes, &mut nodes);
+        }
         Ok(BvhTracer {
-            bvh,
+            nodes,
             triangles,
             ids,
             rules: HitRules::new(scene),
         })
     }
 
-    /// Calls `visit(t, triangle)` for every hit of one line, in traversal order.
-    fn line_hits(&self, line: &Line, mut visit: impl FnMut(f32, u32)) {
-        if self.triangles.is_empty() {
+    /// Offers every leaf whose box the line crosses within `[0, t_max]` to `leaf(first, count)`, which
+    /// returns the `t_max` for the rest of the traversal (never more than `line.t_max`). `stack` is
+    /// scratch space.
+    #[inline(always)]
+    fn traverse(
+        &self,
+        line: &Line,
+        stack: &mut Vec<u32>,
+        mut leaf: impl FnMut(usize, usize) -> f32,
+    ) {
+        if self.nodes.is_empty() {
             return;
         }
-        let sheared = ShearedRay::new(line.origin, line.dir);
-        self.bvh.ray_traverse_anyhit(to_ray(line), |_, slot| {
-            let [a, b, c] = self.triangles[slot];
-            if let Some(t) = sheared.intersect(a, b, c, 0.0, line.t_max) {
-                visit(t, self.ids[slot]);
+        let ray = BoxRay::new(line);
+        let mut t_max = Vec4::splat(line.t_max);
+        stack.clear();
+        stack.push(0);
+        while let Some(n) = stack.pop() {
+            let node = &self.nodes[n as usize];
+            let mut mask = ray.crossed(&node.bounds[0], t_max);
+            if node.wide {
+                mask |= ray.crossed(&node.bounds[1], t_max) << 4;
             }
+            while mask != 0 {
+                let k = mask.trailing_zeros() as usize;
+                mask &= mask - 1;
+                let child = node.children[k % WIDTH];
+                if child & LEAF != 0 {
+                    let first = (child & LEAF_START) as usize;
+                    let count = ((child & !LEAF) >> LEAF_START_BITS) as usize;
+                    t_max = Vec4::splat(leaf(first, count));
+                } else {
+                    stack.push(child);
+                }
+            }
+        }
+    }
+
+    /// Calls `visit(t, triangle)` for every hit of one line, in traversal order.
+    #[inline(always)]
+    fn line_hits(&self, line: &Line, stack: &mut Vec<u32>, mut visit: impl FnMut(f32, u32)) {
+        let sheared = ShearedRay::new(line.origin, line.dir);
+        self.traverse(line, stack, |first, count| {
+            for (slot, [a, b, c]) in self.triangles[first..first + count].iter().enumerate() {
+                if let Some(t) = sheared.intersect(*a, *b, *c, 0.0, line.t_max) {
+                    visit(t, self.ids[first + slot]);
+                }
+            }
+            line.t_max
         });
     }
 
     /// The nearest hit of one line: the least `t`, ties to the lower triangle index (the first hit of the
     /// canonical list, and what the Embree backend's first-hit query returns).
-    fn line_first_hit(&self, line: &Line) -> Option<Hit> {
-        if self.triangles.is_empty() {
-            return None;
-        }
+    fn line_first_hit(&self, line: &Line, stack: &mut Vec<u32>) -> Option<Hit> {
         let sheared = ShearedRay::new(line.origin, line.dir);
         let mut best: Option<Hit> = None;
-        let mut ray_hit = RayHit::none();
-        self.bvh
-            .ray_traverse(to_ray(line), &mut ray_hit, |_, slot| {
-                let [a, b, c] = self.triangles[slot];
-                // Only as far as the nearest hit so far, inclusive: an equal-t tie is still seen. (obvhs also
-                // shortens its ray to the returned distance, which only prunes boxes beyond it.)
+        self.traverse(line, stack, |first, count| {
+            for (slot, [a, b, c]) in self.triangles[first..first + count].iter().enumerate() {
+                // Only as far as the nearest hit so far, inclusive: an equal-t tie is still seen.
                 let t_max = best.map_or(line.t_max, |h| h.t);
-                let Some(t) = sheared.intersect(a, b, c, 0.0, t_max) else {
-                    return f32::INFINITY;
+                let Some(t) = sheared.intersect(*a, *b, *c, 0.0, t_max) else {
+                    continue;
                 };
-                let triangle = self.ids[slot];
+                let triangle = self.ids[first + slot];
                 // The canonical order: `total_cmp` on t (so -0 before +0, as the sorted hit lists have it).
                 if best.is_none_or(|h| t.total_cmp(&h.t).then(triangle.cmp(&h.triangle)).is_lt()) {
                     best = Some(Hit { t, triangle });
                 }
-                t + RAY_BACKUP
-            });
+            }
+            // Boxes beyond the nearest hit hold no nearer one (a box reaching back to a hit at `t` is
+            // entered at or before `t`, so ties are still offered).
+            best.map_or(line.t_max, |h| h.t)
+        });
         best
     }
 }
 
-/// The deepest tree obvhs's traversal stack holds (it pushes at most one entry per level, into 32 slots,
-/// and on overflow overwrites its last slot instead of failing).
-pub const MAX_DEPTH: usize = 30;
-
-/// Levels of internal nodes below the root (a root alone: 0).
-fn tree_depth(bvh: &CwBvh) -> usize {
-    if bvh.nodes.is_empty() {
-        return 0;
-    }
-    let mut deepest = 0;
-    let mut todo = vec![(0usize, 0usize)];
-    while let Some((node, depth)) = todo.pop() {
-        deepest = deepest.max(depth);
-        let n = &bvh.nodes[node];
-        // Internal children are stored contiguously from `child_base_idx`, one per set bit of `imask`.
-        for k in 0..n.imask.count_ones() as usize {
-            todo.push((n.child_base_idx as usize + k, depth + 1));
+/// Copies node `index` of `cw` (and its subtree) into `nodes` in depth-first order, with exact f32
+/// boxes: the union of the children's boxes, down to the triangles' inflated boxes (`boxes`, in primitive
+/// order), rather than the CWBVH's 8-bit quantized ones. Returns the node's box.
+fn convert(cw: &CwBvh, index: usize, boxes: &[Aabb], nodes: &mut Vec<Node>) -> Aabb {
+    let empty = Vec4::splat(f32::INFINITY);
+    let at = nodes.len();
+    nodes.push(Node {
+        bounds: [[[empty, -empty]; 3]; 2],
+        children: [0; WIDTH],
+        wide: false,
+    });
+    let source = &cw.nodes[index];
+    let mut whole = Aabb::empty();
+    let mut used = 0;
+    for ch in 0..WIDTH {
+        if source.is_child_empty(ch) {
+            continue;
         }
+        let (child, bounds) = if source.is_leaf(ch) {
+            let (first, count) = source.child_primitives(ch);
+            let bounds = boxes[first as usize..(first + count) as usize]
+                .iter()
+                .fold(Aabb::empty(), |acc, b| acc.union(b));
+            (LEAF | count << LEAF_START_BITS | first, bounds)
+        } else {
+            let child = nodes.len() as u32;
+            let bounds = convert(cw, source.child_node_index(ch) as usize, boxes, nodes);
+            (child, bounds)
+        };
+        let node = &mut nodes[at];
+        node.children[used] = child;
+        let half = &mut node.bounds[used / 4];
+        for (axis, [lower, upper]) in half.iter_mut().enumerate() {
+            lower[used % 4] = bounds.min[axis];
+            upper[used % 4] = bounds.max[axis];
+        }
+        whole = whole.union(&bounds);
+        used += 1;
     }
-    deepest
+    nodes[at].wide = used > 4;
+    whole
 }
 
 /// Triangles per leaf, at most (obvhs's CWBVH allows 1 to 3).
@@ -209,32 +334,31 @@ fn inflated_box(tri: [[f32; 3]; 3], margin: f32) -> Aabb {
     Aabb::new(lo, hi)
 }
 
-/// How far back (in units of `t`) the BVH's ray starts before the line's origin: obvhs's box test ignores
-/// boxes closer than 1e-4 along the ray, so the ray starts early enough that a line starting on a triangle
-/// still gets it proposed. Hits are decided, and `t` measured, from the line's own origin.
-const RAY_BACKUP: f32 = 1.0;
-
-fn to_ray(line: &Line) -> Ray {
-    let o = Vec3A::from_array(line.origin);
-    let d = Vec3A::from_array(line.dir);
-    Ray::new(o - d * RAY_BACKUP, d, 0.0, line.t_max + RAY_BACKUP)
+/// Whether a line can be traced: finite numbers, a non-zero direction and `t_max >= 0` (the slab tests
+/// assume them). Without short-circuits: branch-free for the common case.
+fn traceable(l: &Line) -> bool {
+    let finite = l
+        .origin
+        .iter()
+        .chain(&l.dir)
+        .fold(l.t_max.is_finite(), |ok, c| ok & c.is_finite());
+    finite & (l.t_max >= 0.0) & (l.dir != [0.0; 3])
 }
 
-/// Lines the BVH can trace: finite numbers, a non-zero direction and `t_max >= 0` (obvhs assumes them).
-fn check_lines(lines: &[Line]) -> Result<(), TraceError> {
+/// The error for line `k`, which is not [`traceable`].
+fn bad_line(k: usize, l: &Line) -> TraceError {
+    error(format!(
+        "line {k} cannot be traced: {l:?} (needs finite values, a direction and t_max >= 0)"
+    ))
+}
+
+/// Batches whose line indices fit a [`RawHit`].
+fn check_batch(lines: &[Line]) -> Result<(), TraceError> {
     if lines.len() > u32::MAX as usize {
         return Err(error(format!(
             "{} lines in one batch; at most 2^32 - 1 fit",
             lines.len()
         )));
-    }
-    for (k, l) in lines.iter().enumerate() {
-        let finite = l.origin.iter().chain(&l.dir).all(|c| c.is_finite()) && l.t_max.is_finite();
-        if !finite || l.t_max < 0.0 || l.dir == [0.0; 3] {
-            return Err(error(format!(
-                "line {k} cannot be traced: {l:?} (needs finite values, a direction and t_max >= 0)"
-            )));
-        }
     }
     Ok(())
 }
@@ -256,10 +380,17 @@ impl Tracer for BvhTracer {
     }
 
     fn raw_hits(&self, lines: &[Line], out: &mut Vec<RawHit>) -> Result<(), TraceError> {
-        check_lines(lines)?;
+        check_batch(lines)?;
         out.clear();
+        let mut stack = Vec::new();
+        // Each line is checked as it is traced, rather than in a pass of its own: the lines are then
+        // read from memory once.
         for (k, line) in lines.iter().enumerate() {
-            self.line_hits(line, |t, triangle| {
+            if !traceable(line) {
+                out.clear();
+                return Err(bad_line(k, line));
+            }
+            self.line_hits(line, &mut stack, |t, triangle| {
                 out.push(RawHit {
                     t,
                     triangle,
@@ -271,9 +402,15 @@ impl Tracer for BvhTracer {
     }
 
     fn first_hits(&self, lines: &[Line], out: &mut Vec<Option<Hit>>) -> Result<(), TraceError> {
-        check_lines(lines)?;
         out.clear();
-        out.extend(lines.iter().map(|l| self.line_first_hit(l)));
+        let mut stack = Vec::new();
+        for (k, line) in lines.iter().enumerate() {
+            if !traceable(line) {
+                out.clear();
+                return Err(bad_line(k, line));
+            }
+            out.push(self.line_first_hit(line, &mut stack));
+        }
         Ok(())
     }
 }
@@ -282,7 +419,7 @@ impl std::fmt::Debug for BvhTracer {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("BvhTracer")
             .field("triangles", &self.triangles.len())
-            .field("nodes", &self.bvh.nodes.len())
+            .field("nodes", &self.nodes.len())
             .finish_non_exhaustive()
     }
 }
@@ -305,7 +442,7 @@ mod tests {
             dir: [0.0, 0.0, 1.0],
             t_max: 1.0,
         };
-        assert!(check_lines(&[ok]).is_ok());
+        assert!(traceable(&ok));
         for bad in [
             Line { t_max: -1.0, ..ok },
             Line {
@@ -317,7 +454,7 @@ mod tests {
                 ..ok
             },
         ] {
-            assert!(check_lines(&[bad]).is_err(), "{bad:?}");
+            assert!(!traceable(&bad), "{bad:?}");
         }
     }
 }

@@ -2,13 +2,33 @@
 //! JCGT 2(1), 2013: no ray passes between two triangles that share an edge, whatever f32 rounding does.
 //! Both faces are hit; hits on an edge or vertex are reported for every triangle that owns it.
 
+/// A coordinate axis, as an index that needs no bounds check (its values are 0, 1, 2).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(usize)]
+enum Axis {
+    X = 0,
+    Y = 1,
+    Z = 2,
+}
+
+impl Axis {
+    const ALL: [Axis; 3] = [Axis::X, Axis::Y, Axis::Z];
+
+    fn next(self) -> Axis {
+        Axis::ALL[(self as usize + 1) % 3]
+    }
+}
+
 /// A ray prepared for the test: the shear that maps its direction onto +z.
 #[derive(Clone, Copy, Debug)]
 pub struct ShearedRay {
-    origin: [f32; 3],
-    kx: usize,
-    ky: usize,
-    kz: usize,
+    kx: Axis,
+    ky: Axis,
+    kz: Axis,
+    /// The origin's coordinates along `kx`, `ky`, `kz`.
+    ox: f32,
+    oy: f32,
+    oz: f32,
     sx: f32,
     sy: f32,
     sz: f32,
@@ -20,33 +40,37 @@ impl ShearedRay {
         let abs = dir.map(f32::abs);
         let kz = if abs[0] > abs[1] {
             if abs[0] > abs[2] {
-                0
+                Axis::X
             } else {
-                2
+                Axis::Z
             }
         } else if abs[1] > abs[2] {
-            1
+            Axis::Y
         } else {
-            2
+            Axis::Z
         };
-        let mut kx = (kz + 1) % 3;
-        let mut ky = (kx + 1) % 3;
+        let mut kx = kz.next();
+        let mut ky = kx.next();
         // Keep the winding: swap when the dominant component is negative.
-        if dir[kz] < 0.0 {
+        if dir[kz as usize] < 0.0 {
             std::mem::swap(&mut kx, &mut ky);
         }
+        let (x, y, z) = (kx as usize, ky as usize, kz as usize);
         ShearedRay {
-            origin,
             kx,
             ky,
             kz,
-            sx: dir[kx] / dir[kz],
-            sy: dir[ky] / dir[kz],
-            sz: 1.0 / dir[kz],
+            ox: origin[x],
+            oy: origin[y],
+            oz: origin[z],
+            sx: dir[x] / dir[z],
+            sy: dir[y] / dir[z],
+            sz: 1.0 / dir[z],
         }
     }
 
     /// The ray parameter `t` of the intersection with triangle `(a, b, c)`, if within `[t_min, t_max]`.
+    #[inline]
     pub fn intersect(
         &self,
         a: [f32; 3],
@@ -55,23 +79,20 @@ impl ShearedRay {
         t_min: f32,
         t_max: f32,
     ) -> Option<f32> {
-        let rel = |p: [f32; 3]| {
-            [
-                p[0] - self.origin[0],
-                p[1] - self.origin[1],
-                p[2] - self.origin[2],
-            ]
-        };
-        let (a, b, c) = (rel(a), rel(b), rel(c));
+        // Relative to the origin, then sheared; only the components the shear reads are computed (each in
+        // the same operations as computing the whole difference first).
+        let (kx, ky, kz) = (self.kx as usize, self.ky as usize, self.kz as usize);
         let shear = |p: [f32; 3]| {
+            let z = p[kz] - self.oz;
             (
-                p[self.kx] - self.sx * p[self.kz],
-                p[self.ky] - self.sy * p[self.kz],
+                (p[kx] - self.ox) - self.sx * z,
+                (p[ky] - self.oy) - self.sy * z,
+                z,
             )
         };
-        let (ax, ay) = shear(a);
-        let (bx, by) = shear(b);
-        let (cx, cy) = shear(c);
+        let (ax, ay, az) = shear(a);
+        let (bx, by, bz) = shear(b);
+        let (cx, cy, cz) = shear(c);
 
         let mut u = cx * by - cy * bx;
         let mut v = ax * cy - ay * cx;
@@ -90,11 +111,7 @@ impl ShearedRay {
         if det == 0.0 {
             return None;
         }
-        let (az, bz, cz) = (
-            self.sz * a[self.kz],
-            self.sz * b[self.kz],
-            self.sz * c[self.kz],
-        );
+        let (az, bz, cz) = (self.sz * az, self.sz * bz, self.sz * cz);
         let t = (u * az + v * bz + w * cz) / det;
         (t >= t_min && t <= t_max).then_some(t)
     }
