@@ -579,11 +579,11 @@ static int check_query(const scx_scene* scene, const scx_line* lines, uint32_t n
   return SCX_OK;
 }
 
-/* Prepares the batch for the watertight test and traces it; the filter delivers the results into q. */
-static int trace(const scx_scene* scene, const scx_line* lines, uint32_t n, uint32_t width, scx_hits* hits,
-                 scx_first_hit* first) {
-  scx_sheared* sheared = malloc((n > 0 ? n : 1) * sizeof(scx_sheared));
-  if (!sheared) return fail(RTC_ERROR_OUT_OF_MEMORY, "out of memory preparing %u lines", n);
+/* Prepares the batch for the watertight test (in the caller's scratch) and traces it; the filter delivers
+ * the results into q. */
+static int trace(const scx_scene* scene, const scx_line* lines, uint32_t n, uint32_t width,
+                 scx_sheared* sheared, scx_hits* hits, scx_first_hit* first) {
+  if (n > 0 && !sheared) return fail(SCX_ERR_INVALID, "null scratch for %u lines", n);
   for (uint32_t k = 0; k < n; ++k) shear_line(&sheared[k], &lines[k]);
   scx_query q;
   query_init(&q, scene, lines, sheared, n, hits, first);
@@ -592,24 +592,24 @@ static int trace(const scx_scene* scene, const scx_line* lines, uint32_t n, uint
   } else {
     trace_packets(scene->rtc, &q, lines, n, width);
   }
-  free(sheared);
   if (q.bad_ray_id) return fail(SCX_ERR_RAY_ID, "Embree reported a hit for a ray or primitive outside the batch");
   return last_code;
 }
 
-int scx_all_hits(const scx_scene* scene, const scx_line* lines, uint32_t n, uint32_t width, scx_hits* out) {
+int scx_all_hits(const scx_scene* scene, const scx_line* lines, uint32_t n, uint32_t width,
+                 scx_sheared* scratch, scx_hits* out) {
   clear_error();
   if (!out) return fail(SCX_ERR_INVALID, "null hit buffer");
   if (check_query(scene, lines, n, width) != SCX_OK) return last_code;
   /* Most lines of a closed scene cross it a few times: start with room for two hits a line. */
   if (!hits_reserve(out, out->len + (size_t)n * 2 + 16)) out->overflow = 1;
-  if (!out->overflow) trace(scene, lines, n, width, out, NULL);
+  if (!out->overflow) trace(scene, lines, n, width, scratch, out, NULL);
   if (out->overflow) return fail(SCX_ERR_HIT_BUFFER, "out of memory growing the hit buffer (%zu hits)", out->len);
   return last_code;
 }
 
 int scx_first_hits(const scx_scene* scene, const scx_line* lines, uint32_t n, uint32_t width,
-                   scx_first_hit* out) {
+                   scx_sheared* scratch, scx_first_hit* out) {
   clear_error();
   if (n > 0 && !out) return fail(SCX_ERR_INVALID, "null output array");
   if (check_query(scene, lines, n, width) != SCX_OK) return last_code;
@@ -617,5 +617,5 @@ int scx_first_hits(const scx_scene* scene, const scx_line* lines, uint32_t n, ui
     out[k].t = 0.0f;
     out[k].prim = SCX_NO_LINE;
   }
-  return trace(scene, lines, n, width, NULL, out);
+  return trace(scene, lines, n, width, scratch, NULL, out);
 }

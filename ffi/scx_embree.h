@@ -173,13 +173,16 @@ void scx_scene_release(scx_scene* scene);
  * t and the hit decision come from the watertight test, identical for single lines and packets.
  * width 1 traces line by line (rtcIntersect1); 4, 8 or 16 traces packets of that many adjacent lines
  * (rtcIntersect4/8/16, native widths only), the last packet padded with inactive lanes. n must be below
- * SCX_NO_LINE. Safe to call from several threads at once with different out buffers. */
-int scx_all_hits(const scx_scene* scene, const scx_line* lines, uint32_t n, uint32_t width, scx_hits* out);
+ * SCX_NO_LINE. scratch is the caller's room for n prepared lines (its contents are overwritten): a caller
+ * that keeps it, and out, from batch to batch allocates nothing per batch. Safe to call from several
+ * threads at once with different out and scratch buffers. */
+int scx_all_hits(const scx_scene* scene, const scx_line* lines, uint32_t n, uint32_t width,
+                 scx_sheared* scratch, scx_hits* out);
 
-/* The nearest hit of each of n lines (by the watertight test), written to out[0..n]; width as for
- * scx_all_hits. */
+/* The nearest hit of each of n lines (by the watertight test), written to out[0..n]; width and scratch
+ * as for scx_all_hits. */
 int scx_first_hits(const scx_scene* scene, const scx_line* lines, uint32_t n, uint32_t width,
-                   scx_first_hit* out);
+                   scx_sheared* scratch, scx_first_hit* out);
 
 /* Frees a hit buffer's storage and zeroes it. */
 void scx_hits_free(scx_hits* hits);

@@ -22,6 +22,7 @@
 
 mod ffi;
 
+use std::cell::RefCell;
 use std::ffi::{c_char, c_int, CStr};
 use std::fmt;
 use std::mem::{align_of, size_of};
@@ -184,13 +185,10 @@ impl Drop for CommittedScene {
 }
 
 /// The shim's growable hit array, freed on drop (also when a query fails half way).
+#[derive(Default)]
 struct HitBuffer(ffi::scx_hits);
 
 impl HitBuffer {
-    fn new() -> Self {
-        HitBuffer(ffi::scx_hits::default())
-    }
-
     fn as_slice(&self) -> &[ffi::scx_hit] {
         if self.0.data.is_null() {
             return &[];
@@ -209,9 +207,10 @@ impl Drop for HitBuffer {
     }
 }
 
-/// Copies lines into the shim's layout (Rust's [`Line`] has no guaranteed layout), checking that Embree
-/// can trace them: finite numbers, `t_max >= 0`, and fewer lines than the shim's padding id.
-fn to_shim_lines(lines: &[Line]) -> Result<Vec<ffi::scx_line>, TraceError> {
+/// Copies lines into the shim's layout (Rust's [`Line`] has no guaranteed layout), replacing `out`'s
+/// contents, checking that Embree can trace them: finite numbers, `t_max >= 0`, and fewer lines than the
+/// shim's padding id.
+fn fill_shim_lines(lines: &[Line], out: &mut Vec<ffi::scx_line>) -> Result<(), TraceError> {
     if lines.len() >= NONE as usize {
         return Err(backend_error(format!(
             "{} lines in one batch; at most {} fit",
@@ -219,24 +218,58 @@ fn to_shim_lines(lines: &[Line]) -> Result<Vec<ffi::scx_line>, TraceError> {
             NONE - 1
         )));
     }
-    lines
-        .iter()
-        .enumerate()
-        .map(|(k, l)| {
-            let finite =
-                l.origin.iter().chain(&l.dir).all(|c| c.is_finite()) && l.t_max.is_finite();
-            if !finite || l.t_max < 0.0 {
-                return Err(backend_error(format!(
-                    "line {k} cannot be traced: {l:?} (needs finite values and t_max >= 0)"
-                )));
-            }
-            Ok(ffi::scx_line {
-                org: l.origin,
-                dir: l.dir,
-                t_max: l.t_max,
-            })
-        })
-        .collect()
+    out.clear();
+    for (k, l) in lines.iter().enumerate() {
+        let finite = l.origin.iter().chain(&l.dir).all(|c| c.is_finite()) && l.t_max.is_finite();
+        if !finite || l.t_max < 0.0 {
+            return Err(backend_error(format!(
+                "line {k} cannot be traced: {l:?} (needs finite values and t_max >= 0)"
+            )));
+        }
+        out.push(ffi::scx_line {
+            org: l.origin,
+            dir: l.dir,
+            t_max: l.t_max,
+        });
+    }
+    Ok(())
+}
+
+/// A thread's query buffers, kept from batch to batch: a batch of 4096 lines needs ~115 KB of lines in
+/// the shim's layout, ~150 KB of lines prepared for the watertight test and ~100 KB of hits, and
+/// allocating them afresh for every batch made the allocator map and the system clear fresh pages each
+/// time (perf: 4-5% of an analysis of `@cube:30` went to clearing pages for them).
+#[derive(Default)]
+struct Scratch {
+    lines: Vec<ffi::scx_line>,
+    sheared: Vec<ffi::scx_sheared>,
+    hits: HitBuffer,
+}
+
+impl Scratch {
+    /// Prepares the buffers for `lines`: the lines copied and checked, room for as many prepared lines,
+    /// and an empty hit buffer.
+    fn prepare(&mut self, lines: &[Line]) -> Result<(), TraceError> {
+        fill_shim_lines(lines, &mut self.lines)?;
+        self.sheared.clear();
+        self.sheared
+            .resize(lines.len(), ffi::scx_sheared::default());
+        self.hits.0.len = 0;
+        self.hits.0.overflow = 0;
+        Ok(())
+    }
+}
+
+thread_local! {
+    static SCRATCH: RefCell<Scratch> = RefCell::new(Scratch::default());
+}
+
+/// Runs `f` with this thread's buffers (or fresh ones, should a query ever run inside another).
+fn with_scratch<R>(f: impl FnOnce(&mut Scratch) -> R) -> R {
+    SCRATCH.with(|s| match s.try_borrow_mut() {
+        Ok(mut s) => f(&mut s),
+        Err(_) => f(&mut Scratch::default()),
+    })
 }
 
 /// One shared struct's size (or alignment, or a constant) as the C shim's compiler and as the Rust
@@ -402,21 +435,24 @@ impl EmbreeTracer {
 
     /// The nearest hit of each line (`None` for a miss), one entry per line; replaces `out`'s contents.
     pub fn first_hits(&self, lines: &[Line], out: &mut Vec<Option<Hit>>) -> Result<(), TraceError> {
-        let shim_lines = to_shim_lines(lines)?;
         let mut first = vec![ffi::scx_first_hit::default(); lines.len()];
-        // SAFETY: the scene is live and committed; `shim_lines` and `first` both hold `lines.len()`
-        // elements (which `to_shim_lines` checked fits in u32); the width was checked against the device
-        // in `new` (and the shim checks it again).
-        let code = unsafe {
-            ffi::scx_first_hits(
-                self.scene.raw.as_ptr(),
-                shim_lines.as_ptr(),
-                shim_lines.len() as u32,
-                self.width,
-                first.as_mut_ptr(),
-            )
-        };
-        check(code)?;
+        with_scratch(|scratch| {
+            scratch.prepare(lines)?;
+            // SAFETY: the scene is live and committed; `scratch.lines`, `scratch.sheared` and `first`
+            // all hold `lines.len()` elements (checked to fit in u32); the width was checked against
+            // the device in `new` (and the shim checks it again).
+            let code = unsafe {
+                ffi::scx_first_hits(
+                    self.scene.raw.as_ptr(),
+                    scratch.lines.as_ptr(),
+                    scratch.lines.len() as u32,
+                    self.width,
+                    scratch.sheared.as_mut_ptr(),
+                    first.as_mut_ptr(),
+                )
+            };
+            check(code)
+        })?;
         out.clear();
         out.extend(first.iter().map(|f| {
             (f.prim != NONE).then_some(Hit {
@@ -468,28 +504,31 @@ impl Tracer for EmbreeTracer {
     }
 
     fn raw_hits(&self, lines: &[Line], out: &mut Vec<RawHit>) -> Result<(), TraceError> {
-        let shim_lines = to_shim_lines(lines)?;
-        let mut hits = HitBuffer::new();
-        // SAFETY: the scene is live and committed; `shim_lines` holds `lines.len()` lines (checked to fit
-        // in u32 below the padding id); `hits` is this call's own buffer, which the shim grows with
-        // realloc; the width was checked against the device in `new` (and the shim checks it again).
-        let code = unsafe {
-            ffi::scx_all_hits(
-                self.scene.raw.as_ptr(),
-                shim_lines.as_ptr(),
-                shim_lines.len() as u32,
-                self.width,
-                &mut hits.0,
-            )
-        };
-        check(code)?;
-        out.clear();
-        out.extend(hits.as_slice().iter().map(|h| RawHit {
-            t: h.t,
-            triangle: h.prim,
-            line: h.line,
-        }));
-        Ok(())
+        with_scratch(|scratch| {
+            scratch.prepare(lines)?;
+            // SAFETY: the scene is live and committed; `scratch.lines` and `scratch.sheared` hold
+            // `lines.len()` elements each (checked to fit in u32 below the padding id); `scratch.hits` is
+            // this thread's buffer, emptied above and grown by the shim with realloc; the width was
+            // checked against the device in `new` (and the shim checks it again).
+            let code = unsafe {
+                ffi::scx_all_hits(
+                    self.scene.raw.as_ptr(),
+                    scratch.lines.as_ptr(),
+                    scratch.lines.len() as u32,
+                    self.width,
+                    scratch.sheared.as_mut_ptr(),
+                    &mut scratch.hits.0,
+                )
+            };
+            check(code)?;
+            out.clear();
+            out.extend(scratch.hits.as_slice().iter().map(|h| RawHit {
+                t: h.t,
+                triangle: h.prim,
+                line: h.line,
+            }));
+            Ok(())
+        })
     }
 }
 
