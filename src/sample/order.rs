@@ -38,6 +38,8 @@ pub(crate) struct Crossing {
     pub cos: f64,
     /// Distance along the line to the patch's plane (the f32 `t` when the line lies in the plane).
     pub t: f64,
+    /// The patch's unit normal.
+    pub normal: [f64; 3],
 }
 
 /// Whether some consecutive hits are too close for their f32 order to be trusted.
@@ -49,10 +51,12 @@ fn close(a: f32, b: f32) -> bool {
     b - a <= WINDOW_ULPS * f32::EPSILON * a.abs().max(1.0)
 }
 
-/// Reorders every window of close hits (`crossings[k]` is `hits[k]`) as the module documentation says;
-/// returns how many crossings met a coincident surface facing the same way (an overlap).
-pub(crate) fn reorder(crossings: &mut [Crossing], hits: &[Hit]) -> u64 {
+/// Reorders every window of close hits (`crossings[k]` is `hits[k]`) as the module documentation says,
+/// and removes the crossings of every edge the line only touches ([`is_touch`]); returns how many
+/// crossings met a coincident surface facing the same way (an overlap).
+pub(crate) fn reorder(crossings: &mut Vec<Crossing>, hits: &[Hit]) -> u64 {
     let mut overlaps = 0;
+    let mut touched = vec![false; crossings.len()];
     let mut start = 0;
     while start < hits.len() {
         let mut end = start + 1;
@@ -60,11 +64,49 @@ pub(crate) fn reorder(crossings: &mut [Crossing], hits: &[Hit]) -> u64 {
             end += 1;
         }
         if end - start > 1 {
-            overlaps += order_window_between(crossings, start, end);
+            if is_touch(&crossings[start..end]) {
+                touched[start..end].fill(true);
+            } else {
+                overlaps += order_window_between(crossings, start, end);
+            }
         }
         start = end;
     }
+    if touched.contains(&true) {
+        let mut k = 0;
+        crossings.retain(|_| {
+            k += 1;
+            !touched[k - 1]
+        });
+    }
     overlaps
+}
+
+/// Whether a window of close crossings is a line touching an edge (or vertex) where surfaces meet at an
+/// angle: planes not all parallel, crossed at distinct places (so not coincident surfaces), as many
+/// arrivals at front sides as departures, none in its plane. Two planes at an angle crossed within a few
+/// f32 ulps of each other are crossed at their common edge, and a line that arrives at one front and
+/// leaves another there grazes the ridge or valley and goes on in the space it came from (in exact
+/// arithmetic it may miss both patches). Ordered by plane distance, such a touch would pair the two
+/// surfaces across a gap of ~1e-9 (a huge term of eq. 27) or read as two escapes from a closed scene
+/// (seen on `@labyrinth`, lines touching the hall's outer edges); it is measure zero, so it is dropped.
+fn is_touch(window: &[Crossing]) -> bool {
+    let arrivals = window.iter().filter(|c| c.cos < 0.0).count();
+    let departures = window.iter().filter(|c| c.cos > 0.0).count();
+    if arrivals == 0 || arrivals != departures || arrivals + departures != window.len() {
+        return false;
+    }
+    let (lo, hi) = window
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), c| {
+            (lo.min(c.t), hi.max(c.t))
+        });
+    let distinct_places = hi - lo > COINCIDENT * lo.abs().max(1.0);
+    let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+    let at_an_angle = window
+        .iter()
+        .any(|a| window.iter().any(|b| dot(a.normal, b.normal).abs() < 1.0 - 1e-9));
+    distinct_places && at_an_angle
 }
 
 /// Orders the window `start..end` given its neighbours. The space the line is in before the window is
@@ -72,35 +114,50 @@ pub(crate) fn reorder(crossings: &mut [Crossing], hits: &[Hit]) -> u64 {
 /// unknown (outside an object is in front of it, outside an enclosure behind its walls): it is then
 /// chosen so that the line ends the window in the space the next crossing closes (in front if that one
 /// arrives at a front side), and in front when there is no next crossing either.
+///
+/// The plane distances give the true order of surfaces that nearly touch. They do not when the line
+/// grazes an edge where two surfaces meet at an angle: it crosses both planes within rounding of the
+/// edge, and which plane comes first says nothing (in exact arithmetic the line may miss both patches).
+/// Such an order shows itself by leaving the line in a space the next crossing does not close (on
+/// `@labyrinth`, a line grazing the floor's edge under a wall read as an escape from a closed scene); the
+/// window is then ordered as crossings at one place, which lets the line graze the edge and go on in the
+/// space it came from.
 fn order_window_between(crossings: &mut [Crossing], start: usize, end: usize) -> u64 {
-    if start > 0 {
-        let in_front = crossings[start - 1].cos >= 0.0;
-        return order_window(&mut crossings[start..end], in_front).0;
-    }
-    let mut trial = crossings[start..end].to_vec();
-    let (overlaps, ends_in_front) = order_window(&mut trial, true);
+    let before = (start > 0).then(|| crossings[start - 1].cos >= 0.0);
     let wanted = crossings.get(end).map(|next| next.cos < 0.0);
-    if wanted.is_some_and(|w| w != ends_in_front) {
-        return order_window(&mut crossings[start..end], false).0;
+    let starts: &[bool] = match before {
+        Some(true) => &[true],
+        Some(false) => &[false],
+        None => &[true, false],
+    };
+    for same_place in [COINCIDENT, f64::INFINITY] {
+        for &in_front in starts {
+            let mut trial = crossings[start..end].to_vec();
+            let (overlaps, ends_in_front) = order_window(&mut trial, in_front, same_place);
+            if wanted.is_none_or(|w| w == ends_in_front) {
+                crossings[start..end].copy_from_slice(&trial);
+                return overlaps;
+            }
+        }
     }
-    crossings[start..end].copy_from_slice(&trial);
-    overlaps
+    // No order is consistent with the neighbours (broken geometry): the plane distances' order.
+    order_window(&mut crossings[start..end], starts[0], COINCIDENT).0
 }
 
-/// Orders one window: by plane distance, and coincident crossings so that the line alternates between
-/// front and back space, starting `in_front` or not. Returns the overlaps met and whether the line ends
-/// in front.
-fn order_window(window: &mut [Crossing], mut in_front: bool) -> (u64, bool) {
+/// Orders one window: by plane distance, and crossings whose plane distances differ by at most
+/// `same_place` (times max(t, 1)) so that the line alternates between front and back space, starting
+/// `in_front` or not. Returns the overlaps met and whether the line ends in front.
+fn order_window(window: &mut [Crossing], mut in_front: bool, same_place: f64) -> (u64, bool) {
     let mut rest: Vec<Crossing> = window.to_vec();
     rest.sort_by(|a, b| a.t.total_cmp(&b.t));
     let mut overlaps = 0;
     for slot in 0..window.len() {
         let t0 = rest[0].t;
-        let same_place = rest
+        let here = rest
             .iter()
-            .take_while(|c| c.t - t0 <= COINCIDENT * t0.abs().max(1.0))
+            .take_while(|c| c.t - t0 <= same_place * t0.abs().max(1.0))
             .count();
-        let pick = choose(&rest[..same_place], in_front);
+        let pick = choose(&rest[..here], in_front);
         let c = rest.remove(pick);
         if slot > 0 {
             let last = window[slot - 1];
@@ -139,13 +196,27 @@ fn choose(candidates: &[Crossing], in_front: bool) -> usize {
 mod tests {
     use super::*;
 
+    /// A crossing of a plane facing +z (all parallel).
     fn c(patch: u32, cos: f64, t: f64) -> Crossing {
         Crossing {
             patch,
             triangle: patch,
             cos,
             t,
+            normal: [0.0, 0.0, 1.0],
         }
+    }
+
+    /// A crossing of a plane with the given normal.
+    fn cn(patch: u32, cos: f64, t: f64, normal: [f64; 3]) -> Crossing {
+        Crossing {
+            normal,
+            ..c(patch, cos, t)
+        }
+    }
+
+    fn patches(x: &[Crossing]) -> Vec<u32> {
+        x.iter().map(|c| c.patch).collect()
     }
 
     fn hit(t: f32) -> Hit {
@@ -156,10 +227,10 @@ mod tests {
     #[test]
     fn close_hits_follow_the_plane_distances() {
         let hits = [hit(1.0), hit(2.0), hit(2.0 + 1e-7)];
-        let mut x = [c(0, 0.5, 1.0), c(2, -0.5, 2.000001), c(1, 0.5, 2.0000005)];
+        let mut x = vec![c(0, 0.5, 1.0), c(2, -0.5, 2.000001), c(1, 0.5, 2.0000005)];
         assert!(has_close_hits(&hits));
         assert_eq!(reorder(&mut x, &hits), 0);
-        assert_eq!(x.map(|c| c.patch), [0, 1, 2]);
+        assert_eq!(patches(&x), [0, 1, 2]);
     }
 
     /// A two-sided panel from front space: arrive at A, leave from B. A base on the floor from inside the
@@ -167,18 +238,73 @@ mod tests {
     #[test]
     fn coincident_crossings_alternate_between_front_and_back_space() {
         let hits = [hit(1.0), hit(2.0), hit(2.0)];
-        let mut panel = [c(0, 0.5, 1.0), c(7, 0.5, 2.0), c(6, -0.5, 2.0)];
+        let mut panel = vec![c(0, 0.5, 1.0), c(7, 0.5, 2.0), c(6, -0.5, 2.0)];
         reorder(&mut panel, &hits);
-        assert_eq!(panel.map(|c| c.patch), [0, 6, 7]);
-        let mut base = [c(0, -0.5, 1.0), c(3, -0.5, 2.0), c(9, 0.5, 2.0)];
+        assert_eq!(patches(&panel), [0, 6, 7]);
+        let mut base = vec![c(0, -0.5, 1.0), c(3, -0.5, 2.0), c(9, 0.5, 2.0)];
         reorder(&mut base, &hits);
-        assert_eq!(base.map(|c| c.patch), [0, 9, 3]);
+        assert_eq!(patches(&base), [0, 9, 3]);
         // From outside an enclosure up into a solid standing on its floor: the floor's back, the base
         // (d = 0), then the solid's top from behind.
         let hits = [hit(1.0), hit(1.0), hit(2.0)];
-        let mut up = [c(9, -0.5, 1.0), c(3, 0.5, 1.0), c(8, 0.5, 2.0)];
+        let mut up = vec![c(9, -0.5, 1.0), c(3, 0.5, 1.0), c(8, 0.5, 2.0)];
         reorder(&mut up, &hits);
-        assert_eq!(up.map(|c| c.patch), [3, 9, 8]);
+        assert_eq!(patches(&up), [3, 9, 8]);
+    }
+
+    /// A line touching an edge where two surfaces meet at an angle crosses both planes within rounding,
+    /// in either order: the touch is dropped and the line goes on in the space it came from.
+    #[test]
+    fn an_edge_touched_within_rounding_is_dropped() {
+        let (floor, wall) = ([0.0, 1.0, 0.0], [0.0, 0.0, -1.0]);
+        // From outside a closed hall, over the edge where its floor meets a wall, on to a wall seen from
+        // behind: in plane order the wall comes first, which read as its front seeing out of the scene.
+        let hits = [hit(1.0), hit(1.0), hit(2.0)];
+        let mut start = vec![
+            cn(115, 0.36, 1.0 + 1e-9, floor),
+            cn(118, -0.26, 1.0, wall),
+            cn(208, 0.9, 2.0, [1.0, 0.0, 0.0]),
+        ];
+        assert_eq!(reorder(&mut start, &hits), 0);
+        assert_eq!(patches(&start), [208]);
+        // The line's only contact: the outer edge of the hall (two escapes before).
+        let hits = [hit(1.0), hit(1.0)];
+        let mut only = vec![cn(1615, 0.78, 1.0 + 1e-9, wall), cn(1523, -0.59, 1.0, floor)];
+        reorder(&mut only, &hits);
+        assert!(only.is_empty());
+        // Inside a room, grazing the edge of a block: the room's two walls see each other.
+        let hits = [hit(1.0), hit(2.0), hit(2.0), hit(3.0)];
+        let mut inside = vec![
+            c(0, 0.5, 1.0),
+            cn(1, -0.5, 2.0 + 1e-9, floor),
+            cn(2, 0.5, 2.0, wall),
+            c(3, -0.5, 3.0),
+        ];
+        reorder(&mut inside, &hits);
+        assert_eq!(patches(&inside), [0, 3]);
+    }
+
+    /// Parallel surfaces that only nearly touch keep their plane order; when that order would leave the
+    /// line in a space its next crossing does not close, they are ordered as one place.
+    #[test]
+    fn parallel_surfaces_keep_a_consistent_order() {
+        let hits = [hit(1.0), hit(2.0), hit(2.0), hit(3.0)];
+        let mut near = vec![
+            c(0, 0.5, 1.0),
+            c(2, 0.5, 2.0 + 1e-9),
+            c(1, -0.5, 2.0),
+            c(3, -0.5, 3.0),
+        ];
+        reorder(&mut near, &hits);
+        assert_eq!(patches(&near), [0, 1, 2, 3]);
+        let mut swapped = vec![
+            c(0, 0.5, 1.0),
+            c(1, -0.5, 2.0 + 1e-9),
+            c(2, 0.5, 2.0),
+            c(3, -0.5, 3.0),
+        ];
+        reorder(&mut swapped, &hits);
+        assert_eq!(patches(&swapped), [0, 1, 2, 3]);
     }
 
     /// Overlapping surfaces facing the same way: the first in the scene is next to the front space,
@@ -186,11 +312,11 @@ mod tests {
     #[test]
     fn overlaps_are_won_by_the_first_surface_and_counted() {
         let hits = [hit(1.0), hit(1.0), hit(3.0)];
-        let mut down = [c(6, -0.5, 1.0), c(4, -0.5, 1.0), c(5, 0.5, 3.0)];
+        let mut down = vec![c(6, -0.5, 1.0), c(4, -0.5, 1.0), c(5, 0.5, 3.0)];
         assert_eq!(reorder(&mut down, &hits), 1);
-        assert_eq!(down.map(|c| c.patch), [4, 6, 5]);
-        let mut up = [c(4, 0.5, 1.0), c(6, 0.5, 1.0), c(5, -0.5, 3.0)];
+        assert_eq!(patches(&down), [4, 6, 5]);
+        let mut up = vec![c(4, 0.5, 1.0), c(6, 0.5, 1.0), c(5, -0.5, 3.0)];
         assert_eq!(reorder(&mut up, &hits), 1);
-        assert_eq!(up.map(|c| c.patch), [6, 4, 5]);
+        assert_eq!(patches(&up), [6, 4, 5]);
     }
 }

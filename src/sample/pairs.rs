@@ -108,6 +108,7 @@ fn crossing(scene: &Scene, l: &LineF64, h: &Hit) -> Crossing {
         triangle: h.triangle,
         cos,
         t,
+        normal: n,
     }
 }
 
