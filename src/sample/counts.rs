@@ -126,7 +126,7 @@ impl PairCounts {
 fn sort_keys(patches: usize, keys: &mut [u64]) {
     let layout = TagLayout::new(patches, 1);
     let mut packed: Vec<u64> = keys.iter().map(|&k| layout.tag(k, 0)).collect();
-    radix_sort_u64(&mut packed, layout.bits, &mut Vec::new());
+    radix_sort(&mut packed, layout.bits, &mut Vec::new());
     for (k, &p) in keys.iter_mut().zip(&packed) {
         *k = layout.untag(p).0;
     }
@@ -158,42 +158,60 @@ pub fn count_by_group(patches: usize, groups: usize, batches: &[(usize, &[u64])]
     let top_bits = (usize::BITS - (keys >> 12).leading_zeros()).clamp(1, layout.bits.min(12));
     let low_bits = layout.bits - top_bits;
 
-    // Stage 1: deal the tagged keys into buckets, one chunk of batches per thread in parallel.
+    // Stage 1: deal the tagged keys into one array, bucket after bucket: each chunk of batches (one per
+    // thread) counts its keys per bucket, then writes them into its own stretch of every bucket.
+    let buckets = 1usize << top_bits;
     let chunk = batches.len().div_ceil(rayon::current_num_threads()).max(1);
-    let dealt: Vec<Vec<Vec<u64>>> = batches
-        .par_chunks(chunk)
+    let chunks: Vec<&[(usize, &[u64])]> = batches.chunks(chunk).collect();
+    let per_chunk: Vec<Vec<usize>> = chunks
+        .par_iter()
         .map(|chunk| {
-            let mut out = vec![Vec::new(); 1 << top_bits];
-            for &(group, keys) in chunk {
+            let mut counts = vec![0; buckets];
+            for &(group, keys) in chunk.iter() {
                 for &k in keys {
-                    let t = layout.tag(k, group);
-                    out[(t >> low_bits) as usize].push(t);
+                    counts[(layout.tag(k, group) >> low_bits) as usize] += 1;
                 }
             }
-            out
+            counts
         })
         .collect();
-    let mut buckets: Vec<Vec<Vec<u64>>> = (0..1usize << top_bits).map(|_| Vec::new()).collect();
-    for chunk in dealt {
-        for (bucket, piece) in buckets.iter_mut().zip(chunk) {
-            bucket.push(piece);
-        }
+    let mut dealt = vec![0u64; keys];
+    // Bucket-major: bucket 0's stretch of chunk 0, of chunk 1, ..., then bucket 1's.
+    let mut stretches = split_by_lengths(
+        &mut dealt,
+        (0..buckets).flat_map(|b| per_chunk.iter().map(move |c| c[b])),
+    );
+    let mut targets: Vec<Vec<&mut [u64]>> = (0..chunks.len()).map(|_| Vec::new()).collect();
+    for (k, stretch) in stretches.drain(..).enumerate() {
+        targets[k % chunks.len()].push(stretch);
     }
+    chunks
+        .par_iter()
+        .zip(targets)
+        .for_each(|(chunk, mut targets)| {
+            let mut next = vec![0; buckets];
+            for &(group, keys) in chunk.iter() {
+                for &k in keys {
+                    let t = layout.tag(k, group);
+                    let b = (t >> low_bits) as usize;
+                    targets[b][next[b]] = t;
+                    next[b] += 1;
+                }
+            }
+        });
 
     // Stage 2: sort each bucket on its low bits, and count its runs per group and in all.
-    let sorted: Vec<(Vec<u64>, Vec<usize>)> = buckets
-        .into_par_iter()
-        .map_init(Vec::new, |scratch, mut pieces| {
-            let mut values = if pieces.len() == 1 {
-                pieces.pop().unwrap_or_default()
-            } else {
-                pieces.concat()
-            };
-            radix_sort_u64(&mut values, low_bits, scratch);
-            let runs = layout.run_counts(&values, groups);
-            (values, runs)
-        })
+    let bucket_lengths = (0..buckets).map(|b| per_chunk.iter().map(|c| c[b]).sum());
+    let mut sorted: Vec<(&mut [u64], Vec<usize>)> = split_by_lengths(&mut dealt, bucket_lengths)
+        .into_iter()
+        .map(|values| (values, Vec::new()))
         .collect();
+    sorted
+        .par_iter_mut()
+        .for_each_init(Vec::new, |scratch, (values, runs)| {
+            radix_sort(values, low_bits, scratch);
+            *runs = layout.run_counts(values, groups);
+        });
 
     // Stage 3: every bucket writes its runs into its own stretch of each list (buckets hold consecutive
     // key ranges, so the lists come out sorted).
@@ -203,30 +221,41 @@ pub fn count_by_group(patches: usize, groups: usize, batches: &[(usize, &[u64])]
             .collect(),
         total: vec![(0, 0); sorted.iter().map(|(_, r)| r[groups]).sum()],
     };
-    let mut rest: Vec<&mut [(u64, u64)]> = out
+    let mut lists: Vec<Vec<&mut [(u64, u64)]>> = out
         .groups
         .iter_mut()
         .chain(std::iter::once(&mut out.total))
-        .map(|l| l.as_mut_slice())
+        .enumerate()
+        .map(|(l, list)| split_by_lengths(list, sorted.iter().map(|(_, r)| r[l])))
         .collect();
-    let mut stretches = Vec::with_capacity(sorted.len());
-    for (_, runs) in &sorted {
-        let mine: Vec<&mut [(u64, u64)]> = rest
-            .iter_mut()
-            .zip(runs)
-            .map(|(list, &n)| {
-                let (head, tail) = std::mem::take(list).split_at_mut(n);
-                *list = tail;
-                head
-            })
-            .collect();
-        stretches.push(mine);
+    // Transposed: per bucket, its stretch of every list.
+    let mut per_bucket: Vec<Vec<&mut [(u64, u64)]>> =
+        (0..sorted.len()).map(|_| Vec::new()).collect();
+    for list in &mut lists {
+        for (b, stretch) in list.drain(..).enumerate() {
+            per_bucket[b].push(stretch);
+        }
     }
     sorted
         .par_iter()
-        .zip(stretches)
+        .zip(per_bucket)
         .for_each(|((values, _), mut lists)| layout.write_runs(values, &mut lists));
     out
+}
+
+/// Cuts `slice` into consecutive pieces of the given lengths (which must not add up to more).
+fn split_by_lengths<T>(
+    mut slice: &mut [T],
+    lengths: impl IntoIterator<Item = usize>,
+) -> Vec<&mut [T]> {
+    lengths
+        .into_iter()
+        .map(|n| {
+            let (head, tail) = std::mem::take(&mut slice).split_at_mut(n);
+            slice = tail;
+            head
+        })
+        .collect()
 }
 
 /// How pair keys are packed for sorting: `(lo << p | hi) << g | group`, with `p` bits for a patch index
@@ -309,30 +338,37 @@ impl TagLayout {
     }
 }
 
-/// Least-significant-digit radix sort of values below 2^bits, 11 bits per pass; `scratch` is reused
-/// between calls.
-fn radix_sort_u64(values: &mut Vec<u64>, bits: u32, scratch: &mut Vec<u64>) {
+/// Least-significant-digit radix sort of values below 2^bits, 11 bits per pass, in place; `scratch` is
+/// reused between calls.
+fn radix_sort(values: &mut [u64], bits: u32, scratch: &mut Vec<u64>) {
     const DIGIT: u32 = 11;
     scratch.clear();
     scratch.resize(values.len(), 0);
+    let (mut from, mut to): (&mut [u64], &mut [u64]) = (values, scratch.as_mut_slice());
     let mut shift = 0;
+    let mut passes = 0;
     while shift < bits {
         let mut offsets = [0usize; 1 << DIGIT];
         let digit = |v: u64| ((v >> shift) & ((1 << DIGIT) - 1)) as usize;
-        for &v in values.iter() {
+        for &v in from.iter() {
             offsets[digit(v)] += 1;
         }
         let mut sum = 0;
         for o in offsets.iter_mut() {
             (*o, sum) = (sum, sum + *o);
         }
-        for &v in values.iter() {
+        for &v in from.iter() {
             let d = digit(v);
-            scratch[offsets[d]] = v;
+            to[offsets[d]] = v;
             offsets[d] += 1;
         }
-        std::mem::swap(values, scratch);
+        std::mem::swap(&mut from, &mut to);
         shift += DIGIT;
+        passes += 1;
+    }
+    if passes % 2 == 1 {
+        // The sorted values are in the scratch (`from`); `to` is the caller's slice again.
+        to.copy_from_slice(from);
     }
 }
 
@@ -481,5 +517,31 @@ mod tests {
         let mut all: Vec<u64> = batches.iter().flat_map(|b| b.1.iter().copied()).collect();
         let total = PairCounts::from_keys(patches as usize, &mut all);
         assert_eq!(entries(&sparse(&counted.total)), entries(&total));
+
+        // A scene so small that the buckets are told apart by the group bits too.
+        let keys: Vec<u64> = (0..9000u64)
+            .map(|k| pair_key((k % 3) as u32, (k % 2) as u32))
+            .collect();
+        let tiny: Vec<(usize, &[u64])> = keys
+            .chunks(1000)
+            .enumerate()
+            .map(|(b, k)| (b % 5, k))
+            .collect();
+        let counted = count_by_group(3, 5, &tiny);
+        let sum: u64 = counted.total.iter().map(|&(_, c)| c).sum();
+        assert_eq!(sum, 9000);
+        for g in 0..5 {
+            let mut alone: Vec<u64> = tiny
+                .iter()
+                .filter(|b| b.0 == g)
+                .flat_map(|b| b.1.to_vec())
+                .collect();
+            let alone = PairCounts::from_keys(3, &mut alone);
+            assert_eq!(
+                entries(&sparse(&counted.groups[g])),
+                entries(&alone),
+                "tiny group {g}"
+            );
+        }
     }
 }

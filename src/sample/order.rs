@@ -103,9 +103,11 @@ fn is_touch(window: &[Crossing]) -> bool {
         });
     let distinct_places = hi - lo > COINCIDENT * lo.abs().max(1.0);
     let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-    let at_an_angle = window
-        .iter()
-        .any(|a| window.iter().any(|b| dot(a.normal, b.normal).abs() < 1.0 - 1e-9));
+    let at_an_angle = window.iter().any(|a| {
+        window
+            .iter()
+            .any(|b| dot(a.normal, b.normal).abs() < 1.0 - 1e-9)
+    });
     distinct_places && at_an_angle
 }
 
@@ -269,7 +271,10 @@ mod tests {
         assert_eq!(patches(&start), [208]);
         // The line's only contact: the outer edge of the hall (two escapes before).
         let hits = [hit(1.0), hit(1.0)];
-        let mut only = vec![cn(1615, 0.78, 1.0 + 1e-9, wall), cn(1523, -0.59, 1.0, floor)];
+        let mut only = vec![
+            cn(1615, 0.78, 1.0 + 1e-9, wall),
+            cn(1523, -0.59, 1.0, floor),
+        ];
         reorder(&mut only, &hits);
         assert!(only.is_empty());
         // Inside a room, grazing the edge of a block: the room's two walls see each other.
