@@ -369,32 +369,50 @@ pub fn analyze_observed(
     } else {
         max_round
     };
+    // Batches traced so far, and the last round's when it is not counted yet: without a precision target
+    // the next round's size does not depend on the counts, so a round is counted while the next one is
+    // traced, which keeps both cores busy through the counting's serial parts.
+    let mut traced_to = 0;
+    let mut pending: Option<TracedBatches> = None;
     let stop_reason = loop {
-        let first = run.batches_done;
-        let last = (first + round).min(plan.batches());
-        let (traced, complete) = trace_batches(
-            scene,
-            tracer,
-            &plan,
-            cfg.source,
-            cfg.seed,
-            first..last,
-            cfg.wanted,
-            &stop,
-        )?;
-        run.add(traced);
-        if !complete {
-            break if control.stop_requested() {
+        let batches = traced_to..(traced_to + round).min(plan.batches());
+        let trace = || {
+            trace_batches(
+                scene,
+                tracer,
+                &plan,
+                cfg.source,
+                cfg.seed,
+                batches.clone(),
+                cfg.wanted,
+                &stop,
+            )
+        };
+        let (traced, complete) = match pending.take() {
+            Some(previous) => rayon::join(trace, || run.add(previous)).0?,
+            None => trace()?,
+        };
+        traced_to += traced.len() as u64;
+        let ended = if !complete {
+            Some(if control.stop_requested() {
                 StopReason::Interrupted
             } else {
                 StopReason::Seconds
-            };
+            })
+        } else if traced_to >= plan.batches() {
+            Some(StopReason::Lines)
+        } else if deadline.is_some_and(|d| Instant::now() >= d) {
+            Some(StopReason::Seconds)
+        } else {
+            None
+        };
+        if ended.is_some() || cfg.budget.target.is_some() {
+            run.add(traced);
+        } else {
+            pending = Some(traced);
         }
-        if run.batches_done >= plan.batches() {
-            break StopReason::Lines;
-        }
-        if deadline.is_some_and(|d| Instant::now() >= d) {
-            break StopReason::Seconds;
+        if let Some(reason) = ended {
+            break reason;
         }
         if let Some(target) = cfg.budget.target {
             let se = run.current_stderr(&areas, cfg, target.measure);
@@ -410,7 +428,7 @@ pub fn analyze_observed(
             }
         } else {
             // Doubling: few rounds, and a time budget is checked before every batch anyway.
-            round = run.batches_done.max(64);
+            round = traced_to.max(64);
         }
         round = round.min(max_round);
     };
