@@ -2,8 +2,9 @@
 //! hits of lines drawn beforehand), of first-hit queries, of drawing the lines and tracing them (what an
 //! analysis does before pairing and counting), and of the whole analysis on the same lines, per tracer
 //! (Embree single lines and native packets, the pure-Rust BVH) and thread count. Best of three runs (the
-//! machine is shared). The last two columns are the analysis's share of the kernel's rate, against the
-//! kernel alone and against drawing plus kernel (so that what remains is pairing and counting).
+//! machine is shared). Then the analysis's share of the kernel's rate, against the kernel alone and
+//! against drawing plus kernel (so that what remains is pairing and counting); last, an analysis of I_s^c
+//! alone (`--measures continuous`: no pair counts) and its share of the kernel's rate.
 //!
 //! `cargo bench --bench throughput [-- SCENE... [LINES]]`, default `@cube:30 @cubes512` and 10^6 lines;
 //! `SCX_BENCH_TRACERS=rust,single` keeps only the tracers whose names contain one of the words.
@@ -13,7 +14,7 @@ use std::time::Instant;
 use rayon::prelude::*;
 use scene_complexity::analysis::{analyze, AnalysisConfig, DEFAULT_GROUPS};
 use scene_complexity::sample::lines::batch_lines;
-use scene_complexity::sample::tally::BatchPlan;
+use scene_complexity::sample::tally::{BatchPlan, Wanted};
 use scene_complexity::scene;
 use scene_complexity::trace::{make_tracer, Backend, Line, LineHits, Query, Tracer};
 
@@ -37,7 +38,7 @@ fn main() -> anyhow::Result<()> {
         "M lines/s: wall clock, and per CPU-second of all threads (robust when the machine is shared)"
     );
     println!(
-        "{:<11} {:<16} {:>3}  {:>14}  {:>14}  {:>14}  {:>14}  {:>10}  {:>10}",
+        "{:<11} {:<16} {:>3}  {:>14}  {:>14}  {:>14}  {:>14}  {:>10}  {:>10}  {:>14}  {:>10}",
         "scene",
         "tracer",
         "thr",
@@ -46,11 +47,14 @@ fn main() -> anyhow::Result<()> {
         "draw+all-hits",
         "analyze",
         "an./all",
-        "an./draw+all"
+        "an./draw+all",
+        "an. I_s^c",
+        "I_s^c/all"
     );
     println!(
-        "{:<11} {:<16} {:>3}  {:>6} {:>7}  {:>6} {:>7}  {:>6} {:>7}  {:>6} {:>7}  {:>4} {:>5}  {:>4} {:>5}",
-        "", "", "", "wall", "cpu", "wall", "cpu", "wall", "cpu", "wall", "cpu", "wall", "cpu", "wall", "cpu"
+        "{:<11} {:<16} {:>3}  {:>6} {:>7}  {:>6} {:>7}  {:>6} {:>7}  {:>6} {:>7}  {:>4} {:>5}  {:>4} {:>5}  {:>6} {:>7}  {:>4} {:>5}",
+        "", "", "", "wall", "cpu", "wall", "cpu", "wall", "cpu", "wall", "cpu", "wall", "cpu", "wall", "cpu",
+        "wall", "cpu", "wall", "cpu"
     );
     // The pools live for the whole run: a thread that exits during a measurement would take its CPU time
     // out of the sum.
@@ -78,6 +82,14 @@ fn bench_scene(spec: &str, count: u64, pools: &[rayon::ThreadPool]) -> anyhow::R
         groups: DEFAULT_GROUPS,
         ..AnalysisConfig::new(count, 1)
     };
+    // `--measures continuous`: I_s^c alone, no pair counts (what a run needs when it wants only eq. 27).
+    let continuous = AnalysisConfig {
+        wanted: Wanted {
+            discrete: false,
+            continuous: true,
+        },
+        ..cfg
+    };
     // `SCX_BENCH_TRACERS=rust,embree single` keeps the tracers whose names contain one of the words.
     let only = std::env::var("SCX_BENCH_TRACERS").unwrap_or_default();
     let wanted = |name: &str| only.is_empty() || only.split(',').any(|w| name.contains(w.trim()));
@@ -96,9 +108,14 @@ fn bench_scene(spec: &str, count: u64, pools: &[rayon::ThreadPool]) -> anyhow::R
                     analyze(&scene, t, &cfg).unwrap();
                 })
             });
+            let continuous_only = pool.install(|| {
+                best(|| {
+                    analyze(&scene, t, &continuous).unwrap();
+                })
+            });
             let rate = |s: f64| count as f64 / s / 1e6;
             println!(
-                "{spec:<11} {name:<16} {threads:>3}  {:>6.2} {:>7.2}  {:>6.2} {:>7.2}  {:>6.2} {:>7.2}  {:>6.2} {:>7.2}  {:>4.2} {:>5.2}  {:>4.2} {:>5.2}",
+                "{spec:<11} {name:<16} {threads:>3}  {:>6.2} {:>7.2}  {:>6.2} {:>7.2}  {:>6.2} {:>7.2}  {:>6.2} {:>7.2}  {:>4.2} {:>5.2}  {:>4.2} {:>5.2}  {:>6.2} {:>7.2}  {:>4.2} {:>5.2}",
                 rate(all.wall),
                 rate(all.cpu),
                 rate(first.wall),
@@ -111,6 +128,10 @@ fn bench_scene(spec: &str, count: u64, pools: &[rayon::ThreadPool]) -> anyhow::R
                 all.cpu / end_to_end.cpu,
                 drawn.wall / end_to_end.wall,
                 drawn.cpu / end_to_end.cpu,
+                rate(continuous_only.wall),
+                rate(continuous_only.cpu),
+                all.wall / continuous_only.wall,
+                all.cpu / continuous_only.cpu,
             );
         }
     }
