@@ -10,9 +10,10 @@
 //!   and Grassberger's `ln N - (1 / N) sum x G(x)`.
 //!
 //! None of these sums needs `N` while it is gathered, so one streaming pass over the counts (each entry
-//! feeding its two rows) replaces the several passes per measure the definitions would take: this runs
-//! for every standard-error group and for the whole run, over every distinct visible pair, and was a
-//! third of the end-to-end run time on a scene of 5400 patches before.
+//! feeding its two rows) replaces the six passes the definitions took: this runs for every
+//! standard-error group and for the whole run, over every distinct visible pair, and those passes were
+//! about a third of what an analysis of the 30 x 30 cube spent besides tracing (27 + 21 ms of 10^6
+//! lines' 150 ms; 12 + 6 ms with one pass).
 
 use super::bias::{digamma, grassberger_g, EntropyEstimator};
 use crate::sample::counts::PairCounts;
