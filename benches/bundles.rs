@@ -7,6 +7,8 @@
 //!
 //! `cargo bench --bench bundles [-- SCENE... [LINES]]`, default `@cube:30 @cubes512` and 10^6 lines.
 
+mod common;
+
 use std::time::Instant;
 
 use scene_complexity::analysis::{analyze, AnalysisConfig};
@@ -18,16 +20,7 @@ const SEEDS: u64 = 3;
 const GROUPS: usize = 64;
 
 fn main() -> anyhow::Result<()> {
-    let args: Vec<String> = std::env::args()
-        .skip(1)
-        .filter(|a| !a.starts_with("--"))
-        .collect();
-    let (counts, mut specs): (Vec<String>, Vec<String>) =
-        args.into_iter().partition(|a| a.parse::<f64>().is_ok());
-    if specs.is_empty() {
-        specs = vec!["@cube:30".into(), "@cubes512".into()];
-    }
-    let lines = counts.first().map_or(Ok(1e6), |c| c.parse::<f64>())? as u64;
+    let (specs, lines) = common::scenes_and_lines(1e6)?;
     let pool = rayon::ThreadPoolBuilder::new().num_threads(2).build()?;
     println!(
         "{lines} lines per run, 2 threads, {SEEDS} seeds x {GROUPS} groups; eff = stderr x sqrt(s), \
@@ -106,10 +99,10 @@ fn measure(scene: &Scene, tracer: &dyn Tracer, lines: u64, grid: u32) -> Row {
         var_mi: 0.0,
     };
     for seed in 1..=SEEDS {
-        let (w0, c0) = (Instant::now(), cpu_seconds());
+        let (w0, c0) = (Instant::now(), common::cpu_seconds());
         let a = analyze(scene, tracer, &cfg(seed)).expect("analysis runs");
         row.wall += w0.elapsed().as_secs_f64();
-        row.cpu += cpu_seconds() - c0;
+        row.cpu += common::cpu_seconds() - c0;
         row.lines += a.lines as f64;
         let se = |e: Option<scene_complexity::measure::Estimate>| {
             e.and_then(|e| e.stderr).unwrap_or(f64::NAN)
@@ -133,21 +126,4 @@ fn print_row(spec: &str, query: &str, grid: u32, r: &Row, base: &Row) {
         rel(r.eff(r.var_mi, r.cpu), base.eff(base.var_mi, base.cpu)),
         rel(r.eff(r.var_mi, r.wall), base.eff(base.var_mi, base.wall)),
     );
-}
-
-/// CPU time used so far by the live threads of this process (Linux `/proc/self/task/*/schedstat`).
-fn cpu_seconds() -> f64 {
-    let Ok(tasks) = std::fs::read_dir("/proc/self/task") else {
-        return f64::NAN;
-    };
-    let mut ns = 0u64;
-    for task in tasks.flatten() {
-        let stat = std::fs::read_to_string(task.path().join("schedstat")).unwrap_or_default();
-        ns += stat
-            .split_whitespace()
-            .next()
-            .and_then(|v| v.parse::<u64>().ok())
-            .unwrap_or(0);
-    }
-    ns as f64 * 1e-9
 }

@@ -11,6 +11,8 @@
 //!
 //! `cargo bench --bench bvh_layouts [-- SCENE...]`, default `@cube:30 @cubes512`.
 
+mod common;
+
 use std::time::Duration;
 
 use glam::Vec3A;
@@ -113,22 +115,11 @@ fn obvhs_traversals(spec: &str, scene: &Scene, lines: &[Line]) {
 fn best_cpu_seconds(mut f: impl FnMut()) -> f64 {
     (0..3)
         .map(|_| {
-            let t0 = thread_cpu_seconds();
+            let t0 = common::thread_cpu_seconds();
             f();
-            thread_cpu_seconds() - t0
+            common::thread_cpu_seconds() - t0
         })
         .fold(f64::INFINITY, f64::min)
-}
-
-/// CPU time of this thread so far (Linux: the first field of `/proc/thread-self/schedstat`, ns on a CPU).
-fn thread_cpu_seconds() -> f64 {
-    let stat = std::fs::read_to_string("/proc/thread-self/schedstat").unwrap_or_default();
-    let ns: u64 = stat
-        .split_whitespace()
-        .next()
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(0);
-    ns as f64 * 1e-9
 }
 
 fn inflated_boxes(scene: &Scene, tris: &[[[f32; 3]; 3]]) -> Vec<Aabb> {

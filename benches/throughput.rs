@@ -9,6 +9,8 @@
 //! `cargo bench --bench throughput [-- SCENE... [LINES]]`, default `@cube:30 @cubes512` and 10^6 lines;
 //! `SCX_BENCH_TRACERS=rust,single` keeps only the tracers whose names contain one of the words.
 
+mod common;
+
 use std::time::Instant;
 
 use rayon::prelude::*;
@@ -22,18 +24,7 @@ const CHUNK: usize = 4096;
 const REPEATS: usize = 3;
 
 fn main() -> anyhow::Result<()> {
-    // `cargo bench` passes `--bench`; keep only our own arguments: numbers are the line count, the rest
-    // scenes.
-    let args: Vec<String> = std::env::args()
-        .skip(1)
-        .filter(|a| !a.starts_with("--"))
-        .collect();
-    let (counts, mut specs): (Vec<String>, Vec<String>) =
-        args.into_iter().partition(|a| a.parse::<f64>().is_ok());
-    if specs.is_empty() {
-        specs = vec!["@cube:30".into(), "@cubes512".into()];
-    }
-    let count = counts.first().map_or(Ok(1e6), |c| c.parse::<f64>())? as u64;
+    let (specs, count) = common::scenes_and_lines(1e6)?;
     println!(
         "M lines/s: wall clock, and per CPU-second of all threads (robust when the machine is shared)"
     );
@@ -165,30 +156,12 @@ fn best(mut f: impl FnMut()) -> Timing {
         cpu: f64::INFINITY,
     };
     for _ in 0..REPEATS {
-        let (w0, c0) = (Instant::now(), cpu_seconds());
+        let (w0, c0) = (Instant::now(), common::cpu_seconds());
         f();
         t.wall = t.wall.min(w0.elapsed().as_secs_f64());
-        t.cpu = t.cpu.min(cpu_seconds() - c0);
+        t.cpu = t.cpu.min(common::cpu_seconds() - c0);
     }
     t
-}
-
-/// CPU time used so far by the live threads of this process (Linux: the first field of each
-/// `/proc/self/task/*/schedstat`, nanoseconds on a CPU); NaN where that is not available.
-fn cpu_seconds() -> f64 {
-    let Ok(tasks) = std::fs::read_dir("/proc/self/task") else {
-        return f64::NAN;
-    };
-    let mut ns = 0u64;
-    for task in tasks.flatten() {
-        let stat = std::fs::read_to_string(task.path().join("schedstat")).unwrap_or_default();
-        ns += stat
-            .split_whitespace()
-            .next()
-            .and_then(|v| v.parse::<u64>().ok())
-            .unwrap_or(0);
-    }
-    ns as f64 * 1e-9
 }
 
 fn first_hit_pass(tracer: &dyn Tracer, lines: &[Line]) {
