@@ -10,7 +10,7 @@ use scene_complexity::sample::lines::LineSource;
 use scene_complexity::sample::tally::{BatchPlan, Wanted};
 use scene_complexity::scene::{self, Scene};
 use scene_complexity::trace::{make_tracer, Backend, LineHits, Query, Tracer};
-use support::{ff_parallel_rectangles, ff_perpendicular_rectangles};
+use support::{count_entries, ff_parallel_rectangles, ff_perpendicular_rectangles};
 
 const ALL: Wanted = Wanted {
     discrete: true,
@@ -146,17 +146,12 @@ fn results_do_not_depend_on_the_thread_count() {
             pool.install(|| run(&scene, tracer.as_ref(), 30_000, 5, grid))
         };
         let (one, two) = (go(1), go(2));
-        let entries = |a: &Analysis| {
-            let mut v = Vec::new();
-            a.tally
-                .counts
-                .as_ref()
-                .unwrap()
-                .for_each(|i, j, c| v.push((i, j, c)));
-            v
-        };
         assert!(!one.tally.counts.as_ref().unwrap().is_dense());
-        assert_eq!(entries(&one), entries(&two), "G = {grid}: identical counts");
+        assert_eq!(
+            count_entries(&one),
+            count_entries(&two),
+            "G = {grid}: identical counts"
+        );
         assert_eq!(one.tally.cmi_sum.to_bits(), two.tally.cmi_sum.to_bits());
         let bits = |a: &Analysis| {
             let v = &a.visibility;

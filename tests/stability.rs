@@ -16,7 +16,7 @@ use scene_complexity::measure::visibility::row_totals;
 use scene_complexity::sample::pairs::{segments, Segment};
 use scene_complexity::scene::{self, Material, Scene, SceneBuilder};
 use scene_complexity::trace::{make_tracer, Backend, Line, LineHits, Query, Tracer};
-use support::{ff_parallel_rectangles, room_with_box_obj};
+use support::{count_entries, ff_parallel_rectangles, room_with_box_obj};
 
 // ------------------------------------------------------------------------------------------------
 // Helpers.
@@ -951,15 +951,7 @@ fn tiny_and_huge_scenes_give_the_same_results() {
     };
     let base_scene = load(1.0);
     let base = run(&base_scene, 50_000, 4);
-    let base_counts = |a: &Analysis| {
-        let mut v = Vec::new();
-        a.tally
-            .counts
-            .as_ref()
-            .unwrap()
-            .for_each(|i, j, c| v.push((i, j, c)));
-        (a.hits, a.pairs, a.unpaired, a.escapes, v)
-    };
+    let base_counts = |a: &Analysis| (a.hits, a.pairs, a.unpaired, a.escapes, count_entries(a));
     for s in [1e-6, 1e6, 2f64.powi(-20), 2f64.powi(20)] {
         let scene = load(s);
         assert_eq!(
@@ -1086,16 +1078,7 @@ fn zero_area_triangles_are_dropped_with_a_warning() {
         assert!((p.area - q.area).abs() < 1e-15);
     }
     let (ra, rb) = (run(&a, 50_000, 2), run(&b, 50_000, 2));
-    let entries = |x: &Analysis| {
-        let mut v = Vec::new();
-        x.tally
-            .counts
-            .as_ref()
-            .unwrap()
-            .for_each(|i, j, c| v.push((i, j, c)));
-        v
-    };
-    assert_eq!(entries(&ra), entries(&rb));
+    assert_eq!(count_entries(&ra), count_entries(&rb));
     let exact = ff_parallel_rectangles(1.0, 1.0, 1.0);
     let (up, total) = block_counts(&rb, 6, &|i| i == 4, &|j| j == 5);
     assert!((up / total - exact).abs() < 4.5 * (exact * (1.0 - exact) / total).sqrt());

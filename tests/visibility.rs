@@ -147,16 +147,7 @@ fn results_do_not_depend_on_the_thread_count() {
             pool.install(|| run(&scene, tracer.as_ref(), 40_000, 3))
         };
         let (one, two) = (go(1), go(2));
-        let entries = |a: &Analysis| {
-            let mut v = Vec::new();
-            a.tally
-                .counts
-                .as_ref()
-                .unwrap()
-                .for_each(|i, j, c| v.push((i, j, c)));
-            v
-        };
-        assert_eq!(entries(&one), entries(&two), "identical counts");
+        assert_eq!(count_entries(&one), count_entries(&two), "identical counts");
         assert_eq!(
             one.tally.cmi_sum.to_bits(),
             two.tally.cmi_sum.to_bits(),

@@ -4,6 +4,7 @@
 
 use std::f64::consts::PI;
 
+use scene_complexity::analysis::Analysis;
 use scene_complexity::scene::Scene;
 
 use scene_complexity::trace::rust::BruteForceTracer;
@@ -265,4 +266,16 @@ pub fn json_of(out: &std::process::Output) -> serde_json::Value {
         String::from_utf8_lossy(&out.stderr)
     );
     serde_json::from_slice(&out.stdout).expect("valid JSON")
+}
+
+/// Every pair count of a run as `(i, j, N_ij)`, in the counts' own order: two runs that counted the same
+/// give equal lists.
+pub fn count_entries(a: &Analysis) -> Vec<(u32, u32, u64)> {
+    let mut v = Vec::new();
+    a.tally
+        .counts
+        .as_ref()
+        .expect("the run counted pairs")
+        .for_each(|i, j, c| v.push((i, j, c)));
+    v
 }
