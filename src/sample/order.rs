@@ -83,12 +83,13 @@ pub(crate) fn reorder(crossings: &mut Vec<Crossing>, hits: &[Hit]) -> u64 {
 }
 
 /// Whether a window of close crossings is a line touching an edge (or vertex) where surfaces meet at an
-/// angle: planes not all parallel, crossed at distinct places (so not coincident surfaces), as many
-/// arrivals at front sides as departures, none in its plane. Two planes at an angle crossed within a few
-/// f32 ulps of each other are crossed at their common edge, and a line that arrives at one front and
-/// leaves another there grazes the ridge or valley and goes on in the space it came from (in exact
-/// arithmetic it may miss both patches). Ordered by plane distance, such a touch would pair the two
-/// surfaces across a gap of ~1e-9 (a huge term of eq. 27) or read as two escapes from a closed scene
+/// angle: planes not all parallel, as many arrivals at front sides as departures, none in its plane. Two
+/// planes at an angle crossed within a few f32 ulps of each other are crossed at their common edge, and a
+/// line that arrives at one front and leaves another there grazes the ridge or valley and goes on in the
+/// space it came from (in exact arithmetic it may miss both patches; a line entering or leaving a solid
+/// through an edge meets its faces all facing one way, and coincident parallel surfaces, a two-sided
+/// panel or a decal, are ordered by [`order_window`] instead). Ordered by plane distance, a touch would
+/// pair the two surfaces across ~1e-9 (a huge term of eq. 27) or read as two escapes from a closed scene
 /// (seen on `@labyrinth`, lines touching the hall's outer edges); it is measure zero, so it is dropped.
 fn is_touch(window: &[Crossing]) -> bool {
     let arrivals = window.iter().filter(|c| c.cos < 0.0).count();
@@ -96,19 +97,12 @@ fn is_touch(window: &[Crossing]) -> bool {
     if arrivals == 0 || arrivals != departures || arrivals + departures != window.len() {
         return false;
     }
-    let (lo, hi) = window
-        .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), c| {
-            (lo.min(c.t), hi.max(c.t))
-        });
-    let distinct_places = hi - lo > COINCIDENT * lo.abs().max(1.0);
     let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-    let at_an_angle = window.iter().any(|a| {
+    window.iter().any(|a| {
         window
             .iter()
             .any(|b| dot(a.normal, b.normal).abs() < 1.0 - 1e-9)
-    });
-    distinct_places && at_an_angle
+    })
 }
 
 /// Orders the window `start..end` given its neighbours. The space the line is in before the window is
@@ -277,6 +271,10 @@ mod tests {
         ];
         reorder(&mut only, &hits);
         assert!(only.is_empty());
+        // Exactly through the edge: the same plane distance, still a touch.
+        let mut exact = vec![cn(1615, 0.78, 1.0, wall), cn(1523, -0.59, 1.0, floor)];
+        reorder(&mut exact, &hits);
+        assert!(exact.is_empty());
         // Inside a room, grazing the edge of a block: the room's two walls see each other.
         let hits = [hit(1.0), hit(2.0), hit(2.0), hit(3.0)];
         let mut inside = vec![
