@@ -135,6 +135,56 @@ fn corrected_estimates_are_reported_beside_the_plug_in() {
     assert_eq!(doc["stop_reason"], "lines");
 }
 
+/// `--errors jackknife` changes the standard errors of the count-based measures only: the values, and
+/// I_s^c's error, are those of the default run; an enclosed scene falls back to batch means and says so.
+#[test]
+fn jackknife_errors_change_only_the_count_based_errors() {
+    let run = |extra: &[&str]| {
+        let mut args = vec![
+            "analyze", "@cube:4", "--lines", "3e4", "--tracer", "rust", "--format", "json",
+        ];
+        args.extend_from_slice(extra);
+        json_of(&scx(&args))
+    };
+    let (groups, jackknife) = (run(&[]), run(&["--errors", "jackknife"]));
+    assert_eq!(groups["errors"], "groups");
+    assert_eq!(jackknife["errors"], "jackknife");
+    let (g, j) = (&groups["visibility"], &jackknife["visibility"]);
+    for key in ["entropy", "mutual_information", "accuracy", "mse_per_line"] {
+        assert_eq!(g[key]["value"], j[key]["value"], "{key}");
+        let (sg, sj) = (
+            g[key]["stderr"].as_f64().unwrap(),
+            j[key]["stderr"].as_f64().unwrap(),
+        );
+        assert!(
+            sj.is_finite() && sj > 0.0 && sj != sg,
+            "{key}: {sg} vs {sj}"
+        );
+    }
+    let cmi = "continuous_mutual_information";
+    assert_eq!(g[cmi], j[cmi]);
+
+    let open = |extra: &[&str]| {
+        let mut args = vec![
+            "analyze",
+            "@cornell-open",
+            "--lines",
+            "2e4",
+            "--tracer",
+            "rust",
+            "--enclose",
+            "--format",
+            "json",
+        ];
+        args.extend_from_slice(extra);
+        json_of(&scx(&args))
+    };
+    assert_eq!(open(&["--errors", "jackknife"])["errors"], "groups");
+    assert!(!scx(&["analyze", "@cube", "--errors", "bogus"])
+        .status
+        .success());
+}
+
 #[test]
 fn budgets_stop_the_run_and_say_why() {
     let doc = json_of(&scx(&[

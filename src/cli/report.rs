@@ -2,7 +2,7 @@
 
 use std::fmt::Write;
 
-use scene_complexity::analysis::{Analysis, StopReason};
+use scene_complexity::analysis::{Analysis, ErrorMethod, StopReason};
 use scene_complexity::measure::Estimate;
 use scene_complexity::radiosity::{RadiosityEstimates, RadiosityOutcome};
 use scene_complexity::scene::Scene;
@@ -195,6 +195,7 @@ pub fn json(run: &RunInfo, a: &Analysis) -> String {
         "stop_reason": a.stop_reason.name(),
         "interrupted": a.stop_reason == StopReason::Interrupted,
         "estimator": a.estimator.name(),
+        "errors": a.errors.name(),
         "hits": a.hits,
         "pairs": a.pairs,
         "escapes": a.escapes,
@@ -384,13 +385,21 @@ pub fn table(run: &RunInfo, a: &Analysis) -> String {
         table_row(&mut s, &r);
     }
     radiosity_table(&mut s, run.radiosity);
+    let errors = match a.errors {
+        ErrorMethod::Groups => format!(
+            "spread of {} independent groups of lines / sqrt({})",
+            a.groups, a.groups
+        ),
+        ErrorMethod::Jackknife => format!(
+            "delete-a-group jackknife over {} groups of lines (I_s^c: spread of the groups / sqrt({}))",
+            a.groups, a.groups
+        ),
+    };
     let _ = writeln!(
         s,
-        "\nstandard errors: spread of {} independent groups of lines / sqrt({}) (statistical error only).\n\
+        "\nstandard errors: {errors} (statistical error only).\n\
          corrected: row entropies by the {} estimator; the plug-in H_s and I_s are biased when rows are \
          undersampled.",
-        a.groups,
-        a.groups,
         a.estimator.name()
     );
     if a.stop_reason != StopReason::Lines {

@@ -115,6 +115,29 @@ impl RowSums {
         self.x_kernel += x_kernel;
     }
 
+    /// Takes one patch outcome seen `x` times out of the row again (the inverse of
+    /// [`RowSums::add_patch_outcome`]).
+    fn remove_patch_outcome(&mut self, x: u64, log2_area: f64, table: &OutcomeTable) {
+        let (x_log2_x, x_kernel) = table.of(x);
+        let xf = x as f64;
+        self.segments -= x;
+        self.seen -= 1;
+        self.singletons -= u64::from(x == 1);
+        self.doubletons -= u64::from(x == 2);
+        self.x_log2_x -= x_log2_x;
+        self.x_squared -= xf * xf;
+        self.x_log2_area -= xf * log2_area;
+        self.x_kernel -= x_kernel;
+    }
+
+    /// The row with one patch outcome seen `x` times seen `x - c` times instead.
+    fn lower_patch_outcome(&mut self, x: u64, c: u64, log2_area: f64, table: &OutcomeTable) {
+        self.remove_patch_outcome(x, log2_area, table);
+        if x > c {
+            self.add_patch_outcome(x - c, log2_area, table);
+        }
+    }
+
     fn add_escapes(&mut self, e: u64, table: &OutcomeTable) {
         if e == 0 {
             return;
@@ -125,6 +148,18 @@ impl RowSums {
         self.singletons += u64::from(e == 1);
         self.doubletons += u64::from(e == 2);
         self.x_kernel += table.of(e).1;
+    }
+
+    fn remove_escapes(&mut self, e: u64, table: &OutcomeTable) {
+        if e == 0 {
+            return;
+        }
+        self.segments -= e;
+        self.escapes -= e;
+        self.seen -= 1;
+        self.singletons -= u64::from(e == 1);
+        self.doubletons -= u64::from(e == 2);
+        self.x_kernel -= table.of(e).1;
     }
 
     /// `N_i` as a float.
@@ -217,10 +252,7 @@ impl Rows {
         estimator: EntropyEstimator,
     ) -> Self {
         let table = OutcomeTable::new(Kernel::of(estimator));
-        let log2_area: Vec<f64> = area_fractions
-            .iter()
-            .map(|&a| if a > 0.0 { a.log2() } else { 0.0 })
-            .collect();
+        let log2_area = log2_areas(area_fractions);
         let mut sums = vec![RowSums::default(); area_fractions.len().max(escapes.len())];
         counts.for_each(|i, j, c| {
             let (i, j) = (i as usize, j as usize);
@@ -238,11 +270,146 @@ impl Rows {
         Rows { estimator, sums }
     }
 
+    /// The rows of `total` without one group's share of it (`group` with its escapes, a part of
+    /// `total`): each of the group's outcomes is lowered by its count. This is a leave-one-group-out
+    /// replicate of the delete-a-group jackknife ([`crate::measure::estimate::Estimate::from_jackknife`]),
+    /// from one pass over the group's counts instead of a gather over all the others'.
+    pub fn without_group(
+        &self,
+        area_fractions: &[f64],
+        total: (&PairCounts, &[u64]),
+        group: (&PairCounts, &[u64]),
+    ) -> Rows {
+        let table = OutcomeTable::new(Kernel::of(self.estimator));
+        let log2_area = log2_areas(area_fractions);
+        let mut sums = self.sums.clone();
+        group.0.for_each_with_total(total.0, |i, j, c, x| {
+            let (i, j) = (i as usize, j as usize);
+            if i == j {
+                sums[i].lower_patch_outcome(2 * x, 2 * c, log2_area[i], &table);
+            } else {
+                sums[i].lower_patch_outcome(x, c, log2_area[j], &table);
+                sums[j].lower_patch_outcome(x, c, log2_area[i], &table);
+            }
+        });
+        for ((row, &e), &g) in sums.iter_mut().zip(total.1).zip(group.1) {
+            if g > 0 {
+                row.remove_escapes(e, &table);
+                row.add_escapes(e - g, &table);
+            }
+        }
+        Rows {
+            estimator: self.estimator,
+            sums,
+        }
+    }
+
     /// Each row's entropy over the patches (bits) by the rows' estimator; `None` for Chao–Shen.
     pub fn corrected_entropies(&self) -> Option<Vec<f64>> {
         self.sums
             .iter()
             .map(|r| r.corrected_entropy(self.estimator))
             .collect()
+    }
+}
+
+/// `log2 a_i`, read as 0 for a patch without area (it meets no line, so no count needs it).
+fn log2_areas(area_fractions: &[f64]) -> Vec<f64> {
+    area_fractions
+        .iter()
+        .map(|&a| if a > 0.0 { a.log2() } else { 0.0 })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sample::counts::pair_key;
+
+    /// Keys of pairs among `patches` patches, skewed so that counts range from 1 to thousands, with
+    /// self pairs.
+    fn keys(seed: u64, n: usize, patches: u32) -> Vec<u64> {
+        let mut rng = seed;
+        (0..n)
+            .map(|_| {
+                rng = rng
+                    .wrapping_mul(6364136223846793005)
+                    .wrapping_add(1442695040888963407);
+                let i = ((rng >> 33) % u64::from(patches)) as u32;
+                let j = if (rng >> 20) % 7 == 0 {
+                    i
+                } else {
+                    ((rng >> 45) % 4) as u32 * (i % 3)
+                };
+                pair_key(i, j)
+            })
+            .collect()
+    }
+
+    /// Lowering the total's rows by a group's counts gives the rows of the other groups' counts, for every
+    /// estimator with a one-pass kernel, in both count layouts.
+    #[test]
+    fn rows_without_a_group_are_the_rows_of_the_rest() {
+        for patches in [40u32, 3000] {
+            let (rest_keys, group_keys) = (keys(1, 20_000, patches), keys(2, 3_000, patches));
+            let n = patches as usize;
+            let areas: Vec<f64> = (0..n).map(|i| 1.0 + (i % 5) as f64).collect();
+            let a: Vec<f64> = areas
+                .iter()
+                .map(|x| x / areas.iter().sum::<f64>())
+                .collect();
+            let rest = PairCounts::from_keys(n, &mut rest_keys.clone());
+            let group = PairCounts::from_keys(n, &mut group_keys.clone());
+            let mut all = [rest_keys, group_keys.clone()].concat();
+            let total = PairCounts::from_keys(n, &mut all);
+            let mut rest_escapes = vec![0u64; n];
+            let mut group_escapes = vec![0u64; n];
+            (
+                rest_escapes[1],
+                rest_escapes[2],
+                group_escapes[2],
+                group_escapes[3],
+            ) = (5, 1, 1, 7);
+            let total_escapes: Vec<u64> = rest_escapes
+                .iter()
+                .zip(&group_escapes)
+                .map(|(r, g)| r + g)
+                .collect();
+            for estimator in [
+                EntropyEstimator::PlugIn,
+                EntropyEstimator::MillerMadow,
+                EntropyEstimator::Grassberger,
+                EntropyEstimator::ChaoWangJost,
+            ] {
+                let direct = Rows::gather(&a, &rest, &rest_escapes, estimator);
+                let lowered = Rows::gather(&a, &total, &total_escapes, estimator).without_group(
+                    &a,
+                    (&total, &total_escapes),
+                    (&group, &group_escapes),
+                );
+                for (i, (d, l)) in direct.sums.iter().zip(&lowered.sums).enumerate() {
+                    let close = |x: f64, y: f64| (x - y).abs() <= 1e-9 * x.abs().max(1.0);
+                    assert_eq!(
+                        (d.segments, d.escapes, d.seen, d.singletons, d.doubletons),
+                        (l.segments, l.escapes, l.seen, l.singletons, l.doubletons),
+                        "{estimator:?}, {patches} patches, row {i}"
+                    );
+                    assert!(
+                        close(d.x_log2_x, l.x_log2_x)
+                            && close(d.x_squared, l.x_squared)
+                            && close(d.x_log2_area, l.x_log2_area)
+                            && close(d.x_kernel, l.x_kernel),
+                        "{estimator:?}, {patches} patches, row {i}: {d:?} vs {l:?}"
+                    );
+                }
+                let (hd, hl) = (
+                    direct.corrected_entropies().unwrap(),
+                    lowered.corrected_entropies().unwrap(),
+                );
+                for (x, y) in hd.iter().zip(&hl) {
+                    assert!((x - y).abs() < 1e-9, "{estimator:?}: {x} vs {y}");
+                }
+            }
+        }
     }
 }

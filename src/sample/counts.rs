@@ -106,6 +106,30 @@ impl PairCounts {
         }
     }
 
+    /// Visits every non-zero entry `(i, j, N_ij, T_ij)` of these counts with `i <= j`, where `T_ij` is
+    /// the entry of `total`, counts of the same scene that include these (every pair here is in
+    /// `total`, with at least the same count).
+    pub fn for_each_with_total(&self, total: &PairCounts, mut f: impl FnMut(u32, u32, u64, u64)) {
+        match (self, total) {
+            (PairCounts::Dense(_), PairCounts::Dense(t)) => {
+                self.for_each(|i, j, c| f(i, j, c, t[[i as usize, j as usize]]));
+            }
+            (PairCounts::Sparse(list), PairCounts::Sparse(t)) => {
+                // Both sorted by key: one walk along the total.
+                let mut k = 0;
+                for &(key, c) in list {
+                    while t[k].0 < key {
+                        k += 1;
+                    }
+                    debug_assert_eq!(t[k].0, key, "a part's pair is in the total");
+                    let (i, j) = split_key(key);
+                    f(i, j, c, t[k].1);
+                }
+            }
+            _ => unreachable!("counts of one scene always share a layout"),
+        }
+    }
+
     /// Number of distinct unordered pairs seen.
     pub fn distinct_pairs(&self) -> usize {
         match self {
