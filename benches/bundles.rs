@@ -6,12 +6,18 @@
 //! wall-clock time; standard errors are averaged (as variances) over a few seeds, each with 64 groups.
 //!
 //! `cargo bench --bench bundles [-- SCENE... [LINES]]`, default `@cube:30 @cubes512` and 10^6 lines.
+//!
+//! Group standard errors are noisy and, for the plug-in and corrected I_s, not the real error in an
+//! undersampled regime, so with `SCX_BUNDLE_SEEDS=N` the bench instead runs N seeds of each line source
+//! (independent, 4 x 4 and 8 x 8 bundles; Embree single lines, 16 groups) and judges them by the spread
+//! of the estimates over the seeds, the direct measure of their error ([`spread`]).
 
 mod common;
 
 use std::time::Instant;
 
-use scene_complexity::analysis::{analyze, AnalysisConfig};
+use scene_complexity::analysis::{analyze, AnalysisConfig, VisibilityEstimates};
+use scene_complexity::measure::Estimate;
 use scene_complexity::sample::lines::LineSource;
 use scene_complexity::scene::{self, Scene};
 use scene_complexity::trace::{make_tracer, Backend, Query, Tracer};
@@ -22,6 +28,9 @@ const GROUPS: usize = 64;
 fn main() -> anyhow::Result<()> {
     let (specs, lines) = common::scenes_and_lines(1e6)?;
     let pool = rayon::ThreadPoolBuilder::new().num_threads(2).build()?;
+    if let Ok(seeds) = std::env::var("SCX_BUNDLE_SEEDS") {
+        return pool.install(|| spread(&specs, lines, seeds.parse()?));
+    }
     println!(
         "{lines} lines per run, 2 threads, {SEEDS} seeds x {GROUPS} groups; eff = stderr x sqrt(s), \
          relative to independent single lines (lower is better)"
@@ -126,4 +135,85 @@ fn print_row(spec: &str, query: &str, grid: u32, r: &Row, base: &Row) {
         rel(r.eff(r.var_mi, r.cpu), base.eff(base.var_mi, base.cpu)),
         rel(r.eff(r.var_mi, r.wall), base.eff(base.var_mi, base.wall)),
     );
+}
+
+/// Where an analysis keeps one of its estimates.
+type Pick = fn(&VisibilityEstimates) -> Option<Estimate>;
+
+/// The measures the seed-spread mode follows: name, and where an analysis keeps it.
+const FOLLOWED: [(&str, Pick); 4] = [
+    ("I_s^c", |v| v.continuous_mutual_information),
+    ("I_s", |v| v.mutual_information),
+    ("I_s corr.", |v| v.mutual_information_corrected),
+    ("E(MSE)", |v| v.mse_per_line),
+];
+
+/// Independent lines against 4 x 4 and 8 x 8 bundles over `seeds` seeds each (seed outermost, so that
+/// a drift of the machine's speed falls on every source alike). Per source and measure: the spread
+/// (sample standard deviation) of the estimate over the seeds with its own relative uncertainty
+/// 1/sqrt(2(n-1)), the rms reported standard error, the mean, and the figure of merit spread x
+/// sqrt(CPU seconds per run) relative to independent lines. A mean that moves between sources by more
+/// than a few of its standard errors (spread/sqrt(n)) is a change of the estimator's bias: the
+/// bias-corrected entropies depend on how the lines were drawn, not only on how many.
+fn spread(specs: &[String], lines: u64, seeds: u64) -> anyhow::Result<()> {
+    const GRIDS: [u32; 3] = [0, 4, 8];
+    println!("{lines} lines per run, 2 threads, Embree single lines, {seeds} seeds per source");
+    for spec in specs {
+        let scene = scene::load(spec)?;
+        let tracer = make_tracer(Backend::Embree, &scene, Query::Single)
+            .or_else(|_| make_tracer(Backend::Rust, &scene, Query::Single))?;
+        // values[grid][measure][seed], cpu seconds per grid.
+        let mut values = vec![vec![Vec::new(); FOLLOWED.len()]; GRIDS.len()];
+        let mut stderrs = vec![vec![Vec::new(); FOLLOWED.len()]; GRIDS.len()];
+        let mut cpu = [0.0; GRIDS.len()];
+        for seed in 1..=seeds {
+            for (g, &grid) in GRIDS.iter().enumerate() {
+                let cfg = AnalysisConfig {
+                    source: LineSource::bundles(grid).expect("grids from the list are valid"),
+                    ..AnalysisConfig::new(lines, seed)
+                };
+                let c0 = common::cpu_seconds();
+                let a = analyze(&scene, tracer.as_ref(), &cfg)?;
+                cpu[g] += common::cpu_seconds() - c0;
+                for (m, (_, of)) in FOLLOWED.iter().enumerate() {
+                    let e = of(&a.visibility).unwrap_or(Estimate {
+                        value: f64::NAN,
+                        stderr: None,
+                    });
+                    values[g][m].push(e.value);
+                    stderrs[g][m].push(e.stderr.unwrap_or(f64::NAN));
+                }
+            }
+        }
+        println!(
+            "{:<10} {:<10} {:>4} {:>7} {:>16} {:>10} {:>22} {:>6}",
+            "scene", "measure", "G", "cpu s", "spread (+-)", "rms se", "mean +- se", "merit"
+        );
+        for (m, (name, _)) in FOLLOWED.iter().enumerate() {
+            let base = sample_sd(&values[0][m]) * (cpu[0] / seeds as f64).sqrt();
+            for (g, &grid) in GRIDS.iter().enumerate() {
+                let v = &values[g][m];
+                let sd = sample_sd(v);
+                let n = v.len() as f64;
+                let rms = (stderrs[g][m].iter().map(|s| s * s).sum::<f64>() / n).sqrt();
+                let mean = v.iter().sum::<f64>() / n;
+                let seconds = cpu[g] / seeds as f64;
+                println!(
+                    "{spec:<10} {name:<10} {grid:>4} {seconds:>7.3} {:>10.3e} {:>4.0}% {rms:>10.3e} {:>12.6} {:>9.2e} {:>6.2}",
+                    sd,
+                    100.0 / (2.0 * (n - 1.0)).sqrt(),
+                    mean,
+                    sd / n.sqrt(),
+                    sd * seconds.sqrt() / base,
+                );
+            }
+        }
+    }
+    Ok(())
+}
+
+fn sample_sd(v: &[f64]) -> f64 {
+    let n = v.len() as f64;
+    let mean = v.iter().sum::<f64>() / n;
+    (v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0)).sqrt()
 }

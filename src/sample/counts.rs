@@ -386,8 +386,7 @@ fn sort_bucket(values: &mut [u64], bits: u32, scratch: &mut Vec<u64>) {
     for o in offsets.iter_mut() {
         (*o, sum) = (sum, sum + *o);
     }
-    scratch.clear();
-    scratch.resize(values.len(), 0);
+    let scratch = scratch_of_len(scratch, values.len());
     for &v in values.iter() {
         let p = part(v);
         scratch[offsets[p]] = v;
@@ -399,13 +398,22 @@ fn sort_bucket(values: &mut [u64], bits: u32, scratch: &mut Vec<u64>) {
         .for_each_init(Vec::new, |scratch, part| sort_bucket(part, shift, scratch));
 }
 
+/// The first `len` values of `scratch`, grown if need be. What it held is left there: every caller
+/// overwrites all `len` before reading, and zeroing a bucket's scratch on every sort cost ~2% of an
+/// analysis.
+fn scratch_of_len(scratch: &mut Vec<u64>, len: usize) -> &mut [u64] {
+    if scratch.len() < len {
+        scratch.resize(len, 0);
+    }
+    &mut scratch[..len]
+}
+
 /// Least-significant-digit radix sort of values below 2^bits, 11 bits per pass, in place; `scratch` is
 /// reused between calls.
 fn radix_sort(values: &mut [u64], bits: u32, scratch: &mut Vec<u64>) {
     const DIGIT: u32 = 11;
-    scratch.clear();
-    scratch.resize(values.len(), 0);
-    let (mut from, mut to): (&mut [u64], &mut [u64]) = (values, scratch.as_mut_slice());
+    let len = values.len();
+    let (mut from, mut to): (&mut [u64], &mut [u64]) = (values, scratch_of_len(scratch, len));
     let mut shift = 0;
     let mut passes = 0;
     while shift < bits {
