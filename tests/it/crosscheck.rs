@@ -2,8 +2,9 @@
 //! Embree is built in, the BVH against brute force always); a tracer with planted faults is caught on
 //! exactly the lines it spoils, by the right kind; the `scx crosscheck` command exits accordingly.
 
+use crate::support;
 #[cfg(feature = "cli")]
-use crate::support::scx;
+use support::scx;
 
 use scene_complexity::crosscheck::{
     compare_hits, crosscheck, CrossCheckConfig, DifferenceKind, Tolerance,
