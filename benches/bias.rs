@@ -3,7 +3,7 @@
 //!
 //! `cargo bench --bench bias -- [N,N,...] [LINES,LINES,...] [SEEDS]`, default `30` and `1e6,1e7,1e8`, 1 seed.
 
-#[path = "../tests/support/mod.rs"]
+#[path = "../tests/it/support.rs"]
 mod support;
 
 use scene_complexity::analysis::{analyze, AnalysisConfig};

@@ -251,6 +251,7 @@ pub fn cube_exact_measures(n: usize) -> (f64, f64) {
 }
 
 /// Runs the `scx` binary with `args`.
+#[cfg(feature = "cli")]
 pub fn scx(args: &[&str]) -> std::process::Output {
     std::process::Command::new(env!("CARGO_BIN_EXE_scx"))
         .args(args)

@@ -1,7 +1,7 @@
 //! Global lines and tracers against truth computed by hand: hits on chosen lines of `@cube:N`, even parity
 //! through edges and vertices of a closed mesh, and Crofton's formula for the uniformity of the lines.
 
-mod support;
+use crate::support;
 
 use rand::{Rng, SeedableRng};
 use scene_complexity::sample::lines::batch_lines;

@@ -1,7 +1,7 @@
 //! `scx reproduce` and the paper's scenes on the command line: the tables print beside the paper's
 //! values; bad tables, line plans and scene parameters are clear errors with exit code 2.
 
-mod support;
+use crate::support;
 
 use support::scx;
 

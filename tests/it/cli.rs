@@ -1,6 +1,6 @@
 //! The `scx` binary: JSON report fields, CSV, errors with exit code 2.
 
-mod support;
+use crate::support;
 
 use support::{json_of, scx};
 

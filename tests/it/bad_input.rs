@@ -2,7 +2,7 @@
 //! the line where it is known) and the problem, exit code 2, no panic and no report on stdout. A missing
 //! MTL library is the one warning-only case.
 
-mod support;
+use crate::support;
 
 use support::scx;
 

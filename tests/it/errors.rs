@@ -1,7 +1,7 @@
 //! Honest error bars: the standard errors scale as they should, cover the spread of independent runs, and
 //! the bias-corrected I_s is closer to the exact value than the plug-in.
 
-mod support;
+use crate::support;
 
 use scene_complexity::analysis::{analyze, Analysis, AnalysisConfig};
 use scene_complexity::measure::Estimate;

@@ -1,6 +1,6 @@
 //! The `scx` binary's radiosity report, `scx refine`, and its errors (exit code 2 naming file and material).
 
-mod support;
+use crate::support;
 
 use support::{json_of, scx};
 

@@ -1,7 +1,7 @@
 //! The visibility measures against independent truth: closed-form form factors of the unit cube, exact
 //! positional entropy, closure and reciprocity, thread and scale invariance.
 
-mod support;
+use crate::support;
 
 use scene_complexity::analysis::{analyze, Analysis, AnalysisConfig};
 use scene_complexity::measure::visibility::{for_each_form_factor, row_totals};

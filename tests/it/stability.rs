@@ -5,7 +5,7 @@
 //! Each test states the behaviour expected of scx and checks it against a closed form or an independent
 //! reference computed here (never against scx's own earlier output).
 
-mod support;
+use crate::support;
 
 use std::f64::consts::{LN_2, PI};
 
@@ -984,6 +984,7 @@ fn tiny_and_huge_scenes_give_the_same_results() {
 /// (`unsampled_patches`, and their area fraction, which for equal patches is their share of the count)
 /// with a warning, never silently dropped; every measure is still a finite number. The run keeps to
 /// seconds (the counts are sparse: memory follows the distinct pairs, not n_p^2).
+#[cfg(feature = "cli")]
 #[test]
 fn a_very_fine_mesh_with_few_lines_reports_its_unsampled_patches() {
     let started = std::time::Instant::now();
@@ -1200,6 +1201,7 @@ fn enclose_closes_open_scenes_consistently() {
 /// two front ends, an escape one; so escapes / (pairs + escapes) = 1 / (1 + (5 - 1) / 2) = 1/3 (Crofton).
 /// With `--enclose` the warning says the escapes became pairs with the environment, and the JSON gives
 /// its area.
+#[cfg(feature = "cli")]
 #[test]
 fn open_scenes_report_their_escapes_and_can_be_enclosed() {
     let dir = tempfile::tempdir().unwrap();

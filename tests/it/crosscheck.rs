@@ -2,7 +2,8 @@
 //! Embree is built in, the BVH against brute force always); a tracer with planted faults is caught on
 //! exactly the lines it spoils, by the right kind; the `scx crosscheck` command exits accordingly.
 
-mod support;
+use crate::support;
+#[cfg(feature = "cli")]
 use support::scx;
 
 use scene_complexity::crosscheck::{
@@ -152,7 +153,7 @@ fn embree_and_the_rust_bvh_agree_on_small_scenes() {
     }
 }
 
-#[cfg(feature = "embree")]
+#[cfg(all(feature = "embree", feature = "cli"))]
 #[test]
 fn the_command_passes_and_reports() {
     let out = scx(&["crosscheck", "@cube:3", "--lines", "2e4", "--threads", "2"]);
@@ -167,7 +168,7 @@ fn the_command_passes_and_reports() {
     assert!(text.contains("I_s^c"), "{text}");
 }
 
-#[cfg(not(feature = "embree"))]
+#[cfg(all(not(feature = "embree"), feature = "cli"))]
 #[test]
 fn without_embree_the_command_says_so() {
     let out = scx(&["crosscheck", "@cube:3", "--lines", "1e3"]);
@@ -175,6 +176,7 @@ fn without_embree_the_command_says_so() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("without Embree"));
 }
 
+#[cfg(feature = "cli")]
 #[test]
 fn bad_arguments_are_clear_errors() {
     let out = scx(&["crosscheck", "@nothing", "--lines", "1e3"]);

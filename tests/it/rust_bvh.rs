@@ -3,7 +3,7 @@
 //! through vertices and edges, on lines in the planes of walls, and on lines that start on a surface; and
 //! first hits equal to the first of the reference's hit lists.
 
-mod support;
+use crate::support;
 
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;

@@ -2,7 +2,7 @@
 //! with one emitting face solved from closed-form form factors, rows of the transition matrix, and the
 //! refinement strategies.
 
-mod support;
+use crate::support;
 
 use scene_complexity::analysis::{AnalysisConfig, RunControl};
 use scene_complexity::measure::radiosity::{

@@ -3,7 +3,7 @@
 //! (the correlation within a bundle is accounted for), and bit-identical results on 1 and 2 threads, also
 //! for a scene with sparse pair counts.
 
-mod support;
+use crate::support;
 
 use scene_complexity::analysis::{analyze, Analysis, AnalysisConfig};
 use scene_complexity::sample::lines::LineSource;

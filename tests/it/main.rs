@@ -1,0 +1,30 @@
+//! scx's integration tests: one test binary (the library and Embree are linked once), one module per
+//! concern. Modules that run the `scx` binary need the `cli` feature; the Embree backend's need `embree`.
+
+mod support;
+
+// The library against independent truth.
+mod bundles;
+mod crosscheck;
+#[cfg(feature = "embree")]
+mod embree_backend;
+mod errors;
+mod lines_and_tracers;
+mod paper;
+mod radiosity;
+mod rust_bvh;
+mod stability;
+mod visibility;
+
+// The `scx` binary.
+#[cfg(feature = "cli")]
+mod bad_input;
+#[cfg(feature = "cli")]
+mod cli;
+#[cfg(feature = "cli")]
+mod cli_radiosity;
+#[cfg(feature = "cli")]
+mod cli_reproduce;
+
+// The source's structure.
+mod layers;
