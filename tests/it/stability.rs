@@ -821,7 +821,6 @@ fn lines_through_stiff_vertices_and_edges_keep_parity() {
             t_max: 5.0,
         });
     }
-    let started = std::time::Instant::now();
     for tracer in support::all_tracers(&scene) {
         let hits = trace(tracer.as_ref(), &lines);
         for (i, line) in lines.iter().enumerate() {
@@ -842,11 +841,6 @@ fn lines_through_stiff_vertices_and_edges_keep_parity() {
             );
         }
     }
-    assert!(
-        started.elapsed().as_secs_f64() < 10.0,
-        "{:?}",
-        started.elapsed()
-    );
 
     let tris = icosphere(2);
     let scene = nested_spheres(&tris, 1e-5);
@@ -982,12 +976,11 @@ fn tiny_and_huge_scenes_give_the_same_results() {
 /// p = A / (2 pi) (Crofton), and each crossing leaves it once towards the inside, so it stays unsampled
 /// with probability (1 - p)^lines: about 88% of the patches here. They are reported
 /// (`unsampled_patches`, and their area fraction, which for equal patches is their share of the count)
-/// with a warning, never silently dropped; every measure is still a finite number. The run keeps to
-/// seconds (the counts are sparse: memory follows the distinct pairs, not n_p^2).
+/// with a warning, never silently dropped; every measure is still a finite number (the counts are
+/// sparse: memory follows the distinct pairs, not n_p^2; its speed is a benchmark matter, not a test's).
 #[cfg(feature = "cli")]
 #[test]
 fn a_very_fine_mesh_with_few_lines_reports_its_unsampled_patches() {
-    let started = std::time::Instant::now();
     let out = std::process::Command::new(env!("CARGO_BIN_EXE_scx"))
         .args([
             "analyze",
@@ -1001,7 +994,6 @@ fn a_very_fine_mesh_with_few_lines_reports_its_unsampled_patches() {
         ])
         .output()
         .unwrap();
-    let seconds = started.elapsed().as_secs_f64();
     assert!(
         out.status.success(),
         "{}",
@@ -1035,7 +1027,6 @@ fn a_very_fine_mesh_with_few_lines_reports_its_unsampled_patches() {
             assert!(m["value"].as_f64().unwrap().is_finite(), "{k}: {m}");
         }
     }
-    assert!(seconds < 30.0, "{seconds} s");
 }
 
 // ------------------------------------------------------------------------------------------------
