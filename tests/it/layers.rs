@@ -432,7 +432,10 @@ impl Resolver {
             }
         };
         for seg in rest {
-            let child = (base.0, [base.1.as_slice(), &[seg.clone()]].concat());
+            let child = (
+                base.0,
+                [base.1.as_slice(), std::slice::from_ref(seg)].concat(),
+            );
             if self.modules.contains(&child) {
                 base = child;
             } else {
