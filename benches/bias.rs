@@ -7,7 +7,8 @@
 mod support;
 
 use scene_complexity::analysis::{analyze, AnalysisConfig};
-use scene_complexity::measure::bias::{corrected, EntropyEstimator};
+use scene_complexity::measure::bias::corrected;
+use scene_complexity::measure::estimators::EntropyEstimator;
 use scene_complexity::sample::tally::Wanted;
 use scene_complexity::scene;
 use scene_complexity::trace::{make_tracer, Backend, Query};

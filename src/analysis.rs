@@ -12,7 +12,9 @@
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::time::{Duration, Instant};
 
-use crate::measure::bias::{self, CorrectedValues, EntropyEstimator};
+use crate::measure::bias::{self, CorrectedValues};
+use crate::measure::channel;
+use crate::measure::estimators::EntropyEstimator;
 use crate::measure::rows::Rows;
 use crate::measure::visibility::{self, ContinuousValues, DiscreteValues};
 use crate::measure::Estimate;
@@ -326,7 +328,7 @@ impl GroupValues {
         // One pass over the counts serves both the plug-in and the corrected measures.
         let (discrete, corrected) = counted
             .map(|c| {
-                let a = visibility::area_distribution(areas);
+                let a = channel::area_distribution(areas);
                 let a = a.as_slice().expect("a fresh array is contiguous");
                 let rows = Rows::gather(a, c, &t.escapes_by_patch, estimator);
                 (
@@ -688,7 +690,7 @@ fn jackknife_replicates(
     }
     let total_counts = total.counts.as_ref()?;
     let areas: Vec<f64> = scene.patches.iter().map(|p| p.area).collect();
-    let a = visibility::area_distribution(&areas);
+    let a = channel::area_distribution(&areas);
     let a = a.as_slice()?;
     let rows = Rows::gather(a, total_counts, &total.escapes_by_patch, estimator);
     groups
@@ -734,7 +736,7 @@ fn merge_tree(mut tallies: Vec<Tally>) -> Option<Tally> {
 }
 
 fn positional_entropy(areas: &[f64]) -> f64 {
-    -visibility::area_distribution(areas)
+    -channel::area_distribution(areas)
         .iter()
         .map(|&x| crate::measure::entropy::xlog2x(x))
         .sum::<f64>()

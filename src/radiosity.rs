@@ -7,7 +7,8 @@
 //! the group values gives the batch-means standard error of the full-run values.
 
 use crate::analysis::{analyze_observed, analyze_with, Analysis, AnalysisConfig, RunControl};
-use crate::measure::bias::{row_corrections, EntropyEstimator};
+use crate::measure::bias::row_corrections;
+use crate::measure::estimators::EntropyEstimator;
 use crate::measure::radiosity::{
     self, FormFactors, MaterialError, PatchMaterials, RadiosityValues, SolveError, SolveOptions,
 };

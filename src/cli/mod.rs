@@ -16,7 +16,7 @@ use scene_complexity::analysis::{
     DEFAULT_ESTIMATOR, DEFAULT_GROUPS,
 };
 use scene_complexity::crosscheck::{self, CrossCheckConfig, Tolerance};
-use scene_complexity::measure::bias::EntropyEstimator;
+use scene_complexity::measure::estimators::EntropyEstimator;
 use scene_complexity::measure::radiosity::SolveOptions;
 use scene_complexity::radiosity::{analyze_with_radiosity, RadiosityOutcome};
 use scene_complexity::refine::{refine, RefineConfig, RefineRound, Strategy};

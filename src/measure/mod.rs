@@ -3,8 +3,10 @@
 //! Logarithms are base 2 (bits). `0 log 0 = 0` everywhere ([`entropy::xlog2x`]).
 
 pub mod bias;
+pub mod channel;
 pub mod entropy;
 pub mod estimate;
+pub mod estimators;
 pub mod radiosity;
 pub mod rows;
 pub mod visibility;

@@ -23,8 +23,8 @@
 
 use ndarray::Array1;
 
+use super::channel::{for_each_form_factor, row_totals};
 use super::entropy::xlog2x;
-use super::visibility::{for_each_form_factor, row_totals};
 use crate::sample::counts::PairCounts;
 use crate::scene::Scene;
 

@@ -6,10 +6,9 @@
 //! escaping an open scene), so a row sums to 1 in a closed scene and reciprocity `A_i F_ij = A_j F_ji`
 //! holds up to sampling error.
 
-use ndarray::Array1;
-
-use super::bias::EntropyEstimator;
+use super::channel::area_distribution;
 use super::entropy::xlog2x;
+use super::estimators::EntropyEstimator;
 use super::rows::{RowSums, Rows};
 use crate::sample::counts::PairCounts;
 
@@ -46,45 +45,6 @@ impl ContinuousValues {
             mutual_information: sum / pairs as f64,
         })
     }
-}
-
-/// Area distribution `a_i = A_i / A_T`.
-pub fn area_distribution(areas: &[f64]) -> Array1<f64> {
-    let a = Array1::from(areas.to_vec());
-    let total = a.sum();
-    a / total
-}
-
-/// `N_i`: segments leaving each patch's front side (pair counts in both directions plus escapes).
-pub fn row_totals(patches: usize, counts: &PairCounts, escapes: &[u64]) -> Array1<f64> {
-    let mut n = Array1::<f64>::zeros(patches);
-    counts.for_each(|i, j, c| {
-        n[i as usize] += c as f64;
-        n[j as usize] += c as f64;
-    });
-    for (t, &e) in n.iter_mut().zip(escapes) {
-        *t += e as f64;
-    }
-    n
-}
-
-/// Visits every estimated form factor `(i, j, F_ij)` with `F_ij > 0` (both directions of each pair).
-pub fn for_each_form_factor(
-    counts: &PairCounts,
-    row_totals: &Array1<f64>,
-    mut f: impl FnMut(usize, usize, f64),
-) {
-    counts.for_each(|i, j, c| {
-        let (i, j) = (i as usize, j as usize);
-        let c = c as f64;
-        if i == j {
-            // One segment from a patch back to itself enters N_ii twice (i -> j and j -> i).
-            f(i, i, 2.0 * c / row_totals[i]);
-        } else {
-            f(i, j, c / row_totals[i]);
-            f(j, i, c / row_totals[j]);
-        }
-    });
 }
 
 /// The discrete measures from the patch areas, the pair counts and the escapes per patch.
@@ -130,6 +90,7 @@ pub fn discrete_from_rows(a: &[f64], rows: &[RowSums]) -> DiscreteValues {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::measure::channel::{for_each_form_factor, row_totals};
     use crate::sample::counts::pair_key;
 
     /// Two facing patches of equal area that only see each other: F_01 = F_10 = 1, so H_s = 0 and

@@ -3,8 +3,8 @@
 
 use rayon::prelude::*;
 
+use crate::measure::channel::row_totals;
 use crate::measure::radiosity::{FormFactors, Solution};
-use crate::measure::visibility::row_totals;
 use crate::sample::counts::pair_key;
 use crate::sample::counts::PairCounts;
 use crate::sample::lines::batch_lines;

@@ -12,7 +12,7 @@ use std::f64::consts::{LN_2, PI};
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
 use scene_complexity::analysis::{analyze, Analysis, AnalysisConfig};
-use scene_complexity::measure::visibility::row_totals;
+use scene_complexity::measure::channel::row_totals;
 use scene_complexity::sample::pairs::{segments, Segment};
 use scene_complexity::scene::{self, Material, Scene, SceneBuilder};
 use scene_complexity::trace::{make_tracer, Backend, Line, LineHits, Query, Tracer};
@@ -1123,9 +1123,7 @@ fn enclose_closes_open_scenes_consistently() {
     let counts = t.counts.as_ref().unwrap();
     let rows = row_totals(n, counts, &t.escapes_by_patch);
     let mut f = vec![vec![0.0; n]; n];
-    scene_complexity::measure::visibility::for_each_form_factor(counts, &rows, |i, j, v| {
-        f[i][j] = v
-    });
+    scene_complexity::measure::channel::for_each_form_factor(counts, &rows, |i, j, v| f[i][j] = v);
     for (i, row) in f.iter().enumerate() {
         assert!((row.iter().sum::<f64>() - 1.0).abs() < 1e-12, "row {i}");
     }
@@ -1164,9 +1162,7 @@ fn enclose_closes_open_scenes_consistently() {
     let counts = t.counts.as_ref().unwrap();
     let rows = row_totals(6, counts, &t.escapes_by_patch);
     let mut f = vec![vec![0.0; 6]; 6];
-    scene_complexity::measure::visibility::for_each_form_factor(counts, &rows, |i, j, v| {
-        f[i][j] = v
-    });
+    scene_complexity::measure::channel::for_each_form_factor(counts, &rows, |i, j, v| f[i][j] = v);
     for (i, row) in f.iter().enumerate() {
         assert!((row.iter().sum::<f64>() - 1.0).abs() < 1e-12, "row {i}");
     }

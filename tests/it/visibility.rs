@@ -4,7 +4,7 @@
 use crate::support;
 
 use scene_complexity::analysis::{analyze, Analysis, AnalysisConfig};
-use scene_complexity::measure::visibility::{for_each_form_factor, row_totals};
+use scene_complexity::measure::channel::{for_each_form_factor, row_totals};
 use scene_complexity::sample::tally::Wanted;
 use scene_complexity::scene::{self, Scene};
 use scene_complexity::trace::Tracer;
