@@ -6,10 +6,10 @@
 #[path = "../tests/it/support.rs"]
 mod support;
 
-use scene_complexity::analysis::{analyze, AnalysisConfig};
 use scene_complexity::measure::bias::corrected;
 use scene_complexity::measure::estimators::EntropyEstimator;
-use scene_complexity::sample::tally::Wanted;
+use scene_complexity::run::Measures;
+use scene_complexity::run::{analyze, AnalysisConfig, RunControl};
 use scene_complexity::scene;
 use scene_complexity::trace::{make_tracer, Backend, Query};
 
@@ -41,13 +41,14 @@ fn main() {
         for &lines in &line_counts {
             for seed in 1..=seeds {
                 let cfg = AnalysisConfig {
-                    wanted: Wanted {
+                    measures: Measures {
                         discrete: true,
                         continuous: false,
+                        radiosity: false,
                     },
                     ..AnalysisConfig::new(lines as u64, seed)
                 };
-                let a = analyze(&scene, tracer.as_ref(), &cfg).unwrap();
+                let a = analyze(&scene, tracer.as_ref(), &cfg, &RunControl::default()).unwrap();
                 let counts = a.tally.counts.as_ref().unwrap();
                 print!(
                     "{:>4} {:>10.0e} {:>9.5} {:>8.2}",

@@ -16,8 +16,8 @@ mod common;
 
 use std::time::Instant;
 
-use scene_complexity::analysis::{analyze, AnalysisConfig, VisibilityEstimates};
 use scene_complexity::measure::Estimate;
+use scene_complexity::run::{analyze, AnalysisConfig, RunControl, VisibilityEstimates};
 use scene_complexity::sample::lines::LineSource;
 use scene_complexity::scene::{self, Scene};
 use scene_complexity::trace::{make_tracer, Backend, Query, Tracer};
@@ -109,7 +109,7 @@ fn measure(scene: &Scene, tracer: &dyn Tracer, lines: u64, grid: u32) -> Row {
     };
     for seed in 1..=SEEDS {
         let (w0, c0) = (Instant::now(), common::cpu_seconds());
-        let a = analyze(scene, tracer, &cfg(seed)).expect("analysis runs");
+        let a = analyze(scene, tracer, &cfg(seed), &RunControl::default()).expect("analysis runs");
         row.wall += w0.elapsed().as_secs_f64();
         row.cpu += common::cpu_seconds() - c0;
         row.lines += a.lines as f64;
@@ -173,7 +173,7 @@ fn spread(specs: &[String], lines: u64, seeds: u64) -> anyhow::Result<()> {
                     ..AnalysisConfig::new(lines, seed)
                 };
                 let c0 = common::cpu_seconds();
-                let a = analyze(&scene, tracer.as_ref(), &cfg)?;
+                let a = analyze(&scene, tracer.as_ref(), &cfg, &RunControl::default())?;
                 cpu[g] += common::cpu_seconds() - c0;
                 for (m, (_, of)) in FOLLOWED.iter().enumerate() {
                     let e = of(&a.visibility).unwrap_or(Estimate {

@@ -14,9 +14,9 @@ mod common;
 use std::time::Instant;
 
 use rayon::prelude::*;
-use scene_complexity::analysis::{analyze, AnalysisConfig, DEFAULT_GROUPS};
+use scene_complexity::run::{analyze, AnalysisConfig, RunControl, DEFAULT_GROUPS};
+use scene_complexity::run::{BatchPlan, Measures};
 use scene_complexity::sample::lines::batch_lines;
-use scene_complexity::sample::tally::{BatchPlan, Wanted};
 use scene_complexity::scene;
 use scene_complexity::trace::{make_tracer, Backend, Line, LineHits, Query, Tracer};
 
@@ -75,9 +75,10 @@ fn bench_scene(spec: &str, count: u64, pools: &[rayon::ThreadPool]) -> anyhow::R
     };
     // `--measures continuous`: I_s^c alone, no pair counts (what a run needs when it wants only eq. 27).
     let continuous = AnalysisConfig {
-        wanted: Wanted {
+        measures: Measures {
             discrete: false,
             continuous: true,
+            radiosity: false,
         },
         ..cfg
     };
@@ -96,12 +97,12 @@ fn bench_scene(spec: &str, count: u64, pools: &[rayon::ThreadPool]) -> anyhow::R
             let drawn = pool.install(|| best(|| draw_and_trace_pass(t, count)));
             let end_to_end = pool.install(|| {
                 best(|| {
-                    analyze(&scene, t, &cfg).unwrap();
+                    analyze(&scene, t, &cfg, &RunControl::default()).unwrap();
                 })
             });
             let continuous_only = pool.install(|| {
                 best(|| {
-                    analyze(&scene, t, &continuous).unwrap();
+                    analyze(&scene, t, &continuous, &RunControl::default()).unwrap();
                 })
             });
             let rate = |s: f64| count as f64 / s / 1e6;

@@ -7,9 +7,9 @@
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use rayon::prelude::*;
-use scene_complexity::analysis::{analyze, AnalysisConfig};
+use scene_complexity::run::Measures;
+use scene_complexity::run::{analyze, AnalysisConfig, RunControl};
 use scene_complexity::sample::lines::LineSource;
-use scene_complexity::sample::tally::Wanted;
 use scene_complexity::scene::{self, Scene};
 use scene_complexity::trace::rust::BruteForceTracer;
 use scene_complexity::trace::{make_tracer, Backend, Line, LineHits, Query, Tracer};
@@ -116,15 +116,16 @@ fn bench_analysis(c: &mut Criterion) {
         g.throughput(Throughput::Elements(LINES as u64));
         g.sample_size(10);
         let cfg = AnalysisConfig {
-            wanted: Wanted {
+            measures: Measures {
                 discrete: true,
                 continuous: true,
+                radiosity: false,
             },
             ..AnalysisConfig::new(LINES as u64, 1)
         };
         for (name, t) in tracers(&scene) {
             g.bench_function(BenchmarkId::from_parameter(&name), |b| {
-                b.iter(|| analyze(&scene, t.as_ref(), &cfg).unwrap())
+                b.iter(|| analyze(&scene, t.as_ref(), &cfg, &RunControl::default()).unwrap())
             });
         }
         g.finish();

@@ -14,14 +14,13 @@
 
 use std::fmt;
 
-use rayon::prelude::*;
-
-use crate::analysis::{analyze, Analysis, AnalysisConfig};
 use crate::measure::Estimate;
-use crate::sample::lines::batch_lines;
-use crate::sample::tally::BatchPlan;
+use crate::run::{
+    analyze, map_batches, Analysis, AnalysisConfig, AnalysisError, Batch, LineStream, Measures,
+    RunControl, TraceBuffers,
+};
 use crate::scene::Scene;
-use crate::trace::{Hit, Line, LineHits, RawHit, TraceError, Tracer};
+use crate::trace::{Hit, Line, TraceError, Tracer};
 
 /// How far apart two hits' distances may be and still agree.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -162,13 +161,11 @@ fn compare_line(
     (beyond.then_some(DifferenceKind::Distance), worst)
 }
 
-/// Per-thread buffers.
+/// Per-thread buffers: one tracer's hits each.
 #[derive(Default)]
 struct Buffers {
-    lines: Vec<Line>,
-    raw: Vec<RawHit>,
-    a: LineHits,
-    b: LineHits,
+    a: TraceBuffers,
+    b: TraceBuffers,
 }
 
 /// What to compare and how much to keep.
@@ -192,13 +189,14 @@ pub fn compare_hits(
     b: &dyn Tracer,
     cfg: &CrossCheckConfig,
 ) -> Result<HitComparison, TraceError> {
-    let plan = BatchPlan::new(cfg.lines);
-    let parts: Vec<HitComparison> = (0..plan.batches())
-        .into_par_iter()
-        .map_init(Buffers::default, |buf, batch| {
-            compare_batch(scene, a, b, cfg, &plan, batch, buf)
-        })
-        .collect::<Result<_, _>>()?;
+    let stream = LineStream::independent(cfg.lines, cfg.seed);
+    let (parts, _) = map_batches(
+        &stream,
+        scene.bounding_radius(),
+        0..stream.plan.batches(),
+        &|_| false,
+        |buf: &mut Buffers, batch| compare_batch(scene, a, b, cfg, batch, buf),
+    )?;
     let mut total = HitComparison::empty((a.name(), b.name()), cfg.tolerance);
     for p in parts {
         total.merge(p, cfg.examples);
@@ -211,35 +209,26 @@ fn compare_batch(
     a: &dyn Tracer,
     b: &dyn Tracer,
     cfg: &CrossCheckConfig,
-    plan: &BatchPlan,
-    batch: u64,
+    batch: Batch<'_>,
     buf: &mut Buffers,
 ) -> Result<HitComparison, TraceError> {
-    buf.lines.clear();
-    let count = plan.batch_len(batch);
-    batch_lines(
-        cfg.seed,
-        batch,
-        count,
-        scene.bounding_radius(),
-        &mut buf.lines,
-    );
-    a.all_hits(&buf.lines, &mut buf.raw, &mut buf.a)?;
-    b.all_hits(&buf.lines, &mut buf.raw, &mut buf.b)?;
+    buf.a.trace(a, batch.lines)?;
+    buf.b.trace(b, batch.lines)?;
+    let (hits_a, hits_b) = (&buf.a.hits, &buf.b.hits);
+    let count = batch.lines.len();
     let mut part = HitComparison::empty((a.name(), b.name()), cfg.tolerance);
     part.lines = count as u64;
-    part.hits = (buf.a.hits.len() as u64, buf.b.hits.len() as u64);
-    let first_index = batch * plan.batch_size;
+    part.hits = (hits_a.hits.len() as u64, hits_b.hits.len() as u64);
     for k in 0..count {
-        let (ra, rb) = (buf.a.of_line(k), buf.b.of_line(k));
+        let (ra, rb) = (hits_a.of_line(k), hits_b.of_line(k));
         let (kind, ulps) = compare_line(scene, ra, rb, cfg.tolerance);
         part.max_ulps = part.max_ulps.max(ulps);
         let Some(kind) = kind else { continue };
         part.differing[kind as usize] += 1;
         if part.examples.len() < cfg.examples {
             part.examples.push(LineDifference {
-                index: first_index + k as u64,
-                line: buf.lines[k],
+                index: batch.first_line + k as u64,
+                line: batch.lines[k],
                 kind,
                 a: ra.to_vec(),
                 b: rb.to_vec(),
@@ -282,9 +271,10 @@ pub fn compare_measures(
     a: &dyn Tracer,
     b: &dyn Tracer,
     cfg: &AnalysisConfig,
-) -> Result<Vec<MeasureComparison>, TraceError> {
-    let ra = analyze(scene, a, cfg)?;
-    let rb = analyze(scene, b, cfg)?;
+) -> Result<Vec<MeasureComparison>, AnalysisError> {
+    let control = RunControl::default();
+    let ra = analyze(scene, a, cfg, &control)?;
+    let rb = analyze(scene, b, cfg, &control)?;
     Ok(measures(&ra)
         .into_iter()
         .zip(measures(&rb))
@@ -328,10 +318,11 @@ pub fn crosscheck(
     b: &dyn Tracer,
     cfg: &CrossCheckConfig,
     groups: usize,
-) -> Result<CrossCheck, TraceError> {
+) -> Result<CrossCheck, AnalysisError> {
     let hits = compare_hits(scene, a, b, cfg)?;
     let analysis = AnalysisConfig {
         groups,
+        measures: Measures::VISIBILITY,
         ..AnalysisConfig::new(cfg.lines, cfg.seed)
     };
     let measures = compare_measures(scene, a, b, &analysis)?;

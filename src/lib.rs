@@ -6,12 +6,11 @@
 
 #![forbid(unsafe_op_in_unsafe_fn)]
 
-pub mod analysis;
 pub mod crosscheck;
 pub mod measure;
-pub mod radiosity;
 pub mod refine;
 pub mod reproduce;
+pub mod run;
 pub mod sample;
 pub mod scene;
 pub mod trace;

@@ -3,8 +3,8 @@
 
 use std::fmt::Write as _;
 
-use scene_complexity::analysis::Analysis;
 use scene_complexity::measure::Estimate;
+use scene_complexity::run::Analysis;
 
 use super::plot::{self, Curve};
 use super::report::{self, Row};
@@ -81,7 +81,7 @@ pub fn run(args: &ConvergenceArgs) -> Result<(), Failure> {
             append_csv(&mut csv, &a, r);
             // The counts are not needed any more; keep the measures only.
             a.tally.counts = None;
-            let interrupted = a.stop_reason != scene_complexity::analysis::StopReason::Lines;
+            let interrupted = a.stop_reason != scene_complexity::run::StopReason::Lines;
             runs.push(a);
             if interrupted {
                 break;
@@ -180,9 +180,7 @@ fn curves(levels: &[Level]) -> Vec<Curve> {
 
 fn table(runner: &Runner, levels: &[Level], repeats: u32) -> String {
     let mut s = String::new();
-    let skipped =
-        scene_complexity::radiosity::RadiosityOutcome::Skipped("not part of convergence".into());
-    let info = runner.info(&skipped);
+    let info = runner.info();
     let _ = writeln!(
         s,
         "scene {} ({} patches), tracer {}, {} thread(s), {repeats} run(s) per line count (means shown)\n",

@@ -11,17 +11,15 @@ use std::sync::Arc;
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand, ValueEnum};
-use scene_complexity::analysis::{
-    analyze_with, Analysis, AnalysisConfig, Budget, ErrorMethod, RunControl, Target, TargetMeasure,
-    DEFAULT_ESTIMATOR, DEFAULT_GROUPS,
-};
 use scene_complexity::crosscheck::{self, CrossCheckConfig, Tolerance};
 use scene_complexity::measure::estimators::EntropyEstimator;
 use scene_complexity::measure::radiosity::SolveOptions;
-use scene_complexity::radiosity::{analyze_with_radiosity, RadiosityOutcome};
 use scene_complexity::refine::{refine, RefineConfig, RefineRound, Strategy};
+use scene_complexity::run::{
+    analyze, Analysis, AnalysisConfig, Budget, ErrorMethod, Measures, RunControl, Target,
+    TargetMeasure, DEFAULT_ESTIMATOR, DEFAULT_GROUPS,
+};
 use scene_complexity::sample::lines::LineSource;
-use scene_complexity::sample::tally::Wanted;
 use scene_complexity::scene::{self, builtin};
 use scene_complexity::trace::{make_tracer, Backend, Query};
 
@@ -394,30 +392,7 @@ impl Runner {
     fn analyze(&self, cfg: &AnalysisConfig, total: Option<u64>) -> Result<Analysis, Failure> {
         progress::while_running(&self.control, total, || {
             self.pool
-                .install(|| analyze_with(&self.scene, self.tracer.as_ref(), cfg, &self.control))
-        })
-        .map_err(|e| Failure {
-            code: 1,
-            message: e.to_string(),
-        })
-    }
-
-    /// Runs one analysis with the radiosity measures (when the scene emits) and a progress bar.
-    fn analyze_radiosity(
-        &self,
-        cfg: &AnalysisConfig,
-        total: Option<u64>,
-    ) -> Result<(Analysis, RadiosityOutcome), Failure> {
-        progress::while_running(&self.control, total, || {
-            self.pool.install(|| {
-                analyze_with_radiosity(
-                    &self.scene,
-                    self.tracer.as_ref(),
-                    cfg,
-                    &SolveOptions::default(),
-                    &self.control,
-                )
-            })
+                .install(|| analyze(&self.scene, self.tracer.as_ref(), cfg, &self.control))
         })
         .map_err(|e| Failure {
             code: if e.is_bad_input() { 2 } else { 1 },
@@ -425,20 +400,20 @@ impl Runner {
         })
     }
 
-    fn info<'a>(&'a self, radiosity: &'a RadiosityOutcome) -> report::RunInfo<'a> {
+    fn info(&self) -> report::RunInfo<'_> {
         report::RunInfo {
             scene: &self.scene,
             tracer: self.tracer.name(),
             query: self.query,
             threads: self.threads,
-            radiosity,
             bundle: 0,
         }
     }
 
-    /// A config for `lines` lines with these options.
+    /// A config for `lines` lines with these options (the visibility measures).
     fn config(&self, opts: &RunOptions, lines: u64, seed: u64) -> AnalysisConfig {
         AnalysisConfig {
+            measures: Measures::VISIBILITY,
             groups: usize::from(opts.groups),
             estimator: opts.estimator,
             errors: opts.errors,
@@ -449,14 +424,12 @@ impl Runner {
 
 fn try_analyze(args: &AnalyzeArgs) -> Result<(), Failure> {
     let runner = Runner::new(&args.scene, &args.run)?;
-    let wanted = match &args.measures {
-        None => Wanted {
-            discrete: true,
-            continuous: true,
-        },
-        Some(m) => Wanted {
+    let measures = match &args.measures {
+        None => Measures::ALL,
+        Some(m) => Measures {
             discrete: m.contains(&MeasureArg::Discrete),
             continuous: m.contains(&MeasureArg::Continuous),
+            radiosity: m.contains(&MeasureArg::Radiosity),
         },
     };
     let budget = Budget {
@@ -466,41 +439,32 @@ fn try_analyze(args: &AnalyzeArgs) -> Result<(), Failure> {
             stderr,
         }),
     };
-    let open_ended = budget.seconds.is_some() || budget.target.is_some();
+    let open_ended = budget.is_open_ended();
     let lines = args.lines.unwrap_or(if open_ended {
         1_000_000_000_000
     } else {
         1_000_000
     });
     let cfg = AnalysisConfig {
-        wanted,
+        measures,
         budget,
         source: LineSource::bundles(args.bundle).map_err(bad_input)?,
         enclose: args.enclose,
         ..runner.config(&args.run, lines, args.run.seed)
     };
-    let want_radiosity = args
-        .measures
-        .as_ref()
-        .is_none_or(|m| m.contains(&MeasureArg::Radiosity));
     let total = (!open_ended).then_some(lines);
-    let (analysis, radiosity) = if want_radiosity {
-        runner.analyze_radiosity(&cfg, total)?
-    } else {
-        let why = "not requested (--measures leaves radiosity out)".to_string();
-        (runner.analyze(&cfg, total)?, RadiosityOutcome::Skipped(why))
-    };
-    for w in report::warnings(&runner.scene, &analysis) {
+    let analysis = runner.analyze(&cfg, total)?;
+    for w in &analysis.warnings {
         eprintln!("scx: warning: {w}");
     }
     let run = report::RunInfo {
         bundle: args.bundle,
-        ..runner.info(&radiosity)
+        ..runner.info()
     };
     let text = match args.format {
         Format::Table => report::table(&run, &analysis),
         Format::Json => report::json(&run, &analysis),
-        Format::Csv => report::csv(&run, &analysis),
+        Format::Csv => report::csv(&analysis),
     };
     write_stdout(&text)
 }
@@ -590,7 +554,7 @@ fn try_crosscheck(args: &CrosscheckArgs) -> Result<(), Failure> {
             crosscheck::crosscheck(&scene, embree.as_ref(), rust.as_ref(), &cfg, DEFAULT_GROUPS)
         })
         .map_err(|e| Failure {
-            code: 1,
+            code: if e.is_bad_input() { 2 } else { 1 },
             message: e.to_string(),
         })?;
     write_stdout(&crosscheck::report(&check, &scene))?;

@@ -5,7 +5,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
 
 use indicatif::{ProgressBar, ProgressStyle};
-use scene_complexity::analysis::RunControl;
+use scene_complexity::run::RunControl;
 
 /// How long a run goes before its progress bar appears.
 const QUIET_FOR: Duration = Duration::from_millis(800);

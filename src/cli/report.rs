@@ -2,9 +2,10 @@
 
 use std::fmt::Write;
 
-use scene_complexity::analysis::{Analysis, ErrorMethod, StopReason};
 use scene_complexity::measure::Estimate;
-use scene_complexity::radiosity::{RadiosityEstimates, RadiosityOutcome};
+use scene_complexity::run::{
+    Analysis, ErrorMethod, RadiosityEstimates, RadiosityOutcome, StopReason,
+};
 use scene_complexity::scene::Scene;
 use scene_complexity::trace::Query;
 use serde_json::{json, Value};
@@ -18,8 +19,6 @@ pub struct RunInfo<'a> {
     pub tracer: &'static str,
     pub query: Query,
     pub threads: usize,
-    /// The radiosity measures, or why they were left out.
-    pub radiosity: &'a RadiosityOutcome,
     /// Lines per side of a bundle, 0 for independent lines.
     pub bundle: u32,
 }
@@ -103,55 +102,6 @@ pub(super) fn measures(a: &Analysis) -> Vec<Row> {
     ]
 }
 
-/// Warnings a user must see about a run's numbers.
-pub fn warnings(scene: &Scene, a: &Analysis) -> Vec<String> {
-    let mut w = Vec::new();
-    if let Some(fraction) = escape_fraction(a).filter(|&f| f > 0.0) {
-        let effect = match a.environment_area {
-            Some(env) => format!(
-                "with --enclose they are pairs with the environment patch (area {:.6} scene units^2), and \
-                 the measures are those of the enclosed scene",
-                env.value
-            ),
-            None => "so form-factor rows sum to less than 1 (--enclose closes the scene)".into(),
-        };
-        w.push(format!(
-            "{}: the scene is open: {:.3}% of the segments leaving a front side escape the scene; {effect}",
-            scene.name,
-            100.0 * fraction
-        ));
-    }
-    if a.tally.coincident_crossings > 0 {
-        w.push(format!(
-            "{}: {} line crossing(s) met coplanar overlapping faces facing the same way; only the face first \
-             in the scene is seen there (remove duplicated faces and decals)",
-            scene.name, a.tally.coincident_crossings
-        ));
-    }
-    if let Some((n, frac)) = a.unsampled {
-        if n > 0 {
-            w.push(format!(
-                "{}: {n} patch(es) ({:.4}% of the area) were never left by a line: their rows are empty; cast more lines",
-                scene.name,
-                100.0 * frac
-            ));
-        }
-    }
-    if a.degenerate_pairs > 0 {
-        w.push(format!(
-            "{}: {} pair(s) joined coincident points (touching surfaces) and were left out of I_s^c",
-            scene.name, a.degenerate_pairs
-        ));
-    }
-    w
-}
-
-/// The fraction of the segments leaving a front side that escape the scene (`None` without segments).
-fn escape_fraction(a: &Analysis) -> Option<f64> {
-    let segments = a.pairs + a.escapes;
-    (segments > 0).then(|| a.escapes as f64 / segments as f64)
-}
-
 fn estimate_json(e: Option<Estimate>) -> Value {
     match e {
         Some(e) => json!({"value": finite(e.value), "stderr": e.stderr.and_then(finite)}),
@@ -200,20 +150,17 @@ pub fn json(run: &RunInfo, a: &Analysis) -> String {
         "pairs": a.pairs,
         "escapes": a.escapes,
         "unpaired": a.unpaired,
-        "escape_fraction": escape_fraction(a),
+        "escape_fraction": a.escape_fraction(),
         "degenerate_pairs": a.degenerate_pairs,
-        "coincident_crossings": a.tally.coincident_crossings,
+        "coincident_crossings": a.tally.counters.coincident_crossings,
         "environment_area": estimate_json(a.environment_area),
         "distinct_pairs": a.distinct_pairs,
         "unsampled_patches": a.unsampled.map(|u| u.0),
         "unsampled_area_fraction": a.unsampled.map(|u| u.1),
         "visibility": Value::Object(visibility),
-        "radiosity": radiosity_json(run.radiosity),
-        "radiosity_skipped": match run.radiosity {
-            RadiosityOutcome::Skipped(reason) => Value::from(reason.as_str()),
-            RadiosityOutcome::Computed(_) => Value::Null,
-        },
-        "warnings": warnings(run.scene, a),
+        "radiosity": radiosity_json(&a.radiosity),
+        "radiosity_skipped": skipped_reason(&a.radiosity).map_or(Value::Null, Value::from),
+        "warnings": a.warnings.iter().map(|w| w.message.as_str()).collect::<Vec<_>>(),
     });
     let mut s = serde_json::to_string_pretty(&doc).expect("a JSON value always serialises");
     s.push('\n');
@@ -274,10 +221,20 @@ fn radiosity_json(outcome: &RadiosityOutcome) -> Value {
     Value::Object(m)
 }
 
+/// Why the radiosity measures were left out (`None` when computed).
+fn skipped_reason(outcome: &RadiosityOutcome) -> Option<&str> {
+    match outcome {
+        RadiosityOutcome::Computed(_) => None,
+        RadiosityOutcome::NotRequested => Some("not requested (--measures leaves radiosity out)"),
+        RadiosityOutcome::Skipped(reason) => Some(reason),
+    }
+}
+
 /// The radiosity lines of the table.
 fn radiosity_table(s: &mut String, outcome: &RadiosityOutcome) {
     match outcome {
-        RadiosityOutcome::Skipped(reason) => {
+        RadiosityOutcome::NotRequested | RadiosityOutcome::Skipped(_) => {
+            let reason = skipped_reason(outcome).unwrap_or_default();
             let _ = writeln!(s, "\nradiosity measures left out: {reason}");
         }
         RadiosityOutcome::Computed(r) => {
@@ -300,7 +257,7 @@ fn radiosity_table(s: &mut String, outcome: &RadiosityOutcome) {
 }
 
 /// `measure,value,stderr` rows with a header.
-pub fn csv(run: &RunInfo, a: &Analysis) -> String {
+pub fn csv(a: &Analysis) -> String {
     let mut s = String::from("measure,value,stderr,corrected,corrected_stderr\n");
     let field = |e: Option<Estimate>| {
         (
@@ -316,7 +273,7 @@ pub fn csv(run: &RunInfo, a: &Analysis) -> String {
             let _ = writeln!(s, "{},{v},{se},{c},{cse}", r.key);
         }
     }
-    if let RadiosityOutcome::Computed(r) = run.radiosity {
+    if let RadiosityOutcome::Computed(r) = &a.radiosity {
         for row in radiosity_measures(r) {
             let ((v, se), (c, cse)) = (field(row.estimate), field(row.corrected));
             let _ = writeln!(s, "radiosity_{},{v},{se},{c},{cse}", row.key);
@@ -384,7 +341,7 @@ pub fn table(run: &RunInfo, a: &Analysis) -> String {
     for r in measures(a) {
         table_row(&mut s, &r);
     }
-    radiosity_table(&mut s, run.radiosity);
+    radiosity_table(&mut s, &a.radiosity);
     let errors = match a.errors {
         ErrorMethod::Groups => format!(
             "spread of {} independent groups of lines / sqrt({})",

@@ -20,8 +20,8 @@ pub mod oracle;
 use std::fmt;
 use std::time::Instant;
 
-use crate::measure::radiosity::{self, FormFactors, PatchMaterials, SolveOptions};
-use crate::radiosity::RadiosityError;
+use crate::measure::radiosity::{self, FormFactors, MaterialError, PatchMaterials, SolveOptions};
+use crate::run::SolveFailure;
 use crate::scene::{Scene, SceneError};
 use crate::trace::{TraceError, Tracer};
 use mesh::Mesh;
@@ -98,9 +98,12 @@ pub enum RefineError {
     /// The scene or a refined mesh could not be built.
     #[error(transparent)]
     Scene(#[from] SceneError),
-    /// Bad materials, or a radiosity system without solution.
+    /// A material outside the physical range.
     #[error(transparent)]
-    Radiosity(#[from] RadiosityError),
+    Material(#[from] MaterialError),
+    /// A radiosity system without solution.
+    #[error(transparent)]
+    Solve(#[from] SolveFailure),
     /// Tracing failed.
     #[error(transparent)]
     Trace(#[from] TraceError),
@@ -124,8 +127,11 @@ impl RefineError {
     /// Whether the user's input (scene, materials, settings) is at fault.
     pub fn is_bad_input(&self) -> bool {
         match self {
-            RefineError::Scene(_) | RefineError::NeedsLight { .. } | RefineError::Config(_) => true,
-            RefineError::Radiosity(e) => e.is_bad_input(),
+            RefineError::Scene(_)
+            | RefineError::Material(_)
+            | RefineError::Solve(_)
+            | RefineError::NeedsLight { .. }
+            | RefineError::Config(_) => true,
             RefineError::Trace(_) => false,
         }
     }
@@ -149,10 +155,7 @@ pub fn refine(
         )));
     }
     // Uniform refinement needs no light and no valid materials: it only looks at the areas.
-    let lit = cfg.strategy != Strategy::Uniform
-        && PatchMaterials::of_scene(scene)
-            .map_err(RadiosityError::from)?
-            .any_emission();
+    let lit = cfg.strategy != Strategy::Uniform && PatchMaterials::of_scene(scene)?.any_emission();
     if !lit && matches!(cfg.strategy, Strategy::Power | Strategy::Smoothness) {
         return Err(RefineError::NeedsLight {
             scene: scene.name.clone(),
@@ -212,9 +215,9 @@ fn measure_round(
     let ff: FormFactors = oracle::form_factors(scene, &sample);
     let a = areas(scene);
     let solution = if lit {
-        let m = PatchMaterials::of_scene(scene).map_err(RadiosityError::from)?;
+        let m = PatchMaterials::of_scene(scene)?;
         Some(
-            radiosity::solve(&ff, &m, &cfg.solve).map_err(|e| RadiosityError::Solve {
+            radiosity::solve(&ff, &m, &cfg.solve).map_err(|e| SolveFailure {
                 scene: scene.name.clone(),
                 message: e.to_string(),
             })?,

@@ -5,14 +5,13 @@ use rayon::prelude::*;
 
 use crate::measure::channel::row_totals;
 use crate::measure::radiosity::{FormFactors, Solution};
-use crate::sample::counts::pair_key;
-use crate::sample::counts::PairCounts;
-use crate::sample::lines::batch_lines;
+use crate::run::{map_traced_batches, LineStream};
+use crate::sample::counts::{pair_key, PairCounts};
+use crate::sample::kernel::kernel_without_pi;
 use crate::sample::lines::orthonormal_basis;
 use crate::sample::pairs::{segments, LineF64, Segment};
-use crate::sample::tally::BatchPlan;
 use crate::scene::Scene;
-use crate::trace::{Line, LineHits, RawHit, TraceError, Tracer};
+use crate::trace::{TraceError, Tracer};
 
 /// What one round's lines found, per unordered patch pair.
 #[derive(Clone, Debug)]
@@ -28,14 +27,6 @@ pub struct PairSample {
     pub escapes: Vec<u64>,
 }
 
-/// Per-thread buffers.
-#[derive(Default)]
-struct Scratch {
-    lines: Vec<Line>,
-    raw: Vec<RawHit>,
-    hits: LineHits,
-}
-
 /// Traces `lines` global lines in batches (in parallel) and hands every segment, with its line, to
 /// `visit`, which fills one `T` per batch; the results come back in batch order, so whatever is merged
 /// from them does not depend on the thread count.
@@ -44,31 +35,25 @@ fn trace_segments<T: Default + Send>(
     tracer: &dyn Tracer,
     lines: u64,
     seed: u64,
-    visit: impl Fn(&LineF64, Segment, &mut T) + Sync,
+    visit: impl Fn(&LineF64, Segment, &mut T) + Sync + Send,
 ) -> Result<Vec<T>, TraceError> {
-    let plan = BatchPlan::new(lines);
-    (0..plan.batches())
-        .into_par_iter()
-        .map_init(Scratch::default, |s, b| {
-            s.lines.clear();
-            batch_lines(
-                seed,
-                b,
-                plan.batch_len(b),
-                scene.bounding_radius(),
-                &mut s.lines,
-            );
-            tracer.all_hits(&s.lines, &mut s.raw, &mut s.hits)?;
+    let stream = LineStream::independent(lines, seed);
+    let (per_batch, _) = map_traced_batches(
+        &stream,
+        tracer,
+        scene.bounding_radius(),
+        0..stream.plan.batches(),
+        &|_| false,
+        |_: &mut (), batch, hits| {
             let mut out = T::default();
-            for (k, line) in s.lines.iter().enumerate() {
+            for (k, line) in batch.lines.iter().enumerate() {
                 let l = LineF64::from(line);
-                segments(scene, line, s.hits.of_line(k), |seg| {
-                    visit(&l, seg, &mut out)
-                });
+                segments(scene, line, hits.of_line(k), |seg| visit(&l, seg, &mut out));
             }
-            Ok(out)
-        })
-        .collect()
+            out
+        },
+    )?;
+    Ok(per_batch)
 }
 
 /// Casts `lines` global lines and gathers a [`PairSample`].
@@ -92,12 +77,10 @@ pub fn sample_pairs(
                 cos_from,
                 cos_to,
             } => {
-                // Coincident points (d = 0) give an infinite kernel: NaN keeps them out of the sum.
-                let term = if distance > 0.0 && cos_from * cos_to > 0.0 {
-                    (cos_from * cos_to / (distance * distance)).log2() - log2_pi
-                } else {
-                    f64::NAN
-                };
+                // A degenerate pair (coincident points, d = 0) has no finite kernel: NaN keeps it out
+                // of the sum.
+                let term = kernel_without_pi(cos_from * cos_to, distance)
+                    .map_or(f64::NAN, |v| v.log2() - log2_pi);
                 out.0.push((pair_key(from, to), term));
             }
             Segment::Escape { patch } => out.1.push(patch),

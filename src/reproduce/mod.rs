@@ -16,14 +16,12 @@ use std::collections::HashMap;
 use std::fmt::Write as _;
 use std::time::Instant;
 
-use crate::analysis::{analyze, AnalysisConfig, RunControl, VisibilityEstimates};
-use crate::measure::radiosity::SolveOptions;
 use crate::measure::Estimate;
-use crate::radiosity::{
-    analyze_with_radiosity, RadiosityError, RadiosityEstimates, RadiosityOutcome,
-};
 use crate::refine::RefineError;
-use crate::sample::tally::Wanted;
+use crate::run::{
+    analyze, AnalysisConfig, AnalysisError, Measures, RadiosityEstimates, RadiosityOutcome,
+    RunControl, VisibilityEstimates,
+};
 use crate::scene::{self, Scene, SceneError};
 use crate::trace::{make_tracer, Backend, Query, TraceError};
 
@@ -188,9 +186,9 @@ pub enum ReproduceError {
     /// Tracing failed, or the backend is not available.
     #[error(transparent)]
     Trace(#[from] TraceError),
-    /// The radiosity solve failed.
+    /// An analysis failed (bad materials, a radiosity system without solution, tracing).
     #[error(transparent)]
-    Radiosity(#[from] RadiosityError),
+    Analysis(#[from] AnalysisError),
     /// A refinement failed.
     #[error(transparent)]
     Refine(#[from] RefineError),
@@ -302,23 +300,17 @@ impl Session<'_> {
         let start = Instant::now();
         let tracer = make_tracer(self.cfg.backend, scene, Query::Single)?;
         let cfg = AnalysisConfig {
-            wanted: Wanted {
+            measures: Measures {
                 discrete: want != Want::Continuous,
                 continuous: true,
+                radiosity: want == Want::Radiosity,
             },
             ..AnalysisConfig::new(lines, self.cfg.seed)
         };
-        let (a, radiosity) = if want == Want::Radiosity {
-            let control = RunControl::default();
-            let opts = SolveOptions::default();
-            let (a, r) = analyze_with_radiosity(scene, tracer.as_ref(), &cfg, &opts, &control)?;
-            let r = match r {
-                RadiosityOutcome::Computed(r) => Some(r),
-                RadiosityOutcome::Skipped(_) => None,
-            };
-            (a, r)
-        } else {
-            (analyze(scene, tracer.as_ref(), &cfg)?, None)
+        let a = analyze(scene, tracer.as_ref(), &cfg, &RunControl::default())?;
+        let radiosity = match &a.radiosity {
+            RadiosityOutcome::Computed(r) => Some(r.clone()),
+            _ => None,
         };
         let seconds = start.elapsed().as_secs_f64();
         self.lines_cast += a.lines;

@@ -3,10 +3,10 @@
 use std::time::Instant;
 
 use super::{est, lines_text, paper, Finding, ReproduceError, Run, Session, TableReport, Want};
-use crate::analysis::VisibilityEstimates;
 use crate::measure::radiosity::SolveOptions;
 use crate::measure::Estimate;
 use crate::refine::{refine, RefineConfig, Strategy};
+use crate::run::VisibilityEstimates;
 use crate::scene::{self, Scene};
 use crate::trace::{make_tracer, Query};
 

@@ -78,6 +78,44 @@ impl PairCounts {
         counts
     }
 
+    /// Counts of `patches` patches from `(key, count)` entries, each key once, in any order.
+    pub fn from_entries(patches: usize, mut entries: Vec<(u64, u64)>) -> Self {
+        match PairCounts::new(patches) {
+            PairCounts::Dense(mut m) => {
+                for (k, c) in entries {
+                    let (i, j) = split_key(k);
+                    m[[i as usize, j as usize]] += c;
+                }
+                PairCounts::Dense(m)
+            }
+            PairCounts::Sparse(_) => {
+                entries.sort_unstable();
+                PairCounts::Sparse(entries)
+            }
+        }
+    }
+
+    /// These counts without `part` (counts of the same scene that these include).
+    pub fn without(&self, part: &PairCounts) -> PairCounts {
+        match (self, part) {
+            (PairCounts::Dense(a), PairCounts::Dense(b)) => PairCounts::Dense(a - b),
+            (PairCounts::Sparse(total), PairCounts::Sparse(part)) => {
+                // Both sorted by key, and every pair of the part is in the total.
+                let mut lowered = total.clone();
+                let mut k = 0;
+                for &(key, c) in part {
+                    while lowered[k].0 < key {
+                        k += 1;
+                    }
+                    lowered[k].1 -= c;
+                }
+                lowered.retain(|e| e.1 > 0);
+                PairCounts::Sparse(lowered)
+            }
+            _ => unreachable!("counts of one scene always share a layout"),
+        }
+    }
+
     /// Adds `other` (of the same size and layout) into `self`.
     pub fn merge(&mut self, other: &PairCounts) {
         match (self, other) {

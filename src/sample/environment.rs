@@ -23,9 +23,7 @@
 //! environment: the sphere would only see the scene's back sides and itself, a separate channel, so
 //! `--enclose` then changes nothing.
 
-use super::counts::{pair_key, PairCounts};
 use super::pairs::LineF64;
-use super::tally::Tally;
 use crate::scene::Scene;
 use crate::trace::Line;
 
@@ -53,66 +51,12 @@ fn sphere_chord(l: &LineF64, r: f64) -> (f64, f64, f64) {
 }
 
 /// The environment's area in tracing space: 2 pi R^2 per segment end on it per line (see the module
-/// documentation); 0 without lines.
-pub fn environment_area(scene: &Scene, tally: &Tally) -> f64 {
-    if tally.lines == 0 {
+/// documentation), for `lines` lines of which `escapes` segments escaped and `misses` met nothing; 0
+/// without lines.
+pub fn area(radius: f64, lines: u64, escapes: u64, misses: u64) -> f64 {
+    if lines == 0 {
         return 0.0;
     }
-    let r = scene.bounding_radius();
-    let ends = tally.escapes as f64 + 2.0 * tally.misses as f64;
-    2.0 * std::f64::consts::PI * r * r * ends / tally.lines as f64
-}
-
-/// The tally of the enclosed scene, whose patch `n_p` is the environment, and the patch areas with the
-/// environment's last. Needs the discrete counts for the pair counts (without them only eq. (27) is
-/// enclosed).
-pub fn enclosed(scene: &Scene, tally: &Tally) -> (Tally, Vec<f64>) {
-    let n = scene.patch_count();
-    let env = n as u32;
-    let mut areas: Vec<f64> = scene.patches.iter().map(|p| p.area).collect();
-    let a_scene: f64 = areas.iter().sum();
-    let a_env = environment_area(scene, tally);
-    areas.push(a_env);
-
-    let mut t = tally.clone();
-    t.counts = tally.counts.as_ref().map(|c| {
-        let mut entries: Vec<(u64, u64)> = Vec::new();
-        c.for_each(|i, j, k| entries.push((pair_key(i, j), k)));
-        for (i, &e) in tally.escapes_by_patch.iter().enumerate() {
-            if e > 0 {
-                entries.push((pair_key(i as u32, env), e));
-            }
-        }
-        if tally.misses > 0 {
-            entries.push((pair_key(env, env), tally.misses));
-        }
-        counts_from_entries(n + 1, entries)
-    });
-    t.escapes_by_patch = vec![0; if tally.counts.is_some() { n + 1 } else { 0 }];
-    t.pairs += tally.escapes + tally.misses;
-    t.escapes = 0;
-
-    // Eq. (27) with A_T' = A_T + A_env: take the scene's log2(A_T / pi) back out of each term.
-    let log2_over_pi = |a: f64| (a / std::f64::consts::PI).log2();
-    let raw = tally.cmi_sum - tally.cmi_pairs as f64 * log2_over_pi(a_scene);
-    t.cmi_pairs = tally.cmi_pairs + tally.env_pairs;
-    t.cmi_sum = raw + tally.env_log2_sum + t.cmi_pairs as f64 * log2_over_pi(a_scene + a_env);
-    (t, areas)
-}
-
-/// Pair counts of `patches` patches from `(key, count)` entries, each key once.
-fn counts_from_entries(patches: usize, mut entries: Vec<(u64, u64)>) -> PairCounts {
-    match PairCounts::new(patches) {
-        PairCounts::Dense(mut m) => {
-            for (k, c) in entries {
-                let (i, j) = super::counts::split_key(k);
-                m[[i as usize, j as usize]] += c;
-            }
-            PairCounts::Dense(m)
-        }
-        PairCounts::Sparse(_) => {
-            entries.sort_unstable();
-            PairCounts::Sparse(entries)
-        }
-    }
+    let ends = escapes as f64 + 2.0 * misses as f64;
+    2.0 * std::f64::consts::PI * radius * radius * ends / lines as f64
 }

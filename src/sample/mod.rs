@@ -1,7 +1,13 @@
-//! Sampling: global lines, hit pairing, and accumulation of counts and sums.
+//! Sampling: global lines, the pairing of their hits into mutually visible points, and the accumulation
+//! of counts and sums (paper sec. 2.1.1 and 3.2.2).
+//!
+//! Inside the layer, data flows: [`lines`] draws the lines; [`pairs`] (with `order`) turns a line's
+//! canonical hits into segments; [`kernel`] and [`environment`] give a segment's eq. (27) term;
+//! [`tally`] adds segments up; [`counts`] turns pair keys into the counts N_ij.
 
 pub mod counts;
 pub mod environment;
+pub mod kernel;
 pub mod lines;
 mod order;
 pub mod pairs;

@@ -5,17 +5,14 @@
 
 use crate::support;
 
-use scene_complexity::analysis::{analyze, Analysis, AnalysisConfig};
+use scene_complexity::run::{analyze, Analysis, AnalysisConfig, RunControl};
+use scene_complexity::run::{BatchPlan, Measures};
 use scene_complexity::sample::lines::LineSource;
-use scene_complexity::sample::tally::{BatchPlan, Wanted};
 use scene_complexity::scene::{self, Scene};
 use scene_complexity::trace::{make_tracer, Backend, LineHits, Query, Tracer};
 use support::{count_entries, ff_parallel_rectangles, ff_perpendicular_rectangles};
 
-const ALL: Wanted = Wanted {
-    discrete: true,
-    continuous: true,
-};
+const ALL: Measures = Measures::VISIBILITY;
 
 fn rust_tracer(scene: &Scene) -> Box<dyn Tracer> {
     make_tracer(Backend::Rust, scene, Query::Single).unwrap()
@@ -23,11 +20,11 @@ fn rust_tracer(scene: &Scene) -> Box<dyn Tracer> {
 
 fn run(scene: &Scene, tracer: &dyn Tracer, lines: u64, seed: u64, grid: u32) -> Analysis {
     let cfg = AnalysisConfig {
-        wanted: ALL,
+        measures: ALL,
         source: LineSource::bundles(grid).unwrap(),
         ..AnalysisConfig::new(lines, seed)
     };
-    analyze(scene, tracer, &cfg).unwrap()
+    analyze(scene, tracer, &cfg, &RunControl::default()).unwrap()
 }
 
 /// Crofton: each line of a bundle meets a planar patch of area A with probability A / (2 pi R^2). The
@@ -152,7 +149,10 @@ fn results_do_not_depend_on_the_thread_count() {
             count_entries(&two),
             "G = {grid}: identical counts"
         );
-        assert_eq!(one.tally.cmi_sum.to_bits(), two.tally.cmi_sum.to_bits());
+        assert_eq!(
+            one.tally.counters.cmi_sum.to_bits(),
+            two.tally.counters.cmi_sum.to_bits()
+        );
         let bits = |a: &Analysis| {
             let v = &a.visibility;
             [

@@ -72,7 +72,7 @@ fn planted_faults_are_found_on_their_lines_and_by_kind() {
     assert_eq!(c.lines, lines);
     assert!(!c.agrees());
     // 2000 lines are at most a few batches; each batch holds lines 3, 5 and 7 of its own.
-    let batches = scene_complexity::sample::tally::BatchPlan::new(lines).batches();
+    let batches = scene_complexity::run::BatchPlan::new(lines).batches();
     // A line that misses the cube (about 1 in 4 within the unit sphere) has nothing to spoil.
     let [count, patch, distance] = c.differing;
     assert!(count <= batches && patch <= batches && distance <= batches);
@@ -98,7 +98,7 @@ struct BatchPlanSize;
 
 impl BatchPlanSize {
     fn of(lines: u64) -> u64 {
-        scene_complexity::sample::tally::BatchPlan::new(lines).batch_size
+        scene_complexity::run::BatchPlan::new(lines).batch_size
     }
 }
 

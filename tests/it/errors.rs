@@ -3,8 +3,8 @@
 
 use crate::support;
 
-use scene_complexity::analysis::{analyze, Analysis, AnalysisConfig};
 use scene_complexity::measure::Estimate;
+use scene_complexity::run::{analyze, Analysis, AnalysisConfig, RunControl};
 use scene_complexity::scene::{self, Scene};
 use scene_complexity::trace::Tracer;
 use support::{all_tracers, cube_exact_measures};
@@ -14,7 +14,13 @@ fn fastest_tracer(scene: &Scene) -> Box<dyn Tracer> {
 }
 
 fn run(scene: &Scene, tracer: &dyn Tracer, lines: u64, seed: u64) -> Analysis {
-    analyze(scene, tracer, &AnalysisConfig::new(lines, seed)).unwrap()
+    analyze(
+        scene,
+        tracer,
+        &AnalysisConfig::new(lines, seed),
+        &RunControl::default(),
+    )
+    .unwrap()
 }
 
 fn cmi(a: &Analysis) -> Estimate {

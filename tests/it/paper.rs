@@ -4,10 +4,9 @@
 //! figs. 5/6 are the best discretised (Tables 6, 7); constant radiosity leaves the measures unchanged
 //! (fig. 9, Table 8).
 
-use scene_complexity::analysis::{analyze, Analysis, AnalysisConfig, RunControl};
-use scene_complexity::measure::radiosity::SolveOptions;
-use scene_complexity::radiosity::{analyze_with_radiosity, RadiosityOutcome};
-use scene_complexity::sample::tally::Wanted;
+use scene_complexity::run::{
+    analyze, Analysis, AnalysisConfig, Measures, RadiosityOutcome, RunControl,
+};
 use scene_complexity::scene::paper::{fig2_corners, fig56_corners, Fig2Placement};
 use scene_complexity::scene::{self, Scene};
 use scene_complexity::trace::{make_tracer, Backend, Query};
@@ -18,14 +17,15 @@ fn run(spec: &str, lines: u64, discrete: bool) -> Analysis {
     let scene = scene::load(spec).unwrap();
     let tracer = make_tracer(Backend::Rust, &scene, Query::Single).unwrap();
     let cfg = AnalysisConfig {
-        wanted: Wanted {
+        measures: Measures {
             discrete,
             continuous: true,
+            radiosity: false,
         },
         groups: 2,
         ..AnalysisConfig::new(lines, 7)
     };
-    let a = analyze(&scene, tracer.as_ref(), &cfg).unwrap();
+    let a = analyze(&scene, tracer.as_ref(), &cfg, &RunControl::default()).unwrap();
     assert_eq!(a.escapes, 0, "{spec}: a closed scene");
     a
 }
@@ -236,14 +236,8 @@ fn labyrinth_radiosity_measures_equal_visibility_measures() {
     }
     let tracer = make_tracer(Backend::Rust, &s, Query::Single).unwrap();
     let cfg = AnalysisConfig::new(100_000, 3);
-    let (a, r) = analyze_with_radiosity(
-        &s,
-        tracer.as_ref(),
-        &cfg,
-        &SolveOptions::default(),
-        &RunControl::default(),
-    )
-    .unwrap();
+    let a = analyze(&s, tracer.as_ref(), &cfg, &RunControl::default()).unwrap();
+    let r = a.radiosity.clone();
     let RadiosityOutcome::Computed(r) = r else {
         panic!("the labyrinth emits");
     };

@@ -4,12 +4,11 @@
 
 use crate::support;
 
-use scene_complexity::analysis::{AnalysisConfig, RunControl};
 use scene_complexity::measure::radiosity::{
     for_each_transition, solve, transformed_areas, FormFactors, PatchMaterials, SolveOptions,
 };
-use scene_complexity::radiosity::{analyze_with_radiosity, RadiosityOutcome};
 use scene_complexity::refine::{oracle, refine, RefineConfig, Strategy};
+use scene_complexity::run::{analyze, AnalysisConfig, RadiosityOutcome, RunControl};
 use scene_complexity::scene::{self, Material, Scene};
 use scene_complexity::trace::{make_tracer, Backend, Query, Tracer};
 use support::*;
@@ -49,14 +48,14 @@ fn table_8_constant_radiosity_gives_the_visibility_measures() {
             &[(0.3, 0.7), (0.0, 1.0), (0.55, 0.45), (1.0, 0.0)],
         );
         for tracer in all_tracers(&scene) {
-            let (a, r) = analyze_with_radiosity(
+            let a = analyze(
                 &scene,
                 tracer.as_ref(),
                 &config(60_000, 4),
-                &SolveOptions::default(),
                 &RunControl::default(),
             )
             .unwrap();
+            let r = a.radiosity.clone();
             let RadiosityOutcome::Computed(r) = r else {
                 panic!("{spec}: radiosity skipped: {r:?}")
             };
@@ -188,14 +187,14 @@ fn unit_cube_with_one_emitting_face_matches_the_hand_solution() {
         ],
     );
     for tracer in all_tracers(&scene) {
-        let (_, r) = analyze_with_radiosity(
+        let analysis = analyze(
             &scene,
             tracer.as_ref(),
             &config(400_000, 9),
-            &SolveOptions::default(),
             &RunControl::default(),
         )
         .unwrap();
+        let r = analysis.radiosity.clone();
         let RadiosityOutcome::Computed(r) = r else {
             panic!("skipped: {r:?}")
         };
@@ -220,11 +219,10 @@ fn transition_rows_sum_to_one_in_the_cornell_box() {
     for spec in ["@cornell", "@cornell-open"] {
         let scene = scene::load(spec).unwrap();
         let tracer = rust_tracer(&scene);
-        let (a, _) = analyze_with_radiosity(
+        let a = analyze(
             &scene,
             tracer.as_ref(),
             &config(30_000, 2),
-            &SolveOptions::default(),
             &RunControl::default(),
         )
         .unwrap();

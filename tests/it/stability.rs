@@ -11,8 +11,8 @@ use std::f64::consts::{LN_2, PI};
 
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
-use scene_complexity::analysis::{analyze, Analysis, AnalysisConfig};
 use scene_complexity::measure::channel::row_totals;
+use scene_complexity::run::{analyze, Analysis, AnalysisConfig, RunControl};
 use scene_complexity::sample::pairs::{segments, Segment};
 use scene_complexity::scene::{self, Material, Scene, SceneBuilder};
 use scene_complexity::trace::{make_tracer, Backend, Line, LineHits, Query, Tracer};
@@ -30,6 +30,7 @@ fn run(scene: &Scene, lines: u64, seed: u64) -> Analysis {
         scene,
         tracer(scene).as_ref(),
         &AnalysisConfig::new(lines, seed),
+        &RunControl::default(),
     )
     .expect("analysis runs")
 }
@@ -62,7 +63,7 @@ fn assert_all_finite(a: &Analysis, what: &str) {
             }
         }
     }
-    assert!(a.tally.cmi_sum.is_finite(), "{what}: eq. (27) sum");
+    assert!(a.tally.counters.cmi_sum.is_finite(), "{what}: eq. (27) sum");
 }
 
 /// Sum of the pair counts between the patches of `from` and those of `to` (ordered: N_ij for i in
@@ -533,7 +534,7 @@ fn cube_almost_touching_and_touching_the_floor() {
         "touching: {got} pairs at d = 0, Crofton expects {expected}"
     );
     assert_eq!(
-        a.tally.cmi_pairs + a.degenerate_pairs,
+        a.tally.counters.cmi_pairs + a.degenerate_pairs,
         a.pairs,
         "d = 0 pairs are left out of eq. (27) only"
     );
@@ -651,7 +652,7 @@ fn coplanar_overlapping_faces_are_seen_once_and_reported() {
     );
     let decal_area = scene.patches[decal].area;
     let expected = lines as f64 * decal_area / (2.0 * PI);
-    let got = a.tally.coincident_crossings as f64;
+    let got = a.tally.counters.coincident_crossings as f64;
     assert!(
         (got - expected).abs() < 5.0 * expected.sqrt(),
         "{got} crossings of the overlap, Crofton expects {expected}"
@@ -1097,7 +1098,6 @@ const OPEN_BOX: &str = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nv 0 0 1\nv 1 0 1\nv 
 /// A closed scene is left alone.
 #[test]
 fn enclose_closes_open_scenes_consistently() {
-    use scene_complexity::sample::environment::enclosed;
     let lines = 200_000;
     let cfg = AnalysisConfig {
         enclose: true,
@@ -1110,14 +1110,14 @@ fn enclose_closes_open_scenes_consistently() {
     let m = b.material(wall());
     add_box(&mut b, [0.0; 3], [1.0; 3], false, m, "cube");
     let cube = b.build().unwrap();
-    let a = analyze(&cube, tracer(&cube).as_ref(), &cfg).unwrap();
+    let a = analyze(&cube, tracer(&cube).as_ref(), &cfg, &RunControl::default()).unwrap();
     assert_all_finite(&a, "cube object");
     let env = a.environment_area.expect("enclosed");
     assert!(
         (env.value - sphere).abs() < 4.5 * env.stderr.unwrap() + 1e-9,
         "{env:?} vs {sphere}"
     );
-    let (t, areas) = enclosed(&cube, &a.tally);
+    let (t, areas) = a.tally.enclosed(&cube);
     assert_eq!(areas.len(), 7);
     let n = 7;
     let counts = t.counts.as_ref().unwrap();
@@ -1150,7 +1150,7 @@ fn enclose_closes_open_scenes_consistently() {
     let path = dir.path().join("open_box.obj");
     std::fs::write(&path, OPEN_BOX).unwrap();
     let open = scene::load(path.to_str().unwrap()).unwrap();
-    let a = analyze(&open, tracer(&open).as_ref(), &cfg).unwrap();
+    let a = analyze(&open, tracer(&open).as_ref(), &cfg, &RunControl::default()).unwrap();
     assert_all_finite(&a, "open box");
     let env = a.environment_area.expect("enclosed");
     let expected = sphere - 5.0;
@@ -1158,7 +1158,7 @@ fn enclose_closes_open_scenes_consistently() {
         (env.value - expected).abs() < 4.5 * env.stderr.unwrap(),
         "{env:?} vs {expected}"
     );
-    let (t, _) = enclosed(&open, &a.tally);
+    let (t, _) = a.tally.enclosed(&open);
     let counts = t.counts.as_ref().unwrap();
     let rows = row_totals(6, counts, &t.escapes_by_patch);
     let mut f = vec![vec![0.0; 6]; 6];
@@ -1175,7 +1175,13 @@ fn enclose_closes_open_scenes_consistently() {
     );
 
     let closed = scene::load("@cube:2").unwrap();
-    let a = analyze(&closed, tracer(&closed).as_ref(), &cfg).unwrap();
+    let a = analyze(
+        &closed,
+        tracer(&closed).as_ref(),
+        &cfg,
+        &RunControl::default(),
+    )
+    .unwrap();
     assert!(
         a.environment_area.is_none(),
         "nothing escapes a closed scene"

@@ -3,24 +3,21 @@
 
 use crate::support;
 
-use scene_complexity::analysis::{analyze, Analysis, AnalysisConfig};
 use scene_complexity::measure::channel::{for_each_form_factor, row_totals};
-use scene_complexity::sample::tally::Wanted;
+use scene_complexity::run::Measures;
+use scene_complexity::run::{analyze, Analysis, AnalysisConfig, RunControl};
 use scene_complexity::scene::{self, Scene};
 use scene_complexity::trace::Tracer;
 use support::*;
 
-const ALL: Wanted = Wanted {
-    discrete: true,
-    continuous: true,
-};
+const ALL: Measures = Measures::VISIBILITY;
 
 fn run(scene: &Scene, tracer: &dyn Tracer, lines: u64, seed: u64) -> Analysis {
     let cfg = AnalysisConfig {
-        wanted: ALL,
+        measures: ALL,
         ..AnalysisConfig::new(lines, seed)
     };
-    analyze(scene, tracer, &cfg).expect("analysis runs")
+    analyze(scene, tracer, &cfg, &RunControl::default()).expect("analysis runs")
 }
 
 /// Dense form-factor matrix of a run (small scenes only).
@@ -149,8 +146,8 @@ fn results_do_not_depend_on_the_thread_count() {
         let (one, two) = (go(1), go(2));
         assert_eq!(count_entries(&one), count_entries(&two), "identical counts");
         assert_eq!(
-            one.tally.cmi_sum.to_bits(),
-            two.tally.cmi_sum.to_bits(),
+            one.tally.counters.cmi_sum.to_bits(),
+            two.tally.counters.cmi_sum.to_bits(),
             "identical f64 sums"
         );
         assert_eq!(

@@ -1,0 +1,630 @@
+//! One analysis run: lines -> hits -> pairs -> counts -> measures, every measure with its standard error.
+//!
+//! [`analyze`] is the one entry point, for the visibility measures (paper sec. 3) and, when the scene
+//! emits, the radiosity measures (sec. 4). It plans rounds of batches, traces a round while it counts
+//! the last ([`RunState`]), stops at the line count, the budget or a stop request, and computes every
+//! measure on the whole run and on each group ([`super::errors`]).
+//!
+//! A stopped run keeps the longest prefix of finished batches, so its lines are always batches `0..k`: the
+//! same seed gives the same numbers for the same number of lines, whatever the thread count.
+
+use std::time::{Duration, Instant};
+
+use rayon::prelude::*;
+
+use super::batches::LineStream;
+use super::control::{Budget, RunControl, StopReason, TargetMeasure};
+use super::errors::{ErrorMethod, Spread};
+use super::plan::{BatchPlan, MAX_ROUND_LINES};
+use super::radiosity::{self, RadiosityOutcome, SolveFailure};
+use super::state::{FinishedRun, RunState, TracedBatches};
+use super::warnings::{self, RunWarning};
+use crate::measure::bias::{self, CorrectedValues};
+use crate::measure::channel;
+use crate::measure::entropy::xlog2x;
+use crate::measure::estimators::EntropyEstimator;
+use crate::measure::radiosity::{MaterialError, PatchMaterials, SolveOptions};
+use crate::measure::rows::Rows;
+use crate::measure::visibility::{self, ContinuousValues, DiscreteValues};
+use crate::measure::Estimate;
+use crate::sample::lines::LineSource;
+use crate::sample::tally::{Tally, Wanted};
+use crate::scene::Scene;
+use crate::trace::{TraceError, Tracer};
+
+/// Default number of independent groups of lines behind every standard error.
+pub const DEFAULT_GROUPS: usize = 16;
+
+/// The entropy estimator behind the bias-corrected H_s and I_s, chosen by measurement against the exact
+/// I_s of `@cube:N` (README, "Error against run time").
+pub const DEFAULT_ESTIMATOR: EntropyEstimator = EntropyEstimator::ChaoWangJost;
+
+/// Which families of measures a run computes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Measures {
+    /// The discrete measures from pair counts (H_s, I_s, E(MSE), ..., paper sec. 3.1).
+    pub discrete: bool,
+    /// The continuous mutual information I_s^c (eq. 27, sec. 3.2).
+    pub continuous: bool,
+    /// The radiosity measures (sec. 4), when the scene emits; they need the pair counts, which are then
+    /// gathered whatever `discrete` says.
+    pub radiosity: bool,
+}
+
+impl Measures {
+    /// Every measure.
+    pub const ALL: Measures = Measures {
+        discrete: true,
+        continuous: true,
+        radiosity: true,
+    };
+
+    /// The visibility measures only (no radiosity).
+    pub const VISIBILITY: Measures = Measures {
+        discrete: true,
+        continuous: true,
+        radiosity: false,
+    };
+}
+
+/// What to run.
+#[derive(Clone, Copy, Debug)]
+pub struct AnalysisConfig {
+    /// Global lines to cast (a cap when a budget is set).
+    pub lines: u64,
+    /// Seed of the line streams.
+    pub seed: u64,
+    /// Which measures to compute.
+    pub measures: Measures,
+    /// Groups for the standard errors ([`super::errors`]).
+    pub groups: usize,
+    /// The estimator of the bias-corrected H_s and I_s.
+    pub estimator: EntropyEstimator,
+    /// How the standard errors of the count-based measures are estimated.
+    pub errors: ErrorMethod,
+    /// When to stop before `lines`.
+    pub budget: Budget,
+    /// Independent lines, or bundles of parallel lines ([`LineSource`]); a bundle never straddles two
+    /// batches, so the group spread includes the correlation within a bundle.
+    pub source: LineSource,
+    /// Close an open scene with the environment patch ([`crate::sample::environment`]): escapes become
+    /// pairs with it, and every measure is that of the enclosed scene. Changes nothing when nothing
+    /// escapes.
+    pub enclose: bool,
+    /// How the radiosity system is solved.
+    pub solve: SolveOptions,
+}
+
+impl AnalysisConfig {
+    /// `lines` lines from `seed`, every measure, default groups and estimator, no budget.
+    pub fn new(lines: u64, seed: u64) -> Self {
+        AnalysisConfig {
+            lines,
+            seed,
+            measures: Measures::ALL,
+            groups: DEFAULT_GROUPS,
+            estimator: DEFAULT_ESTIMATOR,
+            errors: ErrorMethod::Groups,
+            budget: Budget::default(),
+            source: LineSource::Independent,
+            enclose: false,
+            solve: SolveOptions::default(),
+        }
+    }
+}
+
+/// Why an analysis failed.
+#[derive(Debug, thiserror::Error)]
+pub enum AnalysisError {
+    /// A material outside the physical range (bad input), found before any line is cast.
+    #[error(transparent)]
+    Material(#[from] MaterialError),
+    /// The radiosity system has no solution, or the solver gave up (bad input: the materials).
+    #[error(transparent)]
+    Solve(#[from] SolveFailure),
+    /// Tracing failed.
+    #[error(transparent)]
+    Trace(#[from] TraceError),
+}
+
+impl AnalysisError {
+    /// Whether the scene's own data are at fault (materials), not the machinery.
+    pub fn is_bad_input(&self) -> bool {
+        !matches!(self, AnalysisError::Trace(_))
+    }
+}
+
+/// The visibility measures of a run, each with its standard error; `None` when not computed.
+#[derive(Clone, Debug, Default)]
+pub struct VisibilityEstimates {
+    /// Eq. (19), exact.
+    pub positional_entropy: Option<Estimate>,
+    /// Eq. (17), plug-in.
+    pub entropy: Option<Estimate>,
+    /// Eq. (17) with bias-corrected row entropies ([`crate::measure::bias`]).
+    pub entropy_corrected: Option<Estimate>,
+    /// H(X, Y).
+    pub joint_entropy: Option<Estimate>,
+    /// Eq. (21), plug-in.
+    pub mutual_information: Option<Estimate>,
+    /// Eq. (20) with the bias-corrected H_s.
+    pub mutual_information_corrected: Option<Estimate>,
+    /// Eq. (27).
+    pub continuous_mutual_information: Option<Estimate>,
+    /// Sec. 3.3: discretisation accuracy I_s / I_s^c (plug-in I_s).
+    pub accuracy: Option<Estimate>,
+    /// Sec. 3.3 with the bias-corrected I_s.
+    pub accuracy_corrected: Option<Estimate>,
+    /// Sec. 3.3: discretisation relative error (I_s^c - I_s) / I_s^c.
+    pub relative_error: Option<Estimate>,
+    /// Eq. (22), per line.
+    pub mse_per_line: Option<Estimate>,
+}
+
+impl VisibilityEstimates {
+    /// The estimate a precision target watches.
+    pub fn of(&self, measure: TargetMeasure) -> Option<Estimate> {
+        match measure {
+            TargetMeasure::Entropy => self.entropy,
+            TargetMeasure::MutualInformation => self.mutual_information,
+            TargetMeasure::ContinuousMutualInformation => self.continuous_mutual_information,
+            TargetMeasure::Accuracy => self.accuracy,
+        }
+    }
+}
+
+/// Everything a run found.
+#[derive(Clone, Debug)]
+pub struct Analysis {
+    /// Lines cast.
+    pub lines: u64,
+    /// Seed.
+    pub seed: u64,
+    /// Wall-clock seconds of tracing, counting and measuring.
+    pub seconds: f64,
+    /// Why the run ended.
+    pub stop_reason: StopReason,
+    /// Groups behind the standard errors.
+    pub groups: usize,
+    /// The estimator of the corrected measures.
+    pub estimator: EntropyEstimator,
+    /// How the standard errors of the count-based measures were estimated (batch means when the
+    /// jackknife was asked for but does not apply).
+    pub errors: ErrorMethod,
+    /// Canonical hits.
+    pub hits: u64,
+    /// Visible pairs.
+    pub pairs: u64,
+    /// Segments escaping from a front side (0 in a closed scene).
+    pub escapes: u64,
+    /// Segments joining no two front sides.
+    pub unpaired: u64,
+    /// Pairs with coincident points, left out of eq. (27).
+    pub degenerate_pairs: u64,
+    /// Distinct patch pairs seen (when counted).
+    pub distinct_pairs: Option<usize>,
+    /// Patches no segment left from, and their area fraction (when counted).
+    pub unsampled: Option<(usize, f64)>,
+    /// With `--enclose` when something escaped: the environment patch's area in scene units (see
+    /// [`crate::sample::environment`]); `None` otherwise.
+    pub environment_area: Option<Estimate>,
+    /// The visibility measures.
+    pub visibility: VisibilityEstimates,
+    /// The radiosity measures, or why there are none.
+    pub radiosity: RadiosityOutcome,
+    /// What the user must know about these numbers (an open scene, unsampled patches, ...).
+    pub warnings: Vec<RunWarning>,
+    /// The full-run counts, for form factors (when counted).
+    pub tally: Tally,
+}
+
+impl Analysis {
+    /// The fraction of the segments leaving a front side that escape the scene (`None` without
+    /// segments).
+    pub fn escape_fraction(&self) -> Option<f64> {
+        warnings::escape_fraction(&self.tally.counters)
+    }
+}
+
+/// Measures of one group, of one group left out, or of the whole run.
+#[derive(Clone, Copy, Debug)]
+struct GroupValues {
+    discrete: Option<DiscreteValues>,
+    corrected: Option<CorrectedValues>,
+    continuous: Option<ContinuousValues>,
+    /// The environment patch's area (tracing space), when enclosed.
+    environment_area: Option<f64>,
+}
+
+impl GroupValues {
+    /// The values of a tally; of the enclosed scene when `enclose` ([`Tally::enclosed`]).
+    fn of(scene: &Scene, t: &Tally, estimator: EntropyEstimator, enclose: bool) -> Self {
+        if enclose {
+            let (enclosed, areas) = t.enclosed(scene);
+            return GroupValues {
+                environment_area: Some(t.environment_area(scene)),
+                ..GroupValues::plain(&areas, &enclosed, estimator)
+            };
+        }
+        GroupValues::plain(&areas(scene), t, estimator)
+    }
+
+    fn plain(areas: &[f64], t: &Tally, estimator: EntropyEstimator) -> Self {
+        let counted = t.counts.as_ref().filter(|_| t.counters.lines > 0);
+        // One pass over the counts serves both the plug-in and the corrected measures.
+        let (discrete, corrected) = counted
+            .map(|c| {
+                let a = channel::area_distribution(areas);
+                let a = a.as_slice().expect("a fresh array is contiguous");
+                let rows = Rows::gather(a, c, &t.escapes_by_patch, estimator);
+                (
+                    visibility::discrete_from_rows(a, &rows.sums),
+                    bias::corrected_from_rows(a, &rows, c, &t.escapes_by_patch),
+                )
+            })
+            .unzip();
+        GroupValues {
+            discrete,
+            corrected,
+            continuous: ContinuousValues::from_sum(t.counters.cmi_sum, t.counters.cmi_pairs),
+            environment_area: None,
+        }
+    }
+
+    fn accuracy(&self) -> Option<f64> {
+        Some(self.discrete?.mutual_information / self.continuous?.mutual_information)
+    }
+
+    fn accuracy_corrected(&self) -> Option<f64> {
+        Some(self.corrected?.mutual_information / self.continuous?.mutual_information)
+    }
+}
+
+fn areas(scene: &Scene) -> Vec<f64> {
+    scene.patches.iter().map(|p| p.area).collect()
+}
+
+/// Runs an analysis that `control` can watch and stop: casts `cfg.lines` global lines (or fewer, by the
+/// budget) and computes the measures `cfg.measures` asks for, each with its standard error.
+///
+/// With radiosity asked for, the materials are checked before any line is cast; when nothing emits the
+/// radiosity measures are left out with the reason. Uses the current rayon thread pool; results do not
+/// depend on its size.
+pub fn analyze(
+    scene: &Scene,
+    tracer: &dyn Tracer,
+    cfg: &AnalysisConfig,
+    control: &RunControl,
+) -> Result<Analysis, AnalysisError> {
+    let start = Instant::now();
+    let materials = if cfg.measures.radiosity {
+        Some(PatchMaterials::of_scene(scene)?)
+    } else {
+        None
+    };
+    let lit = materials.as_ref().is_some_and(|m| m.any_emission());
+    let wanted = Wanted {
+        discrete: cfg.measures.discrete || lit,
+        continuous: cfg.measures.continuous,
+    };
+    let (state, stop_reason) = cast(scene, tracer, cfg, wanted, control)?;
+    let run = state.finish(scene);
+    let enclose = cfg.enclose && run.groups.iter().any(|t| t.counters.escapes > 0);
+    let jackknife = cfg.errors == ErrorMethod::Jackknife
+        && !enclose
+        && cfg.estimator != EntropyEstimator::ChaoShen
+        && run.groups.len() >= 2;
+    let visibility = visibility_estimates(scene, &run, cfg.estimator, enclose, jackknife, wanted);
+    let radiosity = match &materials {
+        None => RadiosityOutcome::NotRequested,
+        Some(_) if !lit => RadiosityOutcome::Skipped(radiosity::NOTHING_EMITS.into()),
+        Some(m) => radiosity::estimates(
+            scene,
+            m,
+            &run,
+            &cfg.solve,
+            cfg.estimator,
+            visibility.jackknifed,
+        )?,
+    };
+    let FinishedRun { total, .. } = run;
+    let warnings = warnings::of_run(
+        &scene.name,
+        &total.counters,
+        visibility.unsampled,
+        visibility.environment_area,
+    );
+    Ok(Analysis {
+        lines: total.counters.lines,
+        seed: cfg.seed,
+        seconds: start.elapsed().as_secs_f64(),
+        stop_reason,
+        groups: visibility.groups,
+        estimator: cfg.estimator,
+        errors: if visibility.jackknifed {
+            ErrorMethod::Jackknife
+        } else {
+            ErrorMethod::Groups
+        },
+        hits: total.counters.hits,
+        pairs: total.counters.pairs,
+        escapes: total.counters.escapes,
+        unpaired: total.counters.unpaired,
+        degenerate_pairs: total.counters.degenerate_pairs,
+        environment_area: visibility.environment_area,
+        distinct_pairs: total.counts.as_ref().map(|c| c.distinct_pairs()),
+        unsampled: visibility.unsampled,
+        visibility: visibility.estimates,
+        radiosity,
+        warnings,
+        tally: total,
+    })
+}
+
+/// Casts the lines of a run in rounds until its line count, budget or a stop request ends it.
+fn cast(
+    scene: &Scene,
+    tracer: &dyn Tracer,
+    cfg: &AnalysisConfig,
+    wanted: Wanted,
+    control: &RunControl,
+) -> Result<(RunState, StopReason), TraceError> {
+    let start = Instant::now();
+    let open_ended = cfg.budget.is_open_ended();
+    let plan = if open_ended {
+        BatchPlan::open_ended(cfg.lines, cfg.source)
+    } else {
+        BatchPlan::for_source(cfg.lines, cfg.source)
+    };
+    let stream = LineStream {
+        plan,
+        source: cfg.source,
+        seed: cfg.seed,
+    };
+    let deadline = cfg
+        .budget
+        .seconds
+        .map(|s| start + Duration::from_secs_f64(s.max(0.0)));
+    // A short fixed run has fewer batches than groups: one group per batch then.
+    let groups = (cfg.groups.max(2) as u64).min(plan.batches().max(2)) as usize;
+    let mut state = RunState::new(groups, wanted);
+
+    let stop = |b: u64| {
+        let late = deadline.is_some_and(|d| Instant::now() >= d);
+        if control.stop_requested() || late {
+            return true;
+        }
+        control.started(plan.batch_len(b) as u64);
+        false
+    };
+    // Rounds bound the memory held in pair keys and let a budget run check itself; for a fixed run
+    // their sizes depend on the line count only, so the numbers do too.
+    let max_round = (MAX_ROUND_LINES / plan.batch_size).max(1);
+    let mut round = if open_ended {
+        (4 * state.group_count()).max(64)
+    } else {
+        max_round
+    };
+    // Batches traced so far, and the last round's when it is not counted yet: without a precision target
+    // the next round's size does not depend on the counts, so a round is counted while the next one is
+    // traced, which keeps both cores busy through the counting's serial parts.
+    let mut traced_to = 0;
+    let mut pending: Option<TracedBatches> = None;
+    let stop_reason = loop {
+        let batches = traced_to..(traced_to + round).min(plan.batches());
+        let trace = || TracedBatches::trace(scene, tracer, &stream, batches.clone(), wanted, &stop);
+        let (traced, complete) = match pending.take() {
+            Some(previous) => rayon::join(trace, || state.add(scene, previous)).0?,
+            None => trace()?,
+        };
+        traced_to += traced.len() as u64;
+        let ended = if !complete {
+            Some(if control.stop_requested() {
+                StopReason::Interrupted
+            } else {
+                StopReason::Seconds
+            })
+        } else if traced_to >= plan.batches() {
+            Some(StopReason::Lines)
+        } else if deadline.is_some_and(|d| Instant::now() >= d) {
+            Some(StopReason::Seconds)
+        } else {
+            None
+        };
+        if ended.is_some() || cfg.budget.target.is_some() {
+            state.add(scene, traced);
+        } else {
+            pending = Some(traced);
+        }
+        if let Some(reason) = ended {
+            break reason;
+        }
+        if let Some(target) = cfg.budget.target {
+            let done = state.batches_done();
+            match current_stderr(scene, &state, cfg, wanted, target.measure) {
+                Some(se) if se <= target.stderr => break StopReason::Target,
+                // stderr ~ 1/sqrt(lines): aim 10% past the predicted need, at most doubling per round.
+                Some(se) => {
+                    let need = done as f64 * (se / target.stderr).powi(2) * 1.1;
+                    round = ((need as u64).saturating_sub(done)).clamp(1, done.max(1));
+                }
+                None => round = done.max(1),
+            }
+        } else {
+            // Doubling: few rounds, and a time budget is checked before every batch anyway.
+            round = traced_to.max(64);
+        }
+        round = round.min(max_round);
+    };
+    Ok((state, stop_reason))
+}
+
+/// The standard error of `measure` from the groups so far (batch means: the jackknife needs the total's
+/// counts, which a dense run merges only at the end; batch means are larger where they differ, so a
+/// target is never met early).
+fn current_stderr(
+    scene: &Scene,
+    state: &RunState,
+    cfg: &AnalysisConfig,
+    wanted: Wanted,
+    measure: TargetMeasure,
+) -> Option<f64> {
+    let filled = state.filled_groups();
+    let enclose = cfg.enclose && filled.iter().any(|t| t.counters.escapes > 0);
+    let values: Vec<GroupValues> = filled
+        .par_iter()
+        .map(|t| GroupValues::of(scene, t, cfg.estimator, enclose))
+        .collect();
+    // The total's value does not change the spread of the groups; any stand-in does.
+    let spread = Spread {
+        all: values.first()?,
+        groups: &values,
+        replicates: None,
+    };
+    estimates(&areas(scene), &spread, wanted)
+        .of(measure)?
+        .stderr
+}
+
+/// The visibility side of a finished run.
+struct VisibilityOfRun {
+    estimates: VisibilityEstimates,
+    /// The groups with lines.
+    groups: usize,
+    /// Patches no segment left, and their area fraction (when counted).
+    unsampled: Option<(usize, f64)>,
+    /// The environment's area in scene units, when enclosed.
+    environment_area: Option<Estimate>,
+    /// Whether the standard errors came from the jackknife.
+    jackknifed: bool,
+}
+
+/// Every visibility measure of a finished run with its standard error (by the jackknife when asked and
+/// possible), and the environment's area when enclosed.
+fn visibility_estimates(
+    scene: &Scene,
+    run: &FinishedRun,
+    estimator: EntropyEstimator,
+    enclose: bool,
+    jackknife: bool,
+    wanted: Wanted,
+) -> VisibilityOfRun {
+    let values_of = |t: &Tally| GroupValues::of(scene, t, estimator, enclose);
+    let (all, per_group): (GroupValues, Vec<GroupValues>) = rayon::join(
+        || values_of(&run.total),
+        || run.groups.par_iter().map(values_of).collect(),
+    );
+    let replicates = jackknife
+        .then(|| jackknife_replicates(scene, &run.total, &run.groups, estimator))
+        .flatten();
+    let areas = areas(scene);
+    let spread = Spread {
+        all: &all,
+        groups: &per_group,
+        replicates: replicates.as_deref(),
+    };
+    let mut estimates = if run.total.counters.lines == 0 {
+        VisibilityEstimates {
+            positional_entropy: Some(Estimate::exact(positional_entropy(&areas))),
+            ..VisibilityEstimates::default()
+        }
+    } else {
+        estimates(&areas, &spread, wanted)
+    };
+    let mut environment_area = None;
+    if enclose {
+        // The environment's area is counted, so H_p has a spread over the groups too.
+        estimates.positional_entropy = spread.batch_means(|g| Some(g.discrete?.positional_entropy));
+        let scale2 = scene.normalization.scale.powi(2);
+        environment_area = spread.batch_means(|g| Some(g.environment_area? * scale2));
+    }
+    VisibilityOfRun {
+        estimates,
+        groups: per_group.len(),
+        unsampled: all
+            .discrete
+            .map(|d| (d.unsampled_patches, d.unsampled_area_fraction)),
+        environment_area,
+        jackknifed: replicates.is_some(),
+    }
+}
+
+/// The delete-a-group jackknife's replicates: the run's values with each group's lines left out, from
+/// the total's row sums lowered by that group's counts ([`Rows::without_group`]). `None` without pair
+/// counts. Not for an enclosed scene (the environment patch's area is itself estimated from the lines)
+/// nor for Chao–Shen (its second pass needs every count of the replicate): the caller checks.
+fn jackknife_replicates(
+    scene: &Scene,
+    total: &Tally,
+    groups: &[Tally],
+    estimator: EntropyEstimator,
+) -> Option<Vec<GroupValues>> {
+    let total_counts = total.counts.as_ref()?;
+    let a = channel::area_distribution(&areas(scene));
+    let a = a.as_slice()?;
+    let rows = Rows::gather(a, total_counts, &total.escapes_by_patch, estimator);
+    groups
+        .par_iter()
+        .map(|g| {
+            let counts = g.counts.as_ref()?;
+            let left = rows.without_group(
+                a,
+                (total_counts, &total.escapes_by_patch),
+                (counts, &g.escapes_by_patch),
+            );
+            Some(GroupValues {
+                discrete: Some(visibility::discrete_from_rows(a, &left.sums)),
+                // The counts are read only by Chao–Shen, excluded by the caller.
+                corrected: Some(bias::corrected_from_rows(
+                    a,
+                    &left,
+                    counts,
+                    &g.escapes_by_patch,
+                )),
+                continuous: ContinuousValues::from_sum(
+                    total.counters.cmi_sum - g.counters.cmi_sum,
+                    total.counters.cmi_pairs - g.counters.cmi_pairs,
+                ),
+                environment_area: None,
+            })
+        })
+        .collect()
+}
+
+/// Eq. (19), exact from the areas.
+fn positional_entropy(areas: &[f64]) -> f64 {
+    -channel::area_distribution(areas)
+        .iter()
+        .map(|&x| xlog2x(x))
+        .sum::<f64>()
+}
+
+/// Every measure with its standard error: by the delete-a-group jackknife when the spread has
+/// replicates, except I_s^c, a mean, whose batch-means error is exact; else, and for I_s^c, by batch
+/// means.
+fn estimates(areas: &[f64], spread: &Spread<GroupValues>, wanted: Wanted) -> VisibilityEstimates {
+    let both = wanted.discrete && wanted.continuous;
+    let est = |f: &dyn Fn(&GroupValues) -> Option<f64>| spread.estimate(f);
+    VisibilityEstimates {
+        positional_entropy: Some(Estimate::exact(positional_entropy(areas))),
+        entropy: est(&|g| Some(g.discrete?.entropy)),
+        entropy_corrected: est(&|g| Some(g.corrected?.entropy)),
+        joint_entropy: est(&|g| Some(g.discrete?.joint_entropy)),
+        mutual_information: est(&|g| Some(g.discrete?.mutual_information)),
+        mutual_information_corrected: est(&|g| Some(g.corrected?.mutual_information)),
+        continuous_mutual_information: spread
+            .batch_means(|g| Some(g.continuous?.mutual_information)),
+        accuracy: if both { est(&|g| g.accuracy()) } else { None },
+        accuracy_corrected: if both {
+            est(&|g| g.accuracy_corrected())
+        } else {
+            None
+        },
+        relative_error: if both {
+            est(&|g| Some(1.0 - g.accuracy()?))
+        } else {
+            None
+        },
+        mse_per_line: est(&|g| Some(g.discrete?.mse_per_line)),
+    }
+}

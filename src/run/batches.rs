@@ -1,0 +1,138 @@
+//! The one loop over batches of lines that every kind of run uses: draw each batch's lines from its own
+//! random stream, hand them (traced, when asked) to a visitor, in parallel, and collect the results in
+//! batch order, so that whatever is added up from them does not depend on the thread count.
+
+use std::ops::Range;
+
+use rayon::prelude::*;
+
+use super::plan::BatchPlan;
+use crate::sample::lines::LineSource;
+use crate::trace::{Line, LineHits, RawHit, TraceError, Tracer};
+
+/// The lines of a run: its batch plan, where its lines come from, and the seed of their streams. A
+/// batch's lines depend on these and its index only.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct LineStream {
+    /// How the lines are cut into batches.
+    pub plan: BatchPlan,
+    /// Independent lines or bundles (`plan` must hold whole bundles, [`BatchPlan::for_source`]).
+    pub source: LineSource,
+    /// Seed of the streams.
+    pub seed: u64,
+}
+
+impl LineStream {
+    /// `lines` independent lines from `seed`, in the batches of [`BatchPlan::new`]: the lines of `scx
+    /// analyze --seed seed` without a budget.
+    pub fn independent(lines: u64, seed: u64) -> Self {
+        LineStream {
+            plan: BatchPlan::new(lines),
+            source: LineSource::Independent,
+            seed,
+        }
+    }
+
+    /// Appends batch `batch`'s lines to `out` (tracing space, bounding radius `radius`).
+    pub fn draw(&self, batch: u64, radius: f64, out: &mut Vec<Line>) {
+        self.source
+            .batch_lines(self.seed, batch, self.plan.batch_len(batch), radius, out);
+    }
+}
+
+/// One batch of drawn lines.
+#[derive(Clone, Copy, Debug)]
+pub struct Batch<'a> {
+    /// The batch's index in the run.
+    pub index: u64,
+    /// The index of its first line in the run.
+    pub first_line: u64,
+    /// Its lines.
+    pub lines: &'a [Line],
+}
+
+/// Results of batches in batch order, and whether every batch asked for ran.
+pub type Mapped<T> = (Vec<T>, bool);
+
+/// Draws the lines of `batches` and hands each batch to `visit` with a per-thread scratch `S`, in
+/// parallel; returns the results in batch order.
+///
+/// `stop(b)` is asked before batch `b` starts; when it says yes the batch is skipped. Only the longest
+/// prefix of finished batches is kept, so what ran is always batches `start..start + k`; the flag says
+/// whether every batch ran.
+pub fn map_batches<S, T, E>(
+    stream: &LineStream,
+    radius: f64,
+    batches: Range<u64>,
+    stop: &(dyn Fn(u64) -> bool + Sync),
+    visit: impl Fn(&mut S, Batch<'_>) -> Result<T, E> + Sync + Send,
+) -> Result<Mapped<T>, E>
+where
+    S: Default + Send,
+    T: Send,
+    E: Send,
+{
+    let per_batch: Vec<Option<T>> = batches
+        .into_par_iter()
+        .map_init(
+            || (Vec::new(), S::default()),
+            |(lines, scratch), b| {
+                if stop(b) {
+                    return Ok(None);
+                }
+                lines.clear();
+                stream.draw(b, radius, lines);
+                let batch = Batch {
+                    index: b,
+                    first_line: stream.plan.first_line(b),
+                    lines,
+                };
+                visit(scratch, batch).map(Some)
+            },
+        )
+        .collect::<Result<_, _>>()?;
+    let all = per_batch.len();
+    let finished: Vec<T> = per_batch.into_iter().map_while(|b| b).collect();
+    let complete = finished.len() == all;
+    Ok((finished, complete))
+}
+
+/// Buffers for tracing one batch, kept from batch to batch.
+#[derive(Debug, Default)]
+pub struct TraceBuffers {
+    raw: Vec<RawHit>,
+    /// The canonical hits of the batch's lines.
+    pub hits: LineHits,
+}
+
+impl TraceBuffers {
+    /// Traces `lines` with `tracer` into [`TraceBuffers::hits`].
+    pub fn trace(&mut self, tracer: &dyn Tracer, lines: &[Line]) -> Result<(), TraceError> {
+        tracer.all_hits(lines, &mut self.raw, &mut self.hits)
+    }
+}
+
+/// [`map_batches`] with every batch traced first: `visit` gets the batch and its canonical hits.
+pub fn map_traced_batches<S, T>(
+    stream: &LineStream,
+    tracer: &dyn Tracer,
+    radius: f64,
+    batches: Range<u64>,
+    stop: &(dyn Fn(u64) -> bool + Sync),
+    visit: impl Fn(&mut S, Batch<'_>, &LineHits) -> T + Sync + Send,
+) -> Result<Mapped<T>, TraceError>
+where
+    S: Default + Send,
+    T: Send,
+{
+    map_batches(
+        stream,
+        radius,
+        batches,
+        stop,
+        |(buffers, scratch): &mut (TraceBuffers, S), batch| {
+            buffers.trace(tracer, batch.lines)?;
+            Ok(visit(scratch, batch, &buffers.hits))
+        },
+    )
+}

@@ -1,0 +1,31 @@
+//! The run engine: one way to cast a run's lines, for every kind of run.
+//!
+//! * [`plan`]: how lines are cut into batches (a function of the line count, never of the threads) and
+//!   batches into rounds;
+//! * [`batches`]: the one parallel loop over batches, whose results come back in batch order (analyses,
+//!   refinement rounds and cross-checks all use it);
+//! * [`state`]: a run's groups as they fill up, a value ([`RunState`]);
+//! * [`errors`]: standard errors from the groups (batch means, the delete-a-group jackknife);
+//! * [`control`]: budgets, stop reasons and the handle that watches and stops a run;
+//! * [`analysis`]: the analysis of a scene, [`analyze`], with [`radiosity`] and [`warnings`].
+
+pub mod analysis;
+pub mod batches;
+pub mod control;
+pub mod errors;
+pub mod plan;
+pub mod radiosity;
+pub mod state;
+pub mod warnings;
+
+pub use analysis::{
+    analyze, Analysis, AnalysisConfig, AnalysisError, Measures, VisibilityEstimates,
+    DEFAULT_ESTIMATOR, DEFAULT_GROUPS,
+};
+pub use batches::{map_batches, map_traced_batches, Batch, LineStream, TraceBuffers};
+pub use control::{Budget, RunControl, StopReason, Target, TargetMeasure};
+pub use errors::{ErrorMethod, Spread};
+pub use plan::BatchPlan;
+pub use radiosity::{RadiosityEstimates, RadiosityOutcome, SolveFailure, NOTHING_EMITS};
+pub use state::{FinishedRun, RunState, TracedBatches};
+pub use warnings::{RunWarning, RunWarningKind};

@@ -1,0 +1,99 @@
+//! What a user must know about a run's numbers, as data: each warning has a kind a program can test and
+//! a sentence a person can read.
+
+use crate::measure::Estimate;
+use crate::sample::tally::Counters;
+
+/// What a warning is about.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RunWarningKind {
+    /// Segments escaped: form-factor rows sum to less than 1 (or the scene was enclosed).
+    OpenScene,
+    /// Lines met coplanar overlapping faces facing the same way; only the first is seen there.
+    CoincidentCrossings,
+    /// Some patches were never left by a line: their rows are empty.
+    UnsampledPatches,
+    /// Some pairs joined coincident points (touching surfaces) and were left out of I_s^c.
+    DegeneratePairs,
+}
+
+/// One warning about a run.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RunWarning {
+    /// What it is about.
+    pub kind: RunWarningKind,
+    /// The sentence for the report, naming the scene.
+    pub message: String,
+}
+
+impl std::fmt::Display for RunWarning {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.message)
+    }
+}
+
+/// The fraction of the segments leaving a front side that escape the scene (`None` without segments).
+pub fn escape_fraction(counters: &Counters) -> Option<f64> {
+    let segments = counters.pairs + counters.escapes;
+    (segments > 0).then(|| counters.escapes as f64 / segments as f64)
+}
+
+/// The warnings of a run of scene `scene`: its counters, its unsampled patches and area fraction (when
+/// counted) and the environment's area (when enclosed).
+pub(crate) fn of_run(
+    scene: &str,
+    counters: &Counters,
+    unsampled: Option<(usize, f64)>,
+    environment_area: Option<Estimate>,
+) -> Vec<RunWarning> {
+    let mut w = Vec::new();
+    let mut push = |kind, message| w.push(RunWarning { kind, message });
+    if let Some(fraction) = escape_fraction(counters).filter(|&f| f > 0.0) {
+        let effect = match environment_area {
+            Some(env) => format!(
+                "with --enclose they are pairs with the environment patch (area {:.6} scene units^2), and \
+                 the measures are those of the enclosed scene",
+                env.value
+            ),
+            None => "so form-factor rows sum to less than 1 (--enclose closes the scene)".into(),
+        };
+        push(
+            RunWarningKind::OpenScene,
+            format!(
+                "{scene}: the scene is open: {:.3}% of the segments leaving a front side escape the \
+                 scene; {effect}",
+                100.0 * fraction
+            ),
+        );
+    }
+    if counters.coincident_crossings > 0 {
+        push(
+            RunWarningKind::CoincidentCrossings,
+            format!(
+                "{scene}: {} line crossing(s) met coplanar overlapping faces facing the same way; only the \
+                 face first in the scene is seen there (remove duplicated faces and decals)",
+                counters.coincident_crossings
+            ),
+        );
+    }
+    if let Some((n, frac)) = unsampled.filter(|u| u.0 > 0) {
+        push(
+            RunWarningKind::UnsampledPatches,
+            format!(
+                "{scene}: {n} patch(es) ({:.4}% of the area) were never left by a line: their rows are \
+                 empty; cast more lines",
+                100.0 * frac
+            ),
+        );
+    }
+    if counters.degenerate_pairs > 0 {
+        push(
+            RunWarningKind::DegeneratePairs,
+            format!(
+                "{scene}: {} pair(s) joined coincident points (touching surfaces) and were left out of I_s^c",
+                counters.degenerate_pairs
+            ),
+        );
+    }
+    w
+}
