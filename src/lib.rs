@@ -7,6 +7,7 @@
 #![forbid(unsafe_op_in_unsafe_fn)]
 
 pub mod crosscheck;
+pub mod geom;
 pub mod measure;
 pub mod refine;
 pub mod reproduce;

@@ -17,6 +17,7 @@
 
 use std::collections::HashMap;
 
+use crate::geom::Point;
 use crate::scene::{Material, Scene, SceneBuilder, SceneError};
 
 /// One element (a future patch): its corners counter-clockwise seen from the front, and its material.
@@ -31,7 +32,7 @@ pub struct Element {
 /// A mesh of planar convex elements in the scene's own units.
 #[derive(Clone, Debug)]
 pub struct Mesh {
-    vertices: Vec<[f64; 3]>,
+    vertices: Vec<Point>,
     weld: HashMap<[u64; 3], u32>,
     elements: Vec<Element>,
     /// The midpoint vertex of each split edge, keyed by its end vertices (smaller index first).
@@ -75,7 +76,7 @@ impl Mesh {
     }
 
     /// A vertex's position (scene units).
-    pub fn position(&self, v: u32) -> [f64; 3] {
+    pub fn position(&self, v: u32) -> Point {
         self.vertices[v as usize]
     }
 
@@ -121,8 +122,8 @@ impl Mesh {
         self.elements.extend(children);
     }
 
-    fn vertex(&mut self, p: [f64; 3]) -> u32 {
-        let key = p.map(|c| (c + 0.0).to_bits());
+    fn vertex(&mut self, p: Point) -> u32 {
+        let key = p.to_array().map(|c| (c + 0.0).to_bits());
         if let Some(&v) = self.weld.get(&key) {
             return v;
         }
@@ -139,7 +140,7 @@ impl Mesh {
             return m;
         }
         let (p, q) = (self.vertices[key.0 as usize], self.vertices[key.1 as usize]);
-        let m = self.vertex([0, 1, 2].map(|c| 0.5 * (p[c] + q[c])));
+        let m = self.vertex(0.5 * (p + q));
         self.splits.insert(key, m);
         m
     }
@@ -164,9 +165,9 @@ impl Mesh {
             .map(|k| self.midpoint(c[k], c[(k + 1) % 4]))
             .collect();
         let centre = {
-            let p: Vec<[f64; 3]> = c.iter().map(|&v| self.vertices[v as usize]).collect();
+            let p: Vec<Point> = c.iter().map(|&v| self.vertices[v as usize]).collect();
             // The bimedians cross at the mean of the four corners.
-            self.vertex([0, 1, 2].map(|k| 0.25 * (p[0][k] + p[1][k] + p[2][k] + p[3][k])))
+            self.vertex(0.25 * (p[0] + p[1] + p[2] + p[3]))
         };
         vec![
             vec![c[0], m[0], centre, m[3]],
@@ -184,12 +185,9 @@ impl Mesh {
                 self.vertices[c[k] as usize],
                 self.vertices[c[(k + 1) % n] as usize],
             );
-            [0, 1, 2].map(|i| 0.5 * (p[i] + q[i]))
+            0.5 * (p + q)
         };
-        let chord = |k: usize| {
-            let (p, q) = (mid_point(k), mid_point((k + half) % n));
-            (0..3).map(|i| (p[i] - q[i]).powi(2)).sum::<f64>()
-        };
+        let chord = |k: usize| (mid_point(k) - mid_point((k + half) % n)).length_squared();
         // The shortest chord cuts across the polygon's longest extent.
         let k = (0..n)
             .min_by(|&a, &b| chord(a).total_cmp(&chord(b)))

@@ -3,12 +3,12 @@
 
 use rayon::prelude::*;
 
+use crate::geom::{orthonormal_basis, Direction};
 use crate::measure::channel::row_totals;
 use crate::measure::radiosity::{FormFactors, Solution};
 use crate::run::{map_traced_batches, LineStream};
 use crate::sample::counts::{pair_key, PairCounts};
 use crate::sample::kernel::kernel_without_pi;
-use crate::sample::lines::orthonormal_basis;
 use crate::sample::pairs::{segments, LineF64, Segment};
 use crate::scene::Scene;
 use crate::trace::{TraceError, Tracer};
@@ -196,17 +196,16 @@ pub fn arrivals(
     seed: u64,
     radiosity: &[f64],
 ) -> Result<Vec<ArrivalMoments>, TraceError> {
-    let bases: Vec<([f64; 3], [f64; 3])> = scene
+    let bases: Vec<(Direction, Direction)> = scene
         .patches
         .iter()
         .map(|p| orthonormal_basis(p.normal))
         .collect();
     let point_on = |p: usize, l: &LineF64| -> (f64, f64) {
         let patch = &scene.patches[p];
-        let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-        let t = (patch.offset - dot(patch.normal, l.origin)) / dot(patch.normal, l.dir);
-        let x = [0, 1, 2].map(|k| l.origin[k] + t * l.dir[k]);
-        (dot(x, bases[p].0), dot(x, bases[p].1))
+        let t = (patch.offset - patch.normal.dot(l.origin)) / patch.normal.dot(l.dir);
+        let x = l.origin + t * l.dir;
+        (x.dot(bases[p].0), x.dot(bases[p].1))
     };
     let per_batch = trace_segments(
         scene,

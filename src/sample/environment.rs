@@ -33,8 +33,8 @@ pub(crate) fn escape(scene: &Scene, line: &Line, patch: u32, at_start: bool) -> 
     let l = LineF64::from(line);
     let p = &scene.patches[patch as usize];
     let n = p.normal;
-    let cos = n[0] * l.dir[0] + n[1] * l.dir[1] + n[2] * l.dir[2];
-    let t = (p.offset - (n[0] * l.origin[0] + n[1] * l.origin[1] + n[2] * l.origin[2])) / cos;
+    let cos = n.dot(l.dir);
+    let t = (p.offset - n.dot(l.origin)) / cos;
     let (t_in, t_out, cos_sphere) = sphere_chord(&l, scene.bounding_radius());
     let distance = if at_start { t - t_in } else { t_out - t };
     (cos.abs() * cos_sphere, distance)
@@ -44,8 +44,8 @@ pub(crate) fn escape(scene: &Scene, line: &Line, patch: u32, at_start: bool) -> 
 /// the line and the sphere's normal there (the same at both ends).
 fn sphere_chord(l: &LineF64, r: f64) -> (f64, f64, f64) {
     let (o, d) = (l.origin, l.dir);
-    let centre_t = -(o[0] * d[0] + o[1] * d[1] + o[2] * d[2]);
-    let b2 = o[0] * o[0] + o[1] * o[1] + o[2] * o[2] - centre_t * centre_t;
+    let centre_t = -o.dot(d);
+    let b2 = o.dot(o) - centre_t * centre_t;
     let half = (r * r - b2).max(0.0).sqrt();
     (centre_t - half, centre_t + half, half / r)
 }

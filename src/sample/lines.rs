@@ -12,6 +12,7 @@
 use rand::RngCore;
 use rand_pcg::Pcg64;
 
+use crate::geom::{orthonormal_basis, uniform01, DVec3};
 use crate::trace::Line;
 
 /// The traced segment reaches this factor beyond the bounding sphere on both sides, so that f32 rounding
@@ -114,7 +115,7 @@ impl LineSource {
 pub fn bundle_lines(rng: &mut impl RngCore, grid: u32, radius: f64, out: &mut Vec<Line>) {
     let (x, y, s) = point_in_unit_disc(rng);
     let k = 2.0 * (1.0 - s).sqrt();
-    let dir = [x * k, y * k, 1.0 - 2.0 * s];
+    let dir = DVec3::new(x * k, y * k, 1.0 - 2.0 * s);
     let (e1, e2) = orthonormal_basis(dir);
     let reach = radius * SPHERE_MARGIN;
     let cell = 2.0 / f64::from(grid);
@@ -124,15 +125,10 @@ pub fn bundle_lines(rng: &mut impl RngCore, grid: u32, radius: f64, out: &mut Ve
         if i >= grid || j >= grid {
             continue;
         }
-        let a = -1.0 + cell * (f64::from(i) + unit(rng));
-        let b = -1.0 + cell * (f64::from(j) + unit(rng));
+        let a = -1.0 + cell * (f64::from(i) + uniform01(rng));
+        let b = -1.0 + cell * (f64::from(j) + uniform01(rng));
         let (px, py) = concentric_disc(a, b);
-        let origin = [0, 1, 2].map(|c| radius * (px * e1[c] + py * e2[c]) - reach * dir[c]);
-        out.push(Line {
-            origin: origin.map(|v| v as f32),
-            dir: dir.map(|v| v as f32),
-            t_max: (2.0 * reach) as f32,
-        });
+        out.push(line_through(radius * (px * e1 + py * e2), dir, reach));
     }
 }
 
@@ -172,14 +168,19 @@ pub fn global_line(rng: &mut impl RngCore, radius: f64) -> Line {
     let (x, y, s) = point_in_unit_disc(rng);
     // Marsaglia (1972): (2x sqrt(1-s), 2y sqrt(1-s), 1-2s) is uniform on the sphere.
     let k = 2.0 * (1.0 - s).sqrt();
-    let dir = [x * k, y * k, 1.0 - 2.0 * s];
+    let dir = DVec3::new(x * k, y * k, 1.0 - 2.0 * s);
     let (e1, e2) = orthonormal_basis(dir);
     let (px, py, _) = point_in_unit_disc(rng);
     let reach = radius * SPHERE_MARGIN;
-    let origin = [0, 1, 2].map(|a| radius * (px * e1[a] + py * e2[a]) - reach * dir[a]);
+    line_through(radius * (px * e1 + py * e2), dir, reach)
+}
+
+/// The traced line through `point` (on the disc through the centre) along the unit `dir`, from `reach`
+/// before that point to `reach` beyond it, rounded to f32.
+fn line_through(point: DVec3, dir: DVec3, reach: f64) -> Line {
     Line {
-        origin: origin.map(|x| x as f32),
-        dir: dir.map(|x| x as f32),
+        origin: (point - reach * dir).as_vec3().to_array(),
+        dir: dir.as_vec3().to_array(),
         t_max: (2.0 * reach) as f32,
     }
 }
@@ -187,39 +188,13 @@ pub fn global_line(rng: &mut impl RngCore, radius: f64) -> Line {
 /// A point uniform in the unit disc, by rejection from the square, and its squared radius.
 fn point_in_unit_disc(rng: &mut impl RngCore) -> (f64, f64, f64) {
     loop {
-        let x = 2.0 * unit(rng) - 1.0;
-        let y = 2.0 * unit(rng) - 1.0;
+        let x = 2.0 * uniform01(rng) - 1.0;
+        let y = 2.0 * uniform01(rng) - 1.0;
         let s = x * x + y * y;
         if s < 1.0 {
             return (x, y, s);
         }
     }
-}
-
-/// A direction uniform on the unit sphere from two uniforms in [0, 1).
-pub fn uniform_direction(u1: f64, u2: f64) -> [f64; 3] {
-    let z = 1.0 - 2.0 * u1;
-    let r = (1.0 - z * z).max(0.0).sqrt();
-    let phi = std::f64::consts::TAU * u2;
-    let (s, c) = phi.sin_cos();
-    [r * c, r * s, z]
-}
-
-/// Two unit vectors completing the unit vector `n` to a right-handed orthonormal basis
-/// (Duff et al., "Building an orthonormal basis, revisited", JCGT 2017: no branch on a near-pole).
-pub fn orthonormal_basis(n: [f64; 3]) -> ([f64; 3], [f64; 3]) {
-    let sign = 1.0f64.copysign(n[2]);
-    let a = -1.0 / (sign + n[2]);
-    let b = n[0] * n[1] * a;
-    (
-        [1.0 + sign * n[0] * n[0] * a, sign * b, -sign * n[0]],
-        [b, sign + n[1] * n[1] * a, -n[1]],
-    )
-}
-
-/// A uniform double in [0, 1) from the top 53 bits of a 64-bit draw (fixed here, not left to a crate).
-pub fn unit(rng: &mut impl RngCore) -> f64 {
-    (rng.next_u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
 }
 
 /// SplitMix64's finaliser: spreads a seed over all 64 bits.
@@ -233,23 +208,6 @@ fn splitmix64(x: u64) -> u64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn basis_is_orthonormal_near_both_poles() {
-        for n in [
-            [0.0, 0.0, 1.0],
-            [0.0, 0.0, -1.0],
-            [0.6, 0.0, -0.8],
-            [1e-9, 0.0, -1.0],
-        ] {
-            let len: f64 = n[0] * n[0] + n[1] * n[1] + n[2] * n[2];
-            let n = n.map(|c: f64| c / len.sqrt());
-            let (a, b) = orthonormal_basis(n);
-            let d = |x: [f64; 3], y: [f64; 3]| x[0] * y[0] + x[1] * y[1] + x[2] * y[2];
-            assert!((d(a, a) - 1.0).abs() < 1e-12 && (d(b, b) - 1.0).abs() < 1e-12);
-            assert!(d(a, b).abs() < 1e-12 && d(a, n).abs() < 1e-12 && d(b, n).abs() < 1e-12);
-        }
-    }
 
     #[test]
     fn batches_are_reproducible_and_distinct() {

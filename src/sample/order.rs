@@ -16,6 +16,7 @@
 //! there, and it is always the one first in the scene (lowest triangle index), from either side; each
 //! such crossing is counted so that the report can warn.
 
+use crate::geom::Normal;
 use crate::trace::Hit;
 
 /// Consecutive hits at most this many f32 ulps apart (at max(t, 1)) may be in either order: the
@@ -39,7 +40,7 @@ pub(crate) struct Crossing {
     /// Distance along the line to the patch's plane (the f32 `t` when the line lies in the plane).
     pub t: f64,
     /// The patch's unit normal.
-    pub normal: [f64; 3],
+    pub normal: Normal,
 }
 
 /// Whether some consecutive hits are too close for their f32 order to be trusted.
@@ -97,11 +98,10 @@ fn is_touch(window: &[Crossing]) -> bool {
     if arrivals == 0 || arrivals != departures || arrivals + departures != window.len() {
         return false;
     }
-    let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
     window.iter().any(|a| {
         window
             .iter()
-            .any(|b| dot(a.normal, b.normal).abs() < 1.0 - 1e-9)
+            .any(|b| a.normal.dot(b.normal).abs() < 1.0 - 1e-9)
     })
 }
 
@@ -199,14 +199,14 @@ mod tests {
             triangle: patch,
             cos,
             t,
-            normal: [0.0, 0.0, 1.0],
+            normal: Normal::Z,
         }
     }
 
     /// A crossing of a plane with the given normal.
     fn cn(patch: u32, cos: f64, t: f64, normal: [f64; 3]) -> Crossing {
         Crossing {
-            normal,
+            normal: Normal::from_array(normal),
             ..c(patch, cos, t)
         }
     }

@@ -11,6 +11,7 @@
 //! patch's plane faces neither side and makes its segments unpaired.
 
 use super::order::{self, Crossing};
+use crate::geom::{unit_vector, DVec3, Direction, Point};
 use crate::scene::Scene;
 use crate::trace::{Hit, Line};
 
@@ -44,18 +45,16 @@ pub enum Segment {
 #[derive(Clone, Copy, Debug)]
 pub struct LineF64 {
     /// Origin (the traced f32 origin, exactly).
-    pub origin: [f64; 3],
+    pub origin: Point,
     /// Unit direction (the traced f32 direction, renormalised in f64).
-    pub dir: [f64; 3],
+    pub dir: Direction,
 }
 
 impl From<&Line> for LineF64 {
     fn from(l: &Line) -> Self {
-        let d = l.dir.map(f64::from);
-        let len = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
         LineF64 {
-            origin: l.origin.map(f64::from),
-            dir: d.map(|c| c / len),
+            origin: DVec3::from_array(l.origin.map(f64::from)),
+            dir: unit_vector(DVec3::from_array(l.dir.map(f64::from))),
         }
     }
 }
@@ -96,9 +95,9 @@ fn crossing(scene: &Scene, l: &LineF64, h: &Hit) -> Crossing {
     let patch = scene.triangle_patch[h.triangle as usize];
     let p = &scene.patches[patch as usize];
     let n = p.normal;
-    let cos = n[0] * l.dir[0] + n[1] * l.dir[1] + n[2] * l.dir[2];
+    let cos = n.dot(l.dir);
     let t = if cos != 0.0 {
-        (p.offset - (n[0] * l.origin[0] + n[1] * l.origin[1] + n[2] * l.origin[2])) / cos
+        (p.offset - n.dot(l.origin)) / cos
     } else {
         // In the plane: no plane distance; the traced one orders it.
         f64::from(h.t)

@@ -3,6 +3,7 @@
 use std::collections::HashMap;
 
 use super::{Material, Normalization, Patch, Scene, SceneError};
+use crate::geom::{centroid, newell, triangle_area, Normal, Point};
 
 /// A triangle whose area, relative to the squared bounding radius, is below this is degenerate.
 const DEGENERATE_AREA: f64 = 1e-14;
@@ -16,7 +17,7 @@ const PLANARITY_TOLERANCE: f64 = 1e-4;
 #[derive(Debug)]
 pub struct SceneBuilder {
     name: String,
-    vertices: Vec<[f64; 3]>,
+    vertices: Vec<Point>,
     weld: HashMap<[u64; 3], u32>,
     polygons: Vec<Polygon>,
     materials: Vec<Material>,
@@ -45,9 +46,10 @@ impl SceneBuilder {
     }
 
     /// Adds a vertex (welded with an identical earlier one) and returns its index.
-    pub fn vertex(&mut self, p: [f64; 3]) -> u32 {
+    pub fn vertex(&mut self, p: impl Into<Point>) -> u32 {
+        let p = p.into();
         // -0.0 and 0.0 are the same point.
-        let key = p.map(|c| (c + 0.0).to_bits());
+        let key = p.to_array().map(|c| (c + 0.0).to_bits());
         if let Some(&i) = self.weld.get(&key) {
             return i;
         }
@@ -84,7 +86,7 @@ impl SceneBuilder {
         }
         self.check_finite()?;
         let normalization = self.normalization()?;
-        let traced: Vec<[f64; 3]> = self
+        let traced: Vec<Point> = self
             .vertices
             .iter()
             .map(|p| to_tracing_space(*p, &normalization))
@@ -94,12 +96,12 @@ impl SceneBuilder {
         // triangles meeting there share the index (the hit rules merge a crossing of a shared vertex).
         let remap = weld_f32(&traced, &mut self.polygons);
         drop_duplicates(&self.name, &mut self.polygons, &mut self.warnings);
-        let vertices: Vec<[f64; 3]> = remap.iter().map(|&v| self.vertices[v as usize]).collect();
-        let traced: Vec<[f64; 3]> = remap.iter().map(|&v| traced[v as usize]).collect();
+        let vertices: Vec<Point> = remap.iter().map(|&v| self.vertices[v as usize]).collect();
+        let traced: Vec<Point> = remap.iter().map(|&v| traced[v as usize]).collect();
 
         let mut scene = Scene {
             name: self.name.clone(),
-            positions: traced.iter().map(|p| p.map(|c| c as f32)).collect(),
+            positions: traced.iter().map(|p| p.as_vec3().to_array()).collect(),
             vertices,
             triangles: Vec::new(),
             triangle_patch: Vec::new(),
@@ -125,7 +127,7 @@ impl SceneBuilder {
                     poly.origin, poly.material
                 )));
             }
-            let pts: Vec<[f64; 3]> = poly.vertices.iter().map(|&v| traced[v as usize]).collect();
+            let pts: Vec<Point> = poly.vertices.iter().map(|&v| traced[v as usize]).collect();
             let (normal, area) = newell(&pts);
             check_planar(&pts, normal, area)
                 .map_err(|m| self.geometry_error(format!("{}: {m}", poly.origin)))?;
@@ -161,7 +163,7 @@ impl SceneBuilder {
             scene.patches.push(Patch {
                 area: patch_area,
                 normal,
-                offset: dot(normal, centroid),
+                offset: normal.dot(centroid),
                 material: poly.material,
                 first_triangle: first,
                 triangle_count: count,
@@ -201,14 +203,14 @@ impl SceneBuilder {
                 let p = self.vertices.get(v as usize).ok_or_else(|| {
                     self.geometry_error(format!("{}: vertex index {v} out of range", poly.origin))
                 })?;
-                if p.iter().any(|c| !c.is_finite()) {
+                if !p.is_finite() {
                     return Err(self.geometry_error(format!(
                         "{}: vertex {} has a non-finite coordinate ({}, {}, {})",
                         poly.origin,
                         v + 1,
-                        p[0],
-                        p[1],
-                        p[2]
+                        p.x,
+                        p.y,
+                        p.z
                     )));
                 }
             }
@@ -218,7 +220,7 @@ impl SceneBuilder {
 
     /// Centre of the bounding box of the used vertices, and the largest distance from it.
     fn normalization(&self) -> Result<Normalization, SceneError> {
-        let used: Vec<[f64; 3]> = self
+        let used: Vec<Point> = self
             .polygons
             .iter()
             .flat_map(|p| p.vertices.iter().map(|&v| self.vertices[v as usize]))
@@ -226,18 +228,18 @@ impl SceneBuilder {
         if used.is_empty() {
             return Err(self.geometry_error("the scene is empty: no faces".into()));
         }
-        let mut lo = [f64::INFINITY; 3];
-        let mut hi = [f64::NEG_INFINITY; 3];
+        let mut lo = Point::INFINITY;
+        let mut hi = Point::NEG_INFINITY;
         for p in &used {
             for a in 0..3 {
                 lo[a] = lo[a].min(p[a]);
                 hi[a] = hi[a].max(p[a]);
             }
         }
-        let center = [0, 1, 2].map(|a| 0.5 * (lo[a] + hi[a]));
+        let center = 0.5 * (lo + hi);
         let radius = used
             .iter()
-            .map(|p| norm(sub(*p, center)))
+            .map(|&p| (p - center).length())
             .fold(0.0f64, f64::max);
         if !(radius > 0.0 && radius.is_finite()) {
             return Err(self.geometry_error(format!(
@@ -253,7 +255,7 @@ impl SceneBuilder {
 
 /// Renumbers vertices so that those with equal f32 tracing positions become one, rewriting the polygons;
 /// returns, for each new vertex, the old vertex it stands for (unused vertices are dropped).
-fn weld_f32(traced: &[[f64; 3]], polygons: &mut [Polygon]) -> Vec<u32> {
+fn weld_f32(traced: &[Point], polygons: &mut [Polygon]) -> Vec<u32> {
     let mut by_position: HashMap<[u32; 3], u32> = HashMap::new();
     let mut new_of_old: Vec<Option<u32>> = vec![None; traced.len()];
     let mut old_of_new: Vec<u32> = Vec::new();
@@ -261,7 +263,7 @@ fn weld_f32(traced: &[[f64; 3]], polygons: &mut [Polygon]) -> Vec<u32> {
         for v in poly.vertices.iter_mut() {
             let old = *v as usize;
             let new = *new_of_old[old].get_or_insert_with(|| {
-                let key = traced[old].map(|c| ((c as f32) + 0.0).to_bits());
+                let key = traced[old].to_array().map(|c| ((c as f32) + 0.0).to_bits());
                 *by_position.entry(key).or_insert_with(|| {
                     old_of_new.push(old as u32);
                     (old_of_new.len() - 1) as u32
@@ -310,39 +312,19 @@ fn drop_duplicates(name: &str, polygons: &mut Vec<Polygon>, warnings: &mut Vec<S
     });
 }
 
-fn to_tracing_space(p: [f64; 3], n: &Normalization) -> [f64; 3] {
-    [0, 1, 2].map(|a| (p[a] - n.center[a]) / n.scale)
+fn to_tracing_space(p: Point, n: &Normalization) -> Point {
+    (p - n.center) / n.scale
 }
 
-/// Newell's normal of a polygon: unit normal and area (exact for planar polygons).
-fn newell(pts: &[[f64; 3]]) -> ([f64; 3], f64) {
-    let mut n = [0.0; 3];
-    let c = centroid(pts);
-    for k in 0..pts.len() {
-        let a = sub(pts[k], c);
-        let b = sub(pts[(k + 1) % pts.len()], c);
-        let x = cross(a, b);
-        for i in 0..3 {
-            n[i] += x[i];
-        }
-    }
-    let len = norm(n);
-    if len > 0.0 {
-        (n.map(|c| c / len), 0.5 * len)
-    } else {
-        ([0.0; 3], 0.0)
-    }
-}
-
-fn check_planar(pts: &[[f64; 3]], normal: [f64; 3], area: f64) -> Result<(), String> {
+fn check_planar(pts: &[Point], normal: Normal, area: f64) -> Result<(), String> {
     if pts.len() <= 3 || area <= 0.0 {
         return Ok(());
     }
     let c = centroid(pts);
-    let size = pts.iter().map(|p| norm(sub(*p, c))).fold(0.0, f64::max);
+    let size = pts.iter().map(|&p| (p - c).length()).fold(0.0, f64::max);
     let off = pts
         .iter()
-        .map(|p| dot(normal, sub(*p, c)).abs())
+        .map(|&p| normal.dot(p - c).abs())
         .fold(0.0, f64::max);
     if off > PLANARITY_TOLERANCE * size {
         return Err(format!(
@@ -353,38 +335,4 @@ fn check_planar(pts: &[[f64; 3]], normal: [f64; 3], area: f64) -> Result<(), Str
         ));
     }
     Ok(())
-}
-
-fn triangle_area(a: [f64; 3], b: [f64; 3], c: [f64; 3]) -> f64 {
-    0.5 * norm(cross(sub(b, a), sub(c, a)))
-}
-
-fn centroid(pts: &[[f64; 3]]) -> [f64; 3] {
-    let mut c = [0.0; 3];
-    for p in pts {
-        for a in 0..3 {
-            c[a] += p[a];
-        }
-    }
-    c.map(|x| x / pts.len() as f64)
-}
-
-pub(crate) fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-pub(crate) fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-pub(crate) fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-
-pub(crate) fn norm(a: [f64; 3]) -> f64 {
-    dot(a, a).sqrt()
 }

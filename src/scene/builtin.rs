@@ -16,8 +16,8 @@
 //! no emission (an even grey; nothing emits, so these scenes have no radiosity measures). The Cornell box
 //! has its published materials and a light; the labyrinth has materials with R + E = 1.
 
-use super::build::{cross, dot, norm, sub};
 use super::{Material, Scene, SceneBuilder, SceneError};
+use crate::geom::{centroid, orthonormal_basis, unit_vector, DVec3, Point};
 
 /// A built-in scene's name, parameter and description, for `scx scenes`.
 #[derive(Clone, Copy, Debug)]
@@ -153,13 +153,13 @@ fn parse_count(
 }
 
 /// The six faces of the unit cube as (corner, u axis, v axis), with `u x v` pointing inwards.
-const CUBE_FACES: [([f64; 3], [f64; 3], [f64; 3]); 6] = [
-    ([0.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]), // x = 0, normal +x
-    ([1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, 1.0, 0.0]), // x = 1, normal -x
-    ([0.0, 0.0, 0.0], [0.0, 0.0, 1.0], [1.0, 0.0, 0.0]), // y = 0, normal +y
-    ([0.0, 1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]), // y = 1, normal -y
-    ([0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]), // z = 0, normal +z
-    ([0.0, 0.0, 1.0], [0.0, 1.0, 0.0], [1.0, 0.0, 0.0]), // z = 1, normal -z
+const CUBE_FACES: [(DVec3, DVec3, DVec3); 6] = [
+    (DVec3::ZERO, DVec3::Y, DVec3::Z), // x = 0, normal +x
+    (DVec3::X, DVec3::Z, DVec3::Y),    // x = 1, normal -x
+    (DVec3::ZERO, DVec3::Z, DVec3::X), // y = 0, normal +y
+    (DVec3::Y, DVec3::X, DVec3::Z),    // y = 1, normal -y
+    (DVec3::ZERO, DVec3::X, DVec3::Y), // z = 0, normal +z
+    (DVec3::Z, DVec3::Y, DVec3::X),    // z = 1, normal -z
 ];
 
 /// `@cube:N`: the unit cube enclosure, N x N patches per face, inward normals.
@@ -179,7 +179,7 @@ pub fn cube(spec: &str, n: usize) -> Result<Scene, SceneError> {
                 let corner = |di: usize, dj: usize| {
                     let s = (i + di) as f64 / n as f64;
                     let t = (j + dj) as f64 / n as f64;
-                    [0, 1, 2].map(|a| o[a] + s * u[a] + t * v[a])
+                    *o + s * *u + t * *v
                 };
                 let quad = [corner(0, 0), corner(1, 0), corner(1, 1), corner(0, 1)];
                 let idx = quad.map(|p| b.vertex(p));
@@ -192,7 +192,7 @@ pub fn cube(spec: &str, n: usize) -> Result<Scene, SceneError> {
 
 /// A convex polyhedron centred at the origin: vertices and faces (vertex lists, any winding).
 struct Polyhedron {
-    vertices: Vec<[f64; 3]>,
+    vertices: Vec<Point>,
     faces: Vec<Vec<usize>>,
 }
 
@@ -227,20 +227,20 @@ fn solid(spec: &str, poly: &Polyhedron, n: usize) -> Result<Scene, SceneError> {
 }
 
 /// Reorders a convex face so that it is counter-clockwise seen from the origin (its normal points in).
-fn facing_inwards(mut pts: Vec<[f64; 3]>) -> Vec<[f64; 3]> {
+fn facing_inwards(mut pts: Vec<Point>) -> Vec<Point> {
     let c = centroid(&pts);
-    let n = cross(sub(pts[1], pts[0]), sub(pts[2], pts[0]));
-    if dot(n, c) > 0.0 {
+    let n = (pts[1] - pts[0]).cross(pts[2] - pts[0]);
+    if n.dot(c) > 0.0 {
         pts.reverse();
     }
     pts
 }
 
 /// Cuts a triangle into n^2 equal triangles on a barycentric grid (same winding).
-fn split_triangle(b: &mut SceneBuilder, t: [[f64; 3]; 3], n: usize, m: u32, origin: &str) {
+fn split_triangle(b: &mut SceneBuilder, t: [Point; 3], n: usize, m: u32, origin: &str) {
     let point = |i: usize, j: usize| {
         let (u, v) = (i as f64 / n as f64, j as f64 / n as f64);
-        [0, 1, 2].map(|a| t[0][a] + u * (t[1][a] - t[0][a]) + v * (t[2][a] - t[0][a]))
+        t[0] + u * (t[1] - t[0]) + v * (t[2] - t[0])
     };
     for i in 0..n {
         for j in 0..n - i {
@@ -261,11 +261,11 @@ fn split_triangle(b: &mut SceneBuilder, t: [[f64; 3]; 3], n: usize, m: u32, orig
 /// `@sphere:L`: icosphere enclosure, inward normals, every triangle a patch.
 pub fn sphere(spec: &str, levels: usize) -> Result<Scene, SceneError> {
     let ico = icosahedron();
-    let mut tris: Vec<[[f64; 3]; 3]> = ico
+    let mut tris: Vec<[Point; 3]> = ico
         .faces
         .iter()
         .map(|f| {
-            let p = facing_inwards(f.iter().map(|&v| normalize(ico.vertices[v])).collect());
+            let p = facing_inwards(f.iter().map(|&v| unit_vector(ico.vertices[v])).collect());
             [p[0], p[1], p[2]]
         })
         .collect();
@@ -274,8 +274,7 @@ pub fn sphere(spec: &str, levels: usize) -> Result<Scene, SceneError> {
             .iter()
             .flat_map(|&[a, b, c]| {
                 // (x + y) is symmetric, so neighbouring triangles get the bit-identical midpoint.
-                let mid =
-                    |x: [f64; 3], y: [f64; 3]| normalize([x[0] + y[0], x[1] + y[1], x[2] + y[2]]);
+                let mid = |x: Point, y: Point| unit_vector(x + y);
                 let (ab, bc, ca) = (mid(a, b), mid(b, c), mid(c, a));
                 [[a, ab, ca], [ab, b, bc], [ca, bc, c], [ab, bc, ca]]
             })
@@ -292,10 +291,10 @@ pub fn sphere(spec: &str, levels: usize) -> Result<Scene, SceneError> {
 
 fn tetrahedron() -> Polyhedron {
     let vertices = vec![
-        [1.0, 1.0, 1.0],
-        [1.0, -1.0, -1.0],
-        [-1.0, 1.0, -1.0],
-        [-1.0, -1.0, 1.0],
+        DVec3::new(1.0, 1.0, 1.0),
+        DVec3::new(1.0, -1.0, -1.0),
+        DVec3::new(-1.0, 1.0, -1.0),
+        DVec3::new(-1.0, -1.0, 1.0),
     ];
     Polyhedron {
         faces: triangles_with_edge(&vertices, 8f64.sqrt()),
@@ -307,7 +306,7 @@ fn octahedron() -> Polyhedron {
     let mut vertices = Vec::new();
     for a in 0..3 {
         for s in [1.0, -1.0] {
-            let mut v = [0.0; 3];
+            let mut v = DVec3::ZERO;
             v[a] = s;
             vertices.push(v);
         }
@@ -323,9 +322,9 @@ fn icosahedron() -> Polyhedron {
     let mut vertices = Vec::new();
     for s1 in [1.0, -1.0] {
         for s2 in [phi, -phi] {
-            vertices.push([0.0, s1, s2]);
-            vertices.push([s1, s2, 0.0]);
-            vertices.push([s2, 0.0, s1]);
+            vertices.push(DVec3::new(0.0, s1, s2));
+            vertices.push(DVec3::new(s1, s2, 0.0));
+            vertices.push(DVec3::new(s2, 0.0, s1));
         }
     }
     Polyhedron {
@@ -338,20 +337,20 @@ fn icosahedron() -> Polyhedron {
 /// pentagon per icosahedron vertex (the centroids of the five faces around it, in angular order).
 fn dodecahedron() -> Polyhedron {
     let ico = icosahedron();
-    let vertices: Vec<[f64; 3]> = ico
+    let vertices: Vec<Point> = ico
         .faces
         .iter()
         .map(|f| centroid(&f.iter().map(|&v| ico.vertices[v]).collect::<Vec<_>>()))
         .collect();
     let faces = (0..ico.vertices.len())
         .map(|v| {
-            let axis = normalize(ico.vertices[v]);
-            let (e1, e2) = crate::sample::lines::orthonormal_basis(axis);
+            let axis = unit_vector(ico.vertices[v]);
+            let (e1, e2) = orthonormal_basis(axis);
             let mut around: Vec<usize> = (0..ico.faces.len())
                 .filter(|&f| ico.faces[f].contains(&v))
                 .collect();
             around.sort_by(|&a, &b| {
-                let angle = |f: usize| dot(vertices[f], e2).atan2(dot(vertices[f], e1));
+                let angle = |f: usize| vertices[f].dot(e2).atan2(vertices[f].dot(e1));
                 angle(a).total_cmp(&angle(b))
             });
             around
@@ -361,8 +360,8 @@ fn dodecahedron() -> Polyhedron {
 }
 
 /// All vertex triples whose three sides have length `edge`: the faces of a deltahedron.
-fn triangles_with_edge(v: &[[f64; 3]], edge: f64) -> Vec<Vec<usize>> {
-    let is_edge = |a: usize, b: usize| (norm(sub(v[a], v[b])) - edge).abs() < 1e-9 * edge;
+fn triangles_with_edge(v: &[Point], edge: f64) -> Vec<Vec<usize>> {
+    let is_edge = |a: usize, b: usize| ((v[a] - v[b]).length() - edge).abs() < 1e-9 * edge;
     let mut faces = Vec::new();
     for a in 0..v.len() {
         for b in a + 1..v.len() {
@@ -374,16 +373,6 @@ fn triangles_with_edge(v: &[[f64; 3]], edge: f64) -> Vec<Vec<usize>> {
         }
     }
     faces
-}
-
-fn centroid(pts: &[[f64; 3]]) -> [f64; 3] {
-    let n = pts.len() as f64;
-    [0, 1, 2].map(|a| pts.iter().map(|p| p[a]).sum::<f64>() / n)
-}
-
-fn normalize(p: [f64; 3]) -> [f64; 3] {
-    let l = norm(p);
-    p.map(|c| c / l)
 }
 
 #[cfg(test)]

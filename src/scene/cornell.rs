@@ -35,8 +35,8 @@
 //! right wall 1 each, left wall 2, blocks 5 each), 28 in the open one. `@cornell:N` cuts every quad into
 //! an N x N grid and every triangle into N^2 triangles, so it has N^2 times as many patches.
 
-use super::build::{cross, dot, sub};
 use super::{Material, Scene, SceneBuilder, SceneError};
+use crate::geom::{DVec3, Point};
 
 /// Mean of the published spectral reflectance of the white paint (76 samples, 400-700 nm).
 pub const WHITE: f64 = 0.722_671_052_631_578_8;
@@ -98,16 +98,16 @@ const TALL_BLOCK: [[f64; 2]; 4] = [
 pub fn build(spec: &str, n: usize, closed: bool) -> Result<Scene, SceneError> {
     let mut b = SceneBuilder::new(spec);
     let m = Materials::add(&mut b);
-    let centre = [278.0, H / 2.0, 279.6];
-    let mut faces: Vec<(Vec<[f64; 3]>, u32, &str)> = Vec::new();
+    let centre = DVec3::new(278.0, H / 2.0, 279.6);
+    let mut faces: Vec<(Vec<Point>, u32, &str)> = Vec::new();
 
     for piece in FLOOR_PIECES {
         let pts = piece
             .iter()
-            .map(|&k| [FLOOR_POINTS[k][0], 0.0, FLOOR_POINTS[k][1]]);
+            .map(|&k| DVec3::new(FLOOR_POINTS[k][0], 0.0, FLOOR_POINTS[k][1]));
         faces.push((pts.collect(), m.white, "floor"));
     }
-    let ceiling = |x: f64, z: f64| [x, H, z];
+    let ceiling = |x: f64, z: f64| DVec3::new(x, H, z);
     let room = [(0.0, 0.0), (556.0, 0.0), (556.0, 559.2), (0.0, 559.2)];
     let light = [
         (213.0, 227.0),
@@ -131,31 +131,31 @@ pub fn build(spec: &str, n: usize, closed: bool) -> Result<Scene, SceneError> {
         m.light,
         "light",
     ));
-    let floor_back_left = [549.6, 0.0, 559.2];
-    let floor_front_left = [552.8, 0.0, 0.0];
+    let floor_back_left = DVec3::new(549.6, 0.0, 559.2);
+    let floor_front_left = DVec3::new(552.8, 0.0, 0.0);
     faces.push((
         vec![
             floor_back_left,
-            [0.0, 0.0, 559.2],
-            [0.0, H, 559.2],
-            [556.0, H, 559.2],
+            DVec3::new(0.0, 0.0, 559.2),
+            DVec3::new(0.0, H, 559.2),
+            DVec3::new(556.0, H, 559.2),
         ],
         m.white,
         "back wall",
     ));
     faces.push((
         vec![
-            [0.0, 0.0, 559.2],
-            [0.0, 0.0, 0.0],
-            [0.0, H, 0.0],
-            [0.0, H, 559.2],
+            DVec3::new(0.0, 0.0, 559.2),
+            DVec3::new(0.0, 0.0, 0.0),
+            DVec3::new(0.0, H, 0.0),
+            DVec3::new(0.0, H, 559.2),
         ],
         m.green,
         "right wall",
     ));
     // The published left wall is not planar: two triangles sharing the diagonal from its front bottom
     // corner to its back top corner.
-    let (top_back, top_front) = ([556.0, H, 559.2], [556.0, H, 0.0]);
+    let (top_back, top_front) = (DVec3::new(556.0, H, 559.2), DVec3::new(556.0, H, 0.0));
     faces.push((
         vec![floor_front_left, floor_back_left, top_back],
         m.red,
@@ -168,7 +168,12 @@ pub fn build(spec: &str, n: usize, closed: bool) -> Result<Scene, SceneError> {
     ));
     if closed {
         faces.push((
-            vec![[0.0, 0.0, 0.0], floor_front_left, top_front, [0.0, H, 0.0]],
+            vec![
+                DVec3::new(0.0, 0.0, 0.0),
+                floor_front_left,
+                top_front,
+                DVec3::new(0.0, H, 0.0),
+            ],
             m.white,
             "front wall",
         ));
@@ -225,24 +230,26 @@ impl Materials {
 }
 
 /// A block's top and four sides (no bottom: it stands on the floor), each with a point inside the block.
-fn block_faces(top: &[[f64; 2]; 4], height: f64) -> Vec<(Vec<[f64; 3]>, [f64; 3])> {
-    let inside = [
+fn block_faces(top: &[[f64; 2]; 4], height: f64) -> Vec<(Vec<Point>, Point)> {
+    let inside = DVec3::new(
         top.iter().map(|p| p[0]).sum::<f64>() / 4.0,
         height / 2.0,
         top.iter().map(|p| p[1]).sum::<f64>() / 4.0,
-    ];
+    );
     let mut faces = vec![(
-        top.iter().map(|p| [p[0], height, p[1]]).collect::<Vec<_>>(),
+        top.iter()
+            .map(|p| DVec3::new(p[0], height, p[1]))
+            .collect::<Vec<_>>(),
         inside,
     )];
     for k in 0..4 {
         let (a, c) = (top[k], top[(k + 1) % 4]);
         faces.push((
             vec![
-                [a[0], 0.0, a[1]],
-                [c[0], 0.0, c[1]],
-                [c[0], height, c[1]],
-                [a[0], height, a[1]],
+                DVec3::new(a[0], 0.0, a[1]),
+                DVec3::new(c[0], 0.0, c[1]),
+                DVec3::new(c[0], height, c[1]),
+                DVec3::new(a[0], height, a[1]),
             ],
             inside,
         ));
@@ -251,9 +258,9 @@ fn block_faces(top: &[[f64; 2]; 4], height: f64) -> Vec<(Vec<[f64; 3]>, [f64; 3]
 }
 
 /// Orders a planar convex face so that its normal points towards `reference` (`towards`) or away from it.
-fn orient(mut pts: Vec<[f64; 3]>, reference: [f64; 3], towards: bool) -> Vec<[f64; 3]> {
-    let normal = cross(sub(pts[1], pts[0]), sub(pts[2], pts[0]));
-    let facing = dot(normal, sub(reference, pts[0])) > 0.0;
+fn orient(mut pts: Vec<Point>, reference: Point, towards: bool) -> Vec<Point> {
+    let normal = (pts[1] - pts[0]).cross(pts[2] - pts[0]);
+    let facing = normal.dot(reference - pts[0]) > 0.0;
     if facing != towards {
         pts.reverse();
     }
@@ -262,8 +269,12 @@ fn orient(mut pts: Vec<[f64; 3]>, reference: [f64; 3], towards: bool) -> Vec<[f6
 
 /// The point `k / n` of the way along the edge between `a` and `b`, computed the same way whichever
 /// end the edge is walked from, so that faces sharing the edge get bit-identical vertices.
-fn edge_point(a: [f64; 3], b: [f64; 3], k: usize, n: usize) -> [f64; 3] {
-    let (p, q, k) = if a <= b { (a, b, k) } else { (b, a, n - k) };
+fn edge_point(a: Point, b: Point, k: usize, n: usize) -> Point {
+    let (p, q, k) = if a.to_array() <= b.to_array() {
+        (a, b, k)
+    } else {
+        (b, a, n - k)
+    };
     if k == 0 {
         return p;
     }
@@ -271,12 +282,12 @@ fn edge_point(a: [f64; 3], b: [f64; 3], k: usize, n: usize) -> [f64; 3] {
         return q;
     }
     let t = k as f64 / n as f64;
-    [0, 1, 2].map(|c| p[c] + t * (q[c] - p[c]))
+    p + t * (q - p)
 }
 
 /// Adds a triangle or a quad cut into `n` x `n` cells (a quad: a bilinear grid, planar and convex for a
 /// planar convex quad; a triangle: `n^2` triangles on a barycentric grid).
-fn add_subdivided(b: &mut SceneBuilder, pts: &[[f64; 3]], n: usize, m: u32, name: &str) {
+fn add_subdivided(b: &mut SceneBuilder, pts: &[Point], n: usize, m: u32, name: &str) {
     match pts.len() {
         3 => add_triangle_grid(b, [pts[0], pts[1], pts[2]], n, m, name),
         4 => add_quad_grid(b, [pts[0], pts[1], pts[2], pts[3]], n, m, name),
@@ -284,9 +295,9 @@ fn add_subdivided(b: &mut SceneBuilder, pts: &[[f64; 3]], n: usize, m: u32, name
     }
 }
 
-fn add_quad_grid(b: &mut SceneBuilder, q: [[f64; 3]; 4], n: usize, m: u32, name: &str) {
+fn add_quad_grid(b: &mut SceneBuilder, q: [Point; 4], n: usize, m: u32, name: &str) {
     // Grid point (i, j): i steps along q0 -> q1, j along q0 -> q3.
-    let point = |i: usize, j: usize| -> [f64; 3] {
+    let point = |i: usize, j: usize| -> Point {
         match (i, j) {
             (_, 0) => edge_point(q[0], q[1], i, n),
             (_, j) if j == n => edge_point(q[3], q[2], i, n),
@@ -295,7 +306,7 @@ fn add_quad_grid(b: &mut SceneBuilder, q: [[f64; 3]; 4], n: usize, m: u32, name:
             _ => {
                 let (left, right) = (edge_point(q[0], q[3], j, n), edge_point(q[1], q[2], j, n));
                 let t = i as f64 / n as f64;
-                [0, 1, 2].map(|c| left[c] + t * (right[c] - left[c]))
+                left + t * (right - left)
             }
         }
     };
@@ -313,9 +324,9 @@ fn add_quad_grid(b: &mut SceneBuilder, q: [[f64; 3]; 4], n: usize, m: u32, name:
     }
 }
 
-fn add_triangle_grid(b: &mut SceneBuilder, t: [[f64; 3]; 3], n: usize, m: u32, name: &str) {
+fn add_triangle_grid(b: &mut SceneBuilder, t: [Point; 3], n: usize, m: u32, name: &str) {
     // Grid point (i, j) = t0 + i/n (t1 - t0) + j/n (t2 - t0), for i + j <= n.
-    let point = |i: usize, j: usize| -> [f64; 3] {
+    let point = |i: usize, j: usize| -> Point {
         if j == 0 {
             edge_point(t[0], t[1], i, n)
         } else if i == 0 {
@@ -324,7 +335,7 @@ fn add_triangle_grid(b: &mut SceneBuilder, t: [[f64; 3]; 3], n: usize, m: u32, n
             edge_point(t[1], t[2], j, n)
         } else {
             let (u, v) = (i as f64 / n as f64, j as f64 / n as f64);
-            [0, 1, 2].map(|c| t[0][c] + u * (t[1][c] - t[0][c]) + v * (t[2][c] - t[0][c]))
+            t[0] + u * (t[1] - t[0]) + v * (t[2] - t[0])
         }
     };
     for i in 0..n {

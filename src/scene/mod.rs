@@ -19,6 +19,8 @@ pub use build::SceneBuilder;
 
 use std::fmt;
 
+use crate::geom::{Normal, Point};
+
 /// Diffuse material of a patch (paper eq. (2)): emission `E_i` and reflectance `R_i`, one channel each.
 ///
 /// From an MTL file, the single value is the mean of the three RGB channels of `Ke` and `Kd` (exactly the
@@ -51,7 +53,7 @@ pub struct Patch {
     /// Area in tracing space (the scene scaled to its unit bounding sphere).
     pub area: f64,
     /// Unit normal in tracing space; the *front* side is the side it points to.
-    pub normal: [f64; 3],
+    pub normal: Normal,
     /// Plane offset: points `x` of the patch satisfy `normal . x = offset` (tracing space).
     pub offset: f64,
     /// Index into [`Scene::materials`].
@@ -68,7 +70,7 @@ pub struct Patch {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Normalization {
     /// Centre of the bounding sphere, scene units.
-    pub center: [f64; 3],
+    pub center: Point,
     /// Radius of the bounding sphere, scene units.
     pub scale: f64,
 }
@@ -81,7 +83,7 @@ pub struct Scene {
     /// Vertex positions in tracing space (f32, for the tracers).
     pub positions: Vec<[f32; 3]>,
     /// The same vertices in the scene's own units (f64, as loaded).
-    pub vertices: Vec<[f64; 3]>,
+    pub vertices: Vec<Point>,
     /// Triangles as vertex indices, ordered so that each patch's triangles are contiguous.
     pub triangles: Vec<[u32; 3]>,
     /// The patch of each triangle.
@@ -120,7 +122,7 @@ impl Scene {
     }
 
     /// The f64 unit normal of each triangle's patch, indexed by triangle.
-    pub fn triangle_normals(&self) -> Vec<[f64; 3]> {
+    pub fn triangle_normals(&self) -> Vec<Normal> {
         self.triangle_patch
             .iter()
             .map(|&p| self.patches[p as usize].normal)
@@ -157,7 +159,7 @@ impl fmt::Display for Normalization {
         write!(
             f,
             "centre ({:.6}, {:.6}, {:.6}), radius {:.6}",
-            self.center[0], self.center[1], self.center[2], self.scale
+            self.center.x, self.center.y, self.center.z, self.scale
         )
     }
 }

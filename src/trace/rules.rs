@@ -1,6 +1,7 @@
 //! The hit conventions shared by every backend: sorting, and one hit per crossing.
 
 use super::{Hit, Line, LineHits};
+use crate::geom::{DVec3, Direction, Normal};
 use crate::scene::Scene;
 
 /// How many f32 ulps (at the larger of `t` and the bounding radius) two hits may be apart and still be the
@@ -13,7 +14,7 @@ pub const DUPLICATE_ULPS: f32 = 8.0;
 /// vertex indices (for "shares a vertex").
 #[derive(Clone, Debug)]
 pub struct HitRules {
-    normals: Vec<[f64; 3]>,
+    normals: Vec<Normal>,
     vertices: Vec<[u32; 3]>,
 }
 
@@ -37,9 +38,8 @@ impl HitRules {
         }
     }
 
-    fn facing(&self, triangle: u32, dir: [f64; 3]) -> Facing {
-        let n = self.normals[triangle as usize];
-        let d = n[0] * dir[0] + n[1] * dir[1] + n[2] * dir[2];
+    fn facing(&self, triangle: u32, dir: Direction) -> Facing {
+        let d = self.normals[triangle as usize].dot(dir);
         if d < 0.0 {
             Facing::Front
         } else if d > 0.0 {
@@ -81,7 +81,7 @@ impl HitRules {
     /// Merges a sorted row: clusters of hits closer than the tolerance; within a cluster, hits that face
     /// the line the same way and are connected through shared vertices collapse to their first member.
     fn merge_row(&self, line: &Line, row: &[Hit], kept: &mut Vec<Hit>) {
-        let dir = line.dir.map(f64::from);
+        let dir = DVec3::from_array(line.dir.map(f64::from));
         let mut i = 0;
         while i < row.len() {
             let mut j = i + 1;
@@ -93,7 +93,7 @@ impl HitRules {
         }
     }
 
-    fn merge_cluster(&self, dir: [f64; 3], cluster: &[Hit], kept: &mut Vec<Hit>) {
+    fn merge_cluster(&self, dir: Direction, cluster: &[Hit], kept: &mut Vec<Hit>) {
         if cluster.len() == 1 {
             kept.push(cluster[0]);
             return;

@@ -123,7 +123,7 @@ fn lines_through_edges_and_vertices_have_even_parity() {
                 .map(f64::from);
             [0, 1, 2].map(|a| 0.5 * (v[a] + w[a]))
         };
-        let d = scene_complexity::sample::lines::uniform_direction(rng.gen(), rng.gen());
+        let d = scene_complexity::geom::uniform_direction(rng.gen(), rng.gen()).to_array();
         lines.push(Line {
             origin: [0, 1, 2].map(|a| (through[a] - 2.0 * d[a]) as f32),
             dir: d.map(|c| c as f32),

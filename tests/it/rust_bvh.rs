@@ -7,7 +7,8 @@ use crate::support;
 
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
-use scene_complexity::sample::lines::{batch_lines, uniform_direction};
+use scene_complexity::geom::uniform_direction;
+use scene_complexity::sample::lines::batch_lines;
 use scene_complexity::scene::{self, Scene};
 use scene_complexity::trace::rust::{BruteForceTracer, BvhTracer};
 use scene_complexity::trace::{make_tracer, Backend, Line, LineHits, Query, TraceError, Tracer};
@@ -33,7 +34,7 @@ fn vertex_and_edge_lines(scene: &Scene, rng: &mut Pcg64, count: usize) -> Vec<Li
             };
             let nudge = if k % 4 < 2 { 0.0 } else { 1e-7 };
             let p = [0, 1, 2].map(|a| v[a] + f * (w[a] - v[a]) + rng.gen_range(-1.0..=1.0) * nudge);
-            let d = uniform_direction(rng.gen(), rng.gen());
+            let d = uniform_direction(rng.gen(), rng.gen()).to_array();
             Line {
                 origin: [0, 1, 2].map(|a| (p[a] - 2.0 * d[a]) as f32),
                 dir: d.map(|c| c as f32),
@@ -61,7 +62,7 @@ fn in_plane_and_starting_lines(scene: &Scene, rng: &mut Pcg64, count: usize) -> 
                     t_max: 4.0,
                 }
             } else {
-                let d = uniform_direction(rng.gen(), rng.gen());
+                let d = uniform_direction(rng.gen(), rng.gen()).to_array();
                 Line {
                     origin: a,
                     dir: d.map(|c| c as f32),

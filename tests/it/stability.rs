@@ -200,7 +200,11 @@ fn icosphere(level: usize) -> Vec<[[f64; 3]; 3]> {
         .iter()
         .map(|p| {
             // The built-in faces inwards: reverse to face outwards.
-            let v: Vec<[f64; 3]> = p.polygon.iter().map(|&k| s.vertices[k as usize]).collect();
+            let v: Vec<[f64; 3]> = p
+                .polygon
+                .iter()
+                .map(|&k| s.vertices[k as usize].to_array())
+                .collect();
             [v[2], v[1], v[0]]
         })
         .collect()

@@ -114,7 +114,7 @@ impl AxisRect {
         let pts: Vec<[f64; 3]> = scene.patches[p]
             .polygon
             .iter()
-            .map(|&v| scene.vertices[v as usize])
+            .map(|&v| scene.vertices[v as usize].to_array())
             .collect();
         let lo = [0, 1, 2].map(|a| pts.iter().map(|q| q[a]).fold(f64::INFINITY, f64::min));
         let hi = [0, 1, 2].map(|a| pts.iter().map(|q| q[a]).fold(f64::NEG_INFINITY, f64::max));
