@@ -10,7 +10,7 @@ use scene_complexity::measure::bias::corrected;
 use scene_complexity::measure::estimators::EntropyEstimator;
 use scene_complexity::run::Measures;
 use scene_complexity::run::{analyze, AnalysisConfig, RunControl};
-use scene_complexity::scene;
+use scene_complexity::scenes;
 use scene_complexity::trace::{make_tracer, Backend, Query};
 
 fn list(arg: Option<&String>, default: &str) -> Vec<f64> {
@@ -35,7 +35,7 @@ fn main() {
     println!("   (I_s and its relative error)");
     for &n in &sizes {
         let (_, exact) = support::cube_exact_measures(n as usize);
-        let scene = scene::load(&format!("@cube:{}", n as usize)).unwrap();
+        let scene = scenes::load(&format!("@cube:{}", n as usize)).unwrap();
         let areas: Vec<f64> = scene.patches.iter().map(|p| p.area).collect();
         let tracer = make_tracer(Backend::default_available(), &scene, Query::Single).unwrap();
         for &lines in &line_counts {

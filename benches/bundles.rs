@@ -14,12 +14,13 @@
 
 mod common;
 
+use scene_complexity::scenes;
 use std::time::Instant;
 
 use scene_complexity::measure::Estimate;
 use scene_complexity::run::{analyze, AnalysisConfig, RunControl, VisibilityEstimates};
 use scene_complexity::sample::lines::LineSource;
-use scene_complexity::scene::{self, Scene};
+use scene_complexity::scene::Scene;
 use scene_complexity::trace::{make_tracer, Backend, Query, Tracer};
 
 const SEEDS: u64 = 3;
@@ -50,7 +51,7 @@ fn main() -> anyhow::Result<()> {
         "eff wall"
     );
     for spec in &specs {
-        let scene = scene::load(spec)?;
+        let scene = scenes::load(spec)?;
         let mut base: Option<Row> = None;
         for (backend, query) in queries() {
             let Ok(tracer) = make_tracer(backend, &scene, query) else {
@@ -159,7 +160,7 @@ fn spread(specs: &[String], lines: u64, seeds: u64) -> anyhow::Result<()> {
     const GRIDS: [u32; 3] = [0, 4, 8];
     println!("{lines} lines per run, 2 threads, Embree single lines, {seeds} seeds per source");
     for spec in specs {
-        let scene = scene::load(spec)?;
+        let scene = scenes::load(spec)?;
         let tracer = make_tracer(Backend::Embree, &scene, Query::Single)
             .or_else(|_| make_tracer(Backend::Rust, &scene, Query::Single))?;
         // values[grid][measure][seed], cpu seconds per grid.

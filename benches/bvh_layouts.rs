@@ -13,12 +13,13 @@
 
 mod common;
 
+use scene_complexity::scenes;
 use std::time::Duration;
 
 use glam::Vec3A;
 use obvhs::{aabb::Aabb, ray::Ray, BvhBuildParams};
 use scene_complexity::sample::lines::batch_lines;
-use scene_complexity::scene::{self, Scene};
+use scene_complexity::scene::Scene;
 use scene_complexity::trace::rust::{bvh::margin, watertight::ShearedRay, BvhTracer};
 use scene_complexity::trace::{Line, Tracer};
 
@@ -35,7 +36,7 @@ fn main() -> anyhow::Result<()> {
         batch_lines(1, b, 4096, 1.0, &mut lines);
     }
     for spec in &specs {
-        let scene = scene::load(spec)?;
+        let scene = scenes::load(spec)?;
         obvhs_traversals(spec, &scene, &lines);
         let presets = [
             ("fast", BvhBuildParams::fast_build()),

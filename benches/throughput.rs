@@ -11,13 +11,13 @@
 
 mod common;
 
+use scene_complexity::scenes;
 use std::time::Instant;
 
 use rayon::prelude::*;
 use scene_complexity::run::{analyze, AnalysisConfig, RunControl, DEFAULT_GROUPS};
 use scene_complexity::run::{BatchPlan, Measures};
 use scene_complexity::sample::lines::batch_lines;
-use scene_complexity::scene;
 use scene_complexity::trace::{make_tracer, Backend, Line, LineHits, Query, Tracer};
 
 const CHUNK: usize = 4096;
@@ -58,7 +58,7 @@ fn main() -> anyhow::Result<()> {
 }
 
 fn bench_scene(spec: &str, count: u64, pools: &[rayon::ThreadPool]) -> anyhow::Result<()> {
-    let scene = scene::load(spec)?;
+    let scene = scenes::load(spec)?;
     let mut lines = Vec::with_capacity(count as usize);
     for b in 0..count.div_ceil(CHUNK as u64) {
         batch_lines(

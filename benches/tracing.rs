@@ -10,7 +10,8 @@ use rayon::prelude::*;
 use scene_complexity::run::Measures;
 use scene_complexity::run::{analyze, AnalysisConfig, RunControl};
 use scene_complexity::sample::lines::LineSource;
-use scene_complexity::scene::{self, Scene};
+use scene_complexity::scene::Scene;
+use scene_complexity::scenes;
 use scene_complexity::trace::rust::BruteForceTracer;
 use scene_complexity::trace::{make_tracer, Backend, Line, LineHits, Query, Tracer};
 
@@ -87,7 +88,7 @@ fn tracers(scene: &Scene) -> Vec<(String, Box<dyn Tracer>)> {
 
 fn bench_queries(c: &mut Criterion) {
     for spec in SCENES {
-        let scene = scene::load(spec).unwrap();
+        let scene = scenes::load(spec).unwrap();
         let tracers = tracers(&scene);
         for (source_name, source) in sources() {
             let ls = lines(source);
@@ -111,7 +112,7 @@ fn bench_queries(c: &mut Criterion) {
 
 fn bench_analysis(c: &mut Criterion) {
     for spec in SCENES {
-        let scene = scene::load(spec).unwrap();
+        let scene = scenes::load(spec).unwrap();
         let mut g = c.benchmark_group(format!("analyze/{spec}"));
         g.throughput(Throughput::Elements(LINES as u64));
         g.sample_size(10);

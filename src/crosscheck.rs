@@ -419,7 +419,7 @@ mod tests {
 
     #[test]
     fn lines_are_told_apart_by_count_patch_and_distance() {
-        let scene = crate::scene::load("@cube:2").unwrap();
+        let scene = crate::scenes::load("@cube:2").unwrap();
         let tol = Tolerance::default();
         // Triangles 0 and 1 are the two halves of patch 0; triangle 2 is patch 1.
         assert_eq!(scene.triangle_patch[..3], [0, 0, 1]);

@@ -14,4 +14,5 @@ pub mod reproduce;
 pub mod run;
 pub mod sample;
 pub mod scene;
+pub mod scenes;
 pub mod trace;

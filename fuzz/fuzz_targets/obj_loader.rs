@@ -7,8 +7,9 @@
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
-use scene_complexity::analysis::{analyze, AnalysisConfig};
-use scene_complexity::scene::{builtin, obj, Scene};
+use scene_complexity::run::{analyze, AnalysisConfig, RunControl};
+use scene_complexity::scene::{obj, Scene};
+use scene_complexity::scenes;
 use scene_complexity::trace::{make_tracer, Backend, Query};
 
 fuzz_target!(|data: &[u8]| {
@@ -20,7 +21,7 @@ fuzz_target!(|data: &[u8]| {
         if spec.len() > 16 || spec.bytes().filter(u8::is_ascii_digit).count() > 1 {
             return;
         }
-        builtin::build(text)
+        scenes::build(text)
     } else {
         let (obj_text, mtl_text) = text.split_once("\n#MTL\n").unwrap_or((text, ""));
         let mtl = mtl_text.to_string();
@@ -41,7 +42,12 @@ fn trace_a_little(scene: &Scene) {
         enclose: scene.triangles.len() % 2 == 0,
         ..AnalysisConfig::new(256, 1)
     };
-    let a = analyze(scene, tracer.as_ref(), &cfg).expect("tracing a loaded scene works");
+    let a = match analyze(scene, tracer.as_ref(), &cfg, &RunControl::default()) {
+        Ok(a) => a,
+        // Materials outside the physical range are refused with a message, as they should be.
+        Err(e) if e.is_bad_input() => return,
+        Err(e) => panic!("tracing a loaded scene failed: {e}"),
+    };
     for e in [
         a.visibility.positional_entropy,
         a.visibility.entropy,

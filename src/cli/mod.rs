@@ -20,7 +20,8 @@ use scene_complexity::run::{
     TargetMeasure, DEFAULT_ESTIMATOR, DEFAULT_GROUPS,
 };
 use scene_complexity::sample::lines::LineSource;
-use scene_complexity::scene::{self, builtin};
+use scene_complexity::scene;
+use scene_complexity::scenes;
 use scene_complexity::trace::{make_tracer, Backend, Query};
 
 /// scx: how hard is a 3D scene to light and to mesh? Information-theoretic scene complexity
@@ -296,7 +297,7 @@ pub fn main() -> ExitCode {
     let cli = Cli::parse();
     match cli.command {
         Command::Scenes => {
-            let list: String = builtin::BUILTINS
+            let list: String = scenes::CATALOGUE
                 .iter()
                 .map(|b| format!("{:<18} {}\n", b.usage, b.description))
                 .collect();
@@ -322,7 +323,7 @@ fn finish(result: Result<(), Failure>) -> ExitCode {
 }
 
 fn load_scene(spec: &str) -> Result<scene::Scene, Failure> {
-    let scene = scene::load(spec).map_err(bad_input)?;
+    let scene = scenes::load(spec).map_err(bad_input)?;
     for w in &scene.warnings {
         eprintln!("scx: warning: {w}");
     }

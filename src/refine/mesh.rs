@@ -221,7 +221,7 @@ impl Mesh {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scene;
+    use crate::scenes;
 
     fn total_area(s: &Scene) -> f64 {
         s.total_area_scene_units()
@@ -230,7 +230,7 @@ mod tests {
     #[test]
     fn splits_keep_the_area_and_make_the_expected_children() {
         for (spec, grow) in [("@cube", 3), ("@tetrahedron", 3), ("@dodecahedron", 1)] {
-            let s = scene::load(spec).unwrap();
+            let s = scenes::load(spec).unwrap();
             let mut m = Mesh::from_scene(&s);
             let before = m.len();
             m.split(0);
@@ -260,7 +260,7 @@ mod tests {
 
     #[test]
     fn neighbours_share_the_midpoint_of_a_shared_edge() {
-        let s = scene::load("@cube:2").unwrap();
+        let s = scenes::load("@cube:2").unwrap();
         let mut m = Mesh::from_scene(&s);
         // Patches 0 and 1 are side by side on face x = 0 (i = 0, j = 0 and 1): they share an edge.
         m.split(0);

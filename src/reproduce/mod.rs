@@ -12,6 +12,7 @@
 pub mod paper;
 mod tables;
 
+use crate::scenes;
 use std::collections::HashMap;
 use std::fmt::Write as _;
 use std::time::Instant;
@@ -22,7 +23,7 @@ use crate::run::{
     analyze, AnalysisConfig, AnalysisError, Measures, RadiosityEstimates, RadiosityOutcome,
     RunControl, VisibilityEstimates,
 };
-use crate::scene::{self, Scene, SceneError};
+use crate::scene::{Scene, SceneError};
 use crate::trace::{make_tracer, Backend, Query, TraceError};
 
 /// The tables there are.
@@ -289,7 +290,7 @@ impl Session<'_> {
             self.reused += 1;
             return Ok(r.clone());
         }
-        let scene = scene::load(spec)?;
+        let scene = scenes::load(spec)?;
         let run = self.run_scene(&scene, lines, want)?;
         self.cache.insert(key, run.clone());
         Ok(run)

@@ -1,5 +1,6 @@
 //! The nine tables: which scenes, which columns, and which of the paper's claims to check.
 
+use crate::scenes;
 use std::time::Instant;
 
 use super::{est, lines_text, paper, Finding, ReproduceError, Run, Session, TableReport, Want};
@@ -7,7 +8,7 @@ use crate::measure::radiosity::SolveOptions;
 use crate::measure::Estimate;
 use crate::refine::{refine, RefineConfig, Strategy};
 use crate::run::VisibilityEstimates;
-use crate::scene::{self, Scene};
+use crate::scene::Scene;
 use crate::trace::{make_tracer, Query};
 
 /// Regenerates table `t` (1..=9); its lines and seconds are filled in by the caller.
@@ -760,7 +761,7 @@ fn table9(s: &mut Session) -> Result<TableReport, ReproduceError> {
             "I_s paper",
         ],
     );
-    let base = scene::load("@cornell")?;
+    let base = scenes::load("@cornell")?;
     let mut mi = Vec::new();
     for &(fig, mesh, patches, lines, hp, hs, is) in &paper::TABLE9 {
         let strategy = match mesh {

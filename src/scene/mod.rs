@@ -6,14 +6,8 @@
 //! original f64 coordinates.
 
 mod build;
-pub mod builtin;
-pub mod clutter;
-pub mod cornell;
-pub mod furniture;
-pub mod labyrinth;
 pub mod obj;
 mod obj_check;
-pub mod paper;
 
 pub use build::SceneBuilder;
 
@@ -161,14 +155,5 @@ impl fmt::Display for Normalization {
             "centre ({:.6}, {:.6}, {:.6}), radius {:.6}",
             self.center.x, self.center.y, self.center.z, self.scale
         )
-    }
-}
-
-/// Loads a scene: a built-in name starting with `@` (see [`builtin`]) or an OBJ file (see [`obj`]).
-pub fn load(spec: &str) -> Result<Scene, SceneError> {
-    if spec.starts_with('@') {
-        builtin::build(spec)
-    } else {
-        obj::load(std::path::Path::new(spec))
     }
 }

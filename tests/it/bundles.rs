@@ -4,11 +4,12 @@
 //! for a scene with sparse pair counts.
 
 use crate::support;
+use scene_complexity::scenes;
 
 use scene_complexity::run::{analyze, Analysis, AnalysisConfig, RunControl};
 use scene_complexity::run::{BatchPlan, Measures};
 use scene_complexity::sample::lines::LineSource;
-use scene_complexity::scene::{self, Scene};
+use scene_complexity::scene::Scene;
 use scene_complexity::trace::{make_tracer, Backend, LineHits, Query, Tracer};
 use support::{count_entries, ff_parallel_rectangles, ff_perpendicular_rectangles};
 
@@ -32,7 +33,7 @@ fn run(scene: &Scene, tracer: &dyn Tracer, lines: u64, seed: u64, grid: u32) -> 
 /// measured from the bundles themselves.
 #[test]
 fn bundled_lines_hit_each_patch_as_often_as_crofton_says() {
-    let scene = scene::load("@cube:2").unwrap();
+    let scene = scenes::load("@cube:2").unwrap();
     let tracer = rust_tracer(&scene);
     let grid = 16u32;
     let per_bundle = (grid * grid) as usize;
@@ -67,7 +68,7 @@ fn bundled_lines_hit_each_patch_as_often_as_crofton_says() {
 
 #[test]
 fn unit_cube_mutual_information_matches_closed_form_with_bundles() {
-    let scene = scene::load("@cube").unwrap();
+    let scene = scenes::load("@cube").unwrap();
     let tracer = rust_tracer(&scene);
     let f_par = ff_parallel_rectangles(1.0, 1.0, 1.0);
     let f_perp = ff_perpendicular_rectangles(1.0, 1.0, 1.0);
@@ -108,7 +109,7 @@ fn plans_never_cut_a_bundle() {
 /// lines in a 4 x 4 cube, where the lines of a bundle are strongly correlated).
 #[test]
 fn standard_errors_match_the_spread_between_runs() {
-    let scene = scene::load("@cube:4").unwrap();
+    let scene = scenes::load("@cube:4").unwrap();
     let tracer = rust_tracer(&scene);
     let runs: Vec<(f64, f64)> = (0..24)
         .map(|seed| {
@@ -132,7 +133,7 @@ fn standard_errors_match_the_spread_between_runs() {
 #[test]
 fn results_do_not_depend_on_the_thread_count() {
     // @cubes512 has 3078 patches: sparse counts, merged from per-batch sorted lists.
-    let scene = scene::load("@cubes512").unwrap();
+    let scene = scenes::load("@cubes512").unwrap();
     let tracer = rust_tracer(&scene);
     for grid in [0, 8] {
         let go = |threads: usize| {

@@ -3,13 +3,14 @@
 //! exactly the lines it spoils, by the right kind; the `scx crosscheck` command exits accordingly.
 
 use crate::support;
+use scene_complexity::scenes;
 #[cfg(feature = "cli")]
 use support::scx;
 
 use scene_complexity::crosscheck::{
     compare_hits, crosscheck, CrossCheckConfig, DifferenceKind, Tolerance,
 };
-use scene_complexity::scene::{self, Scene};
+use scene_complexity::scene::Scene;
 use scene_complexity::trace::rust::{BruteForceTracer, BvhTracer};
 use scene_complexity::trace::{HitRules, Line, RawHit, TraceError, Tracer};
 
@@ -61,7 +62,7 @@ impl Tracer for Faulty {
 #[test]
 fn planted_faults_are_found_on_their_lines_and_by_kind() {
     // @cube:1: one patch per face; every line through the cube hits it twice, so every fault is visible.
-    let scene = scene::load("@cube").unwrap();
+    let scene = scenes::load("@cube").unwrap();
     let faulty = Faulty {
         inner: BruteForceTracer::new(&scene),
         other_patch_triangle: 2,
@@ -105,7 +106,7 @@ impl BatchPlanSize {
 #[test]
 fn the_bvh_and_brute_force_agree_line_for_line() {
     for spec in ["@cube:3", "@sphere:1", "@dodecahedron"] {
-        let scene: Scene = scene::load(spec).unwrap();
+        let scene: Scene = scenes::load(spec).unwrap();
         let check = crosscheck(
             &scene,
             &BruteForceTracer::new(&scene),
@@ -137,7 +138,7 @@ fn embree_and_the_rust_bvh_agree_on_small_scenes() {
         "@icosahedron:2",
         room.to_str().unwrap(),
     ] {
-        let scene = scene::load(spec).unwrap();
+        let scene = scenes::load(spec).unwrap();
         let embree = make_tracer(Backend::Embree, &scene, Query::Single).unwrap();
         let rust = make_tracer(Backend::Rust, &scene, Query::Single).unwrap();
         let check = crosscheck(&scene, embree.as_ref(), rust.as_ref(), &config(50_000), 4).unwrap();

@@ -7,7 +7,8 @@ use std::sync::Arc;
 
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
-use scene_complexity::scene::{builtin, Scene};
+use scene_complexity::scene::Scene;
+use scene_complexity::scenes::solids;
 use scene_complexity::trace::embree::{header_version, layout_checks, EmbreeTracer};
 use scene_complexity::trace::rust::BruteForceTracer;
 use scene_complexity::trace::{Line, LineHits, Query, RawHit, TraceError, Tracer};
@@ -19,7 +20,7 @@ const H: f64 = 0.577_350_269_189_625_8; // 1 / sqrt(3)
 const T_TOLERANCE: f64 = 1e-5;
 
 fn cube(n: usize) -> Scene {
-    builtin::cube(&format!("@cube:{n}"), n).expect("cube builds")
+    solids::cube(&format!("@cube:{n}"), n).expect("cube builds")
 }
 
 /// A point of the unit cube `[0, 1]^3` in tracing space.

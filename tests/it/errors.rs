@@ -2,10 +2,11 @@
 //! the bias-corrected I_s is closer to the exact value than the plug-in.
 
 use crate::support;
+use scene_complexity::scenes;
 
 use scene_complexity::measure::Estimate;
 use scene_complexity::run::{analyze, Analysis, AnalysisConfig, RunControl};
-use scene_complexity::scene::{self, Scene};
+use scene_complexity::scene::Scene;
 use scene_complexity::trace::Tracer;
 use support::{all_tracers, cube_exact_measures};
 
@@ -29,7 +30,7 @@ fn cmi(a: &Analysis) -> Estimate {
 
 #[test]
 fn stderr_shrinks_like_one_over_sqrt_lines() {
-    let scene = scene::load("@cube:2").unwrap();
+    let scene = scenes::load("@cube:2").unwrap();
     let tracer = fastest_tracer(&scene);
     // Average over a few seeds: one stderr from 16 groups is itself uncertain by ~18%.
     let mean_se = |lines| {
@@ -47,7 +48,7 @@ fn stderr_shrinks_like_one_over_sqrt_lines() {
 
 #[test]
 fn error_bars_cover_the_spread_of_independent_runs() {
-    let scene = scene::load("@cube:2").unwrap();
+    let scene = scenes::load("@cube:2").unwrap();
     let tracer = fastest_tracer(&scene);
     let runs: Vec<Estimate> = (100..140)
         .map(|seed| cmi(&run(&scene, tracer.as_ref(), 20_000, seed)))
@@ -83,7 +84,7 @@ fn error_bars_cover_the_spread_of_independent_runs() {
 #[test]
 fn corrected_mutual_information_beats_the_plug_in_on_a_small_cube() {
     let (_, exact) = cube_exact_measures(4);
-    let scene = scene::load("@cube:4").unwrap();
+    let scene = scenes::load("@cube:4").unwrap();
     let tracer = fastest_tracer(&scene);
     let a = run(&scene, tracer.as_ref(), 100_000, 7);
     let plug = a.visibility.mutual_information.unwrap().value;

@@ -591,7 +591,6 @@ fn cycles_within_layers(edges: &[Edge]) -> Vec<Vec<String>> {
 }
 
 #[test]
-#[ignore = "enabled when the issue-13 layout lands"]
 fn layers_import_only_downwards_and_without_cycles() {
     let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
     let (edges, modules) = edges(&src);

@@ -2,11 +2,12 @@
 //! through edges and vertices of a closed mesh, and Crofton's formula for the uniformity of the lines.
 
 use crate::support;
+use scene_complexity::scenes;
 
 use rand::{Rng, SeedableRng};
 use scene_complexity::sample::lines::batch_lines;
 use scene_complexity::sample::pairs::{segments, Segment};
-use scene_complexity::scene::{self, Scene};
+use scene_complexity::scene::Scene;
 use scene_complexity::trace::{Line, LineHits, Tracer};
 use support::all_tracers;
 
@@ -27,7 +28,7 @@ fn tr(x: f64) -> f64 {
 #[test]
 fn axis_lines_through_patch_centres_hit_the_expected_patches() {
     let n = 5usize;
-    let scene = scene::load(&format!("@cube:{n}")).unwrap();
+    let scene = scenes::load(&format!("@cube:{n}")).unwrap();
     let h = tr(1.0);
     for tracer in all_tracers(&scene) {
         for (i, j) in [(0usize, 0usize), (2, 3), (4, 1)] {
@@ -109,7 +110,7 @@ fn axis_lines_through_patch_centres_hit_the_expected_patches() {
 /// every line crosses the closed surface an even number of times.
 #[test]
 fn lines_through_edges_and_vertices_have_even_parity() {
-    let scene = scene::load("@cube:4").unwrap();
+    let scene = scenes::load("@cube:4").unwrap();
     let mut rng = rand_pcg::Pcg64::seed_from_u64(17);
     let mut lines = Vec::new();
     for k in 0..20_000 {
@@ -173,7 +174,7 @@ fn lines_through_edges_and_vertices_have_even_parity() {
 /// Crofton: a uniform global line meets a planar patch of area A with probability A / (2 pi R^2).
 #[test]
 fn hits_per_patch_follow_crofton() {
-    let scene: Scene = scene::load("@cube:2").unwrap();
+    let scene: Scene = scenes::load("@cube:2").unwrap();
     let lines_n = 1_000_000usize;
     for tracer in all_tracers(&scene) {
         let mut per_patch = vec![0u64; scene.patch_count()];

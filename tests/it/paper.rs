@@ -4,17 +4,20 @@
 //! figs. 5/6 are the best discretised (Tables 6, 7); constant radiosity leaves the measures unchanged
 //! (fig. 9, Table 8).
 
+use scene_complexity::geom::DVec3;
 use scene_complexity::run::{
     analyze, Analysis, AnalysisConfig, Measures, RadiosityOutcome, RunControl,
 };
-use scene_complexity::scene::paper::{fig2_corners, fig56_corners, Fig2Placement};
-use scene_complexity::scene::{self, Scene};
+use scene_complexity::scene::Scene;
+use scene_complexity::scenes;
+use scene_complexity::scenes::cube_clusters::{fig2_corners, Fig2Placement};
+use scene_complexity::scenes::cube_lattice::fig56_corners;
 use scene_complexity::trace::{make_tracer, Backend, Query};
 
 /// An analysis with the pure-Rust tracer; 2 groups, since these tests compare values, not errors (every
 /// group's own measures cost as much as the run's on scenes of ~2000 patches).
 fn run(spec: &str, lines: u64, discrete: bool) -> Analysis {
-    let scene = scene::load(spec).unwrap();
+    let scene = scenes::load(spec).unwrap();
     let tracer = make_tracer(Backend::Rust, &scene, Query::Single).unwrap();
     let cfg = AnalysisConfig {
         measures: Measures {
@@ -54,11 +57,11 @@ fn entropy_of_groups(groups: &[(f64, f64)]) -> f64 {
 
 /// Axis-aligned cubes of side `side` at `corners`: inside the unit room by at least `wall_gap`, apart
 /// from each other by at least `gap` on some axis.
-fn check_cubes(corners: &[[f64; 3]], side: f64, wall_gap: f64, gap: f64) {
+fn check_cubes(corners: &[DVec3], side: f64, wall_gap: f64, gap: f64) {
     for (i, c) in corners.iter().enumerate() {
-        for x in c {
+        for x in c.to_array() {
             assert!(
-                *x >= wall_gap - 1e-12 && x + side <= 1.0 - wall_gap + 1e-12,
+                x >= wall_gap - 1e-12 && x + side <= 1.0 - wall_gap + 1e-12,
                 "cube {i}"
             );
         }
@@ -79,7 +82,7 @@ fn fig2_has_table_1s_positional_entropy_and_no_touching_cubes() {
         ("b", Fig2Placement::Clusters8),
         ("c", Fig2Placement::Clusters64),
     ] {
-        let s = scene::load(&format!("@fig2:{v}")).unwrap();
+        let s = scenes::load(&format!("@fig2:{v}")).unwrap();
         assert_eq!(s.patch_count(), 3672);
         assert!((entropy_of_areas(&s) - exact).abs() < 1e-9, "@fig2:{v}");
         // Random cubes keep 1/64 between them; clustered ones 1/200 (a tenth of a side).
@@ -155,7 +158,7 @@ fn figs_5_and_6_have_the_papers_counts_and_equal_positional_entropy() {
     let exact = entropy_of_groups(&[(1536.0, 6.0 / 1536.0), (384.0, 6.0 / 384.0)]);
     for fig in ["5", "6"] {
         for stage in "af".chars() {
-            let s = scene::load(&format!("@fig{fig}:{stage}")).unwrap();
+            let s = scenes::load(&format!("@fig{fig}:{stage}")).unwrap();
             assert_eq!(s.patch_count(), 1920);
             // Patch 0 is a wall patch; the cube patches are the others.
             let wall = s.patches[0].area;
@@ -219,7 +222,7 @@ fn middle_stages_are_discretised_most_accurately() {
 /// visibility measures.
 #[test]
 fn labyrinth_radiosity_measures_equal_visibility_measures() {
-    let s = scene::load("@labyrinth").unwrap();
+    let s = scenes::load("@labyrinth").unwrap();
     // 23 x 23 floor-or-block-top squares, as many ceiling squares, 4 * 11^2 block sides facing a
     // corridor in a perfect maze, 4 * 23 hall-wall squares: all unit squares.
     assert_eq!(s.patch_count(), 2 * 529 + 484 + 92);

@@ -3,6 +3,7 @@
 //! refinement strategies.
 
 use crate::support;
+use scene_complexity::scenes;
 
 use scene_complexity::measure::radiosity::{
     for_each_transition, solve, transformed_areas, FormFactors, PatchMaterials, SolveOptions,
@@ -42,7 +43,7 @@ fn set_materials(scene: &mut Scene, mats: &[(f64, f64)]) {
 #[test]
 fn table_8_constant_radiosity_gives_the_visibility_measures() {
     for spec in ["@cube:3", "@cornell"] {
-        let mut scene = scene::load(spec).unwrap();
+        let mut scene = scenes::load(spec).unwrap();
         set_materials(
             &mut scene,
             &[(0.3, 0.7), (0.0, 1.0), (0.55, 0.45), (1.0, 0.0)],
@@ -174,7 +175,7 @@ fn unit_cube_with_one_emitting_face_matches_the_hand_solution() {
     }
     // And a Monte Carlo run lands on the closed-form radiosity measures within its standard errors.
     let (hp, hs, is) = paper_measures(&b, &f, &e, 0.5);
-    let mut scene = scene::load("@cube:1").unwrap();
+    let mut scene = scenes::load("@cube:1").unwrap();
     set_materials(
         &mut scene,
         &[
@@ -217,7 +218,7 @@ fn unit_cube_with_one_emitting_face_matches_the_hand_solution() {
 #[test]
 fn transition_rows_sum_to_one_in_the_cornell_box() {
     for spec in ["@cornell", "@cornell-open"] {
-        let scene = scene::load(spec).unwrap();
+        let scene = scenes::load(spec).unwrap();
         let tracer = rust_tracer(&scene);
         let a = analyze(
             &scene,
@@ -253,7 +254,7 @@ fn transition_rows_sum_to_one_in_the_cornell_box() {
 /// closed-form form factors and I_s^c = 1.6093 (paper Table 4, also checked in tests/visibility.rs).
 #[test]
 fn information_scores_add_up_to_the_discretisation_loss() {
-    let scene = scene::load("@cube:1").unwrap();
+    let scene = scenes::load("@cube:1").unwrap();
     let (fp, fq) = (
         ff_parallel_rectangles(1.0, 1.0, 1.0),
         ff_perpendicular_rectangles(1.0, 1.0, 1.0),
@@ -276,7 +277,7 @@ fn information_scores_add_up_to_the_discretisation_loss() {
 }
 
 fn refine_with(spec: &str, strategy: Strategy, target: usize) -> (Scene, Scene) {
-    let scene = scene::load(spec).unwrap();
+    let scene = scenes::load(spec).unwrap();
     let cfg = RefineConfig {
         strategy,
         target_patches: target,
@@ -359,7 +360,7 @@ fn refined_mesh_round_trips_through_obj_with_its_materials() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("mesh.obj");
     scene::obj::write(&refined, &path).unwrap();
-    let back = scene::load(path.to_str().unwrap()).unwrap();
+    let back = scenes::load(path.to_str().unwrap()).unwrap();
     assert_eq!(back.patch_count(), refined.patch_count());
     assert!(back.warnings.is_empty(), "{:?}", back.warnings);
     for (p, q) in refined.patches.iter().zip(&back.patches) {

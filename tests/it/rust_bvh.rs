@@ -4,12 +4,13 @@
 //! first hits equal to the first of the reference's hit lists.
 
 use crate::support;
+use scene_complexity::scenes;
 
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
 use scene_complexity::geom::uniform_direction;
 use scene_complexity::sample::lines::batch_lines;
-use scene_complexity::scene::{self, Scene};
+use scene_complexity::scene::Scene;
 use scene_complexity::trace::rust::{BruteForceTracer, BvhTracer};
 use scene_complexity::trace::{make_tracer, Backend, Line, LineHits, Query, TraceError, Tracer};
 
@@ -86,14 +87,14 @@ fn room_with_box() -> Scene {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("room.obj");
     std::fs::write(&path, support::room_with_box_obj(1.0)).unwrap();
-    scene::load(path.to_str().unwrap()).unwrap()
+    scenes::load(path.to_str().unwrap()).unwrap()
 }
 
 #[test]
 fn all_hits_equal_the_brute_force_tracer_to_the_bit() {
     let mut scenes: Vec<Scene> = ["@cube:3", "@sphere:2", "@dodecahedron:2", "@tetrahedron"]
         .iter()
-        .map(|s| scene::load(s).unwrap())
+        .map(|s| scenes::load(s).unwrap())
         .collect();
     scenes.push(room_with_box());
     for (k, scene) in scenes.iter().enumerate() {
@@ -117,7 +118,7 @@ fn all_hits_equal_the_brute_force_tracer_to_the_bit() {
 
 #[test]
 fn first_hits_are_the_nearest_of_the_reference() {
-    let scene = scene::load("@cube:4").unwrap();
+    let scene = scenes::load("@cube:4").unwrap();
     let lines = test_lines(&scene, 7);
     let reference = trace(&BruteForceTracer::new(&scene), &lines);
     let bvh = BvhTracer::new(&scene).unwrap();
@@ -132,7 +133,7 @@ fn first_hits_are_the_nearest_of_the_reference() {
 
 #[test]
 fn make_tracer_gives_the_bvh_and_refuses_packets() {
-    let scene = scene::load("@cube:2").unwrap();
+    let scene = scenes::load("@cube:2").unwrap();
     let t = make_tracer(Backend::Rust, &scene, Query::Single).unwrap();
     assert_eq!(t.name(), "rust");
     assert!(matches!(
@@ -143,7 +144,7 @@ fn make_tracer_gives_the_bvh_and_refuses_packets() {
 
 #[test]
 fn bad_lines_are_errors_not_panics() {
-    let scene = scene::load("@cube:2").unwrap();
+    let scene = scenes::load("@cube:2").unwrap();
     let bvh = BvhTracer::new(&scene).unwrap();
     let bad = Line {
         origin: [f32::NAN, 0.0, 0.0],

@@ -6,6 +6,7 @@
 //! reference computed here (never against scx's own earlier output).
 
 use crate::support;
+use scene_complexity::scenes;
 
 use std::f64::consts::{LN_2, PI};
 
@@ -14,7 +15,7 @@ use rand_pcg::Pcg64;
 use scene_complexity::measure::channel::row_totals;
 use scene_complexity::run::{analyze, Analysis, AnalysisConfig, RunControl};
 use scene_complexity::sample::pairs::{segments, Segment};
-use scene_complexity::scene::{self, Material, Scene, SceneBuilder};
+use scene_complexity::scene::{Material, Scene, SceneBuilder};
 use scene_complexity::trace::{make_tracer, Backend, Line, LineHits, Query, Tracer};
 use support::{count_entries, ff_parallel_rectangles, room_with_box_obj};
 
@@ -154,7 +155,7 @@ fn room_with_floor_square(b: &mut SceneBuilder, a: f64, c: f64, m: u32) {
     );
     add_quad(b, [p(0.0, a), p(a, a), p(a, c), p(0.0, c)], m, "floor west");
     add_quad(b, [p(c, a), p(1.0, a), p(1.0, c), p(c, c)], m, "floor east");
-    let room = scene_complexity::scene::builtin::cube("room", 1).expect("cube");
+    let room = scene_complexity::scenes::solids::cube("room", 1).expect("cube");
     // The other five walls of the unit cube, inward, from the built-in cube (face 4 is the floor z = 0).
     for (k, patch) in room.patches.iter().enumerate() {
         if k == 4 {
@@ -195,7 +196,7 @@ fn norm(a: [f64; 3]) -> f64 {
 /// The triangles of the icosphere `@sphere:level` (unit circumradius), counter-clockwise seen from
 /// outside (outward normals).
 fn icosphere(level: usize) -> Vec<[[f64; 3]; 3]> {
-    let s = scene::load(&format!("@sphere:{level}")).unwrap();
+    let s = scenes::load(&format!("@sphere:{level}")).unwrap();
     s.patches
         .iter()
         .map(|p| {
@@ -687,7 +688,7 @@ fn coplanar_overlapping_faces_are_seen_once_and_reported() {
 /// above the floor. Nothing is NaN, nothing escapes.
 #[test]
 fn grazing_lines_give_finite_exact_pairs() {
-    let scene = scene::load("@cube").unwrap();
+    let scene = scenes::load("@cube").unwrap();
     let h = 1.0 / 3f64.sqrt();
     let (floor, east, west) = (4u32, 1u32, 0u32);
     for tracer in support::all_tracers(&scene) {
@@ -934,7 +935,7 @@ fn tiny_and_huge_scenes_give_the_same_results() {
     let load = |s: f64| {
         let path = dir.path().join(format!("room_{s:e}.obj"));
         std::fs::write(&path, room_with_box_obj(s)).unwrap();
-        scene::load(path.to_str().unwrap()).unwrap()
+        scenes::load(path.to_str().unwrap()).unwrap()
     };
     let measures = |a: &Analysis| {
         let v = &a.visibility;
@@ -1057,8 +1058,8 @@ fn zero_area_triangles_are_dropped_with_a_warning() {
     .unwrap();
     let broken = dir.path().join("broken.obj");
     std::fs::write(&broken, format!("{corners}v 0.5 0.5 0.5\n{faces}f 1 9 8\n")).unwrap();
-    let a = scene::load(plain.to_str().unwrap()).unwrap();
-    let b = scene::load(broken.to_str().unwrap()).unwrap();
+    let a = scenes::load(plain.to_str().unwrap()).unwrap();
+    let b = scenes::load(broken.to_str().unwrap()).unwrap();
     assert!(a.warnings.is_empty(), "{:?}", a.warnings);
     let joined = b.warnings.join("\n");
     assert!(
@@ -1153,7 +1154,7 @@ fn enclose_closes_open_scenes_consistently() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("open_box.obj");
     std::fs::write(&path, OPEN_BOX).unwrap();
-    let open = scene::load(path.to_str().unwrap()).unwrap();
+    let open = scenes::load(path.to_str().unwrap()).unwrap();
     let a = analyze(&open, tracer(&open).as_ref(), &cfg, &RunControl::default()).unwrap();
     assert_all_finite(&a, "open box");
     let env = a.environment_area.expect("enclosed");
@@ -1178,7 +1179,7 @@ fn enclose_closes_open_scenes_consistently() {
         f[4][5]
     );
 
-    let closed = scene::load("@cube:2").unwrap();
+    let closed = scenes::load("@cube:2").unwrap();
     let a = analyze(
         &closed,
         tracer(&closed).as_ref(),

@@ -229,7 +229,7 @@ pub fn cube_form_factor_row(scene: &Scene, rects: &[AxisRect], i: usize) -> Vec<
 /// symmetry maps every face onto face 0, so the rows of face 0's patches suffice.
 pub fn cube_exact_measures(n: usize) -> (f64, f64) {
     use rayon::prelude::*;
-    let scene = scene_complexity::scene::load(&format!("@cube:{n}")).unwrap();
+    let scene = scene_complexity::scenes::load(&format!("@cube:{n}")).unwrap();
     let rects: Vec<AxisRect> = (0..scene.patch_count())
         .map(|p| AxisRect::of_patch(&scene, p))
         .collect();

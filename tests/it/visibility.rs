@@ -2,11 +2,12 @@
 //! positional entropy, closure and reciprocity, thread and scale invariance.
 
 use crate::support;
+use scene_complexity::scenes;
 
 use scene_complexity::measure::channel::{for_each_form_factor, row_totals};
 use scene_complexity::run::Measures;
 use scene_complexity::run::{analyze, Analysis, AnalysisConfig, RunControl};
-use scene_complexity::scene::{self, Scene};
+use scene_complexity::scene::Scene;
 use scene_complexity::trace::Tracer;
 use support::*;
 
@@ -37,7 +38,7 @@ fn opposite(i: usize, j: usize) -> bool {
 
 #[test]
 fn unit_cube_form_factors_and_mutual_information_match_closed_form() {
-    let scene = scene::load("@cube:1").unwrap();
+    let scene = scenes::load("@cube:1").unwrap();
     let f_par = ff_parallel_rectangles(1.0, 1.0, 1.0);
     let f_perp = ff_perpendicular_rectangles(1.0, 1.0, 1.0);
     // Closed-form I_s (eq. 21) with a_j = 1/6: sum_j F_1j log2(6 F_1j), the same for every row.
@@ -84,7 +85,7 @@ fn unit_cube_form_factors_and_mutual_information_match_closed_form() {
 #[test]
 fn positional_entropy_is_exact() {
     for n in [1usize, 3, 7] {
-        let scene = scene::load(&format!("@cube:{n}")).unwrap();
+        let scene = scenes::load(&format!("@cube:{n}")).unwrap();
         let tracer = &all_tracers(&scene)[0];
         let a = run(&scene, tracer.as_ref(), 5_000, 1);
         let hp = a.visibility.positional_entropy.unwrap();
@@ -95,7 +96,7 @@ fn positional_entropy_is_exact() {
 
 #[test]
 fn rows_sum_to_one_and_reciprocity_holds_in_a_closed_scene() {
-    let scene = scene::load("@cube:3").unwrap();
+    let scene = scenes::load("@cube:3").unwrap();
     for tracer in all_tracers(&scene) {
         let a = run(&scene, tracer.as_ref(), 100_000, 5);
         assert_eq!(a.escapes, 0, "a closed scene has no escapes");
@@ -134,7 +135,7 @@ fn rows_sum_to_one_and_reciprocity_holds_in_a_closed_scene() {
 
 #[test]
 fn results_do_not_depend_on_the_thread_count() {
-    let scene = scene::load("@cube:4").unwrap();
+    let scene = scenes::load("@cube:4").unwrap();
     for tracer in all_tracers(&scene) {
         let go = |threads: usize| {
             let pool = rayon::ThreadPoolBuilder::new()
@@ -165,7 +166,7 @@ fn scaling_the_scene_changes_nothing() {
         .map(|&s| {
             let path = dir.path().join(format!("room_{s}.obj"));
             std::fs::write(&path, room_with_box_obj(s)).unwrap();
-            let scene = scene::load(path.to_str().unwrap()).unwrap();
+            let scene = scenes::load(path.to_str().unwrap()).unwrap();
             let tracer = &all_tracers(&scene)[0];
             (
                 run(&scene, tracer.as_ref(), 30_000, 9),
@@ -206,7 +207,7 @@ fn sphere_mutual_information_tends_to_zero() {
     let mut previous_cmi = f64::INFINITY;
     let mut previous_is = f64::INFINITY;
     for level in 0..=3usize {
-        let scene = scene::load(&format!("@sphere:{level}")).unwrap();
+        let scene = scenes::load(&format!("@sphere:{level}")).unwrap();
         let tracer = all_tracers(&scene).pop().unwrap();
         let a = run(&scene, tracer.as_ref(), 400_000, 21);
         let cmi = a.visibility.continuous_mutual_information.unwrap();
@@ -234,7 +235,7 @@ fn sphere_mutual_information_tends_to_zero() {
 /// to 1, reciprocity is exact, and N = 1 reproduces the unit-square values.
 #[test]
 fn closed_form_cube_form_factors_are_consistent() {
-    let scene = scene::load("@cube:4").unwrap();
+    let scene = scenes::load("@cube:4").unwrap();
     let rects: Vec<AxisRect> = (0..scene.patch_count())
         .map(|p| AxisRect::of_patch(&scene, p))
         .collect();

@@ -24,8 +24,9 @@
 use rand::RngCore;
 use rand_pcg::Pcg64;
 
-use super::paper::{add_rect, Rect};
-use super::{Material, Scene, SceneBuilder, SceneError};
+use super::parts::add_rect;
+use crate::geom::shapes::Rect;
+use crate::scene::{Material, Scene, SceneBuilder, SceneError};
 
 /// Default cells per side.
 pub const DEFAULT_CELLS: usize = 11;

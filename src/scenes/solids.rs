@@ -1,156 +1,16 @@
-//! Built-in scenes, named `@name` or `@name:param`; every one is an enclosure seen from inside (normals
-//! point inwards), so every line segment inside it joins two patches.
+//! The interiors of the unit cube, the regular solids and the icosphere: enclosures seen from inside
+//! (normals point inwards), so every line segment inside joins two patches (paper Tables 2 and 4).
 //!
 //! * `@cube:N`: the interior of the unit cube (area 6), each face cut into N x N square patches.
-//!   `@cube` is `@cube:1`.
 //! * `@sphere:L`: an icosphere after L subdivisions of the icosahedron (20 * 4^L triangles, each a patch),
 //!   vertices on the unit sphere.
 //! * `@tetrahedron`, `@octahedron`, `@icosahedron` (`:N` cuts each triangular face into N^2 equal
 //!   triangles) and `@dodecahedron` (one pentagon patch per face; `:N` cuts each pentagon into 5 triangles
 //!   from its centre, then each into N^2): the interiors of the regular solids, circumradius 1.
-//! * `@cornell[:N]` and `@cornell-open[:N]`: the Cornell box, see [`super::cornell`].
-//! * The scenes of the paper's figures: `@fig2:a|b|c`, `@fig5:S` and `@fig6:S` ([`super::paper`]),
-//!   `@fig4:a..f` ([`super::furniture`]) and `@labyrinth[:N]` ([`super::labyrinth`]).
-//!
-//! Materials: every built-in but the Cornell box and the labyrinth has one material, `wall`, with reflectance R = 0.5 and
-//! no emission (an even grey; nothing emits, so these scenes have no radiosity measures). The Cornell box
-//! has its published materials and a light; the labyrinth has materials with R + E = 1.
 
-use super::{Material, Scene, SceneBuilder, SceneError};
+use super::parts::grey_wall;
 use crate::geom::{centroid, orthonormal_basis, unit_vector, DVec3, Point};
-
-/// A built-in scene's name, parameter and description, for `scx scenes`.
-#[derive(Clone, Copy, Debug)]
-pub struct BuiltinInfo {
-    /// How to name it (`@cube:N`).
-    pub usage: &'static str,
-    /// What it is.
-    pub description: &'static str,
-}
-
-/// Every built-in scene.
-pub const BUILTINS: &[BuiltinInfo] = &[
-    BuiltinInfo {
-        usage: "@cube[:N]",
-        description: "unit cube enclosure, each face cut into N x N square patches (N >= 1, default 1)",
-    },
-    BuiltinInfo {
-        usage: "@sphere[:L]",
-        description: "icosphere enclosure after L subdivisions (0..=7, default 3): 20*4^L triangle patches",
-    },
-    BuiltinInfo {
-        usage: "@tetrahedron[:N]",
-        description: "regular tetrahedron interior, each face cut into N^2 triangles (default 1: 4 patches)",
-    },
-    BuiltinInfo {
-        usage: "@octahedron[:N]",
-        description: "regular octahedron interior, each face cut into N^2 triangles (default 1: 8 patches)",
-    },
-    BuiltinInfo {
-        usage: "@icosahedron[:N]",
-        description: "regular icosahedron interior, each face cut into N^2 triangles (default 1: 20 patches)",
-    },
-    BuiltinInfo {
-        usage: "@dodecahedron[:N]",
-        description: "regular dodecahedron interior, one pentagon per face; N > 1 cuts each into 5 N^2 triangles",
-    },
-    BuiltinInfo {
-        usage: "@cornell[:N]",
-        description: "the Cornell box (published geometry, mm), closed by a white front wall; light E = 10.93, \
-                      white/red/green R = 0.723/0.243/0.198; 29 N^2 patches",
-    },
-    BuiltinInfo {
-        usage: "@cornell-open[:N]",
-        description: "the Cornell box as published, open at the front (lines escape there); 28 N^2 patches",
-    },
-    BuiltinInfo {
-        usage: "@cubes512",
-        description: "unit cube room holding 512 small cubes (side 1/16, one per cell of an 8^3 grid, fixed random offsets)",
-    },
-    BuiltinInfo {
-        usage: "@fig2:a|b|c",
-        description: "paper fig. 2: unit cube room with 512 cubes of side 1/20, walls 10 x 10 patches, cube \
-                      faces 1 (3672 patches, H_p 11.5407); a: one cube at random in each cell of an 8^3 \
-                      grid; b: 64 clusters of 2^3 cubes, c: 8 clusters of 4^3 (gaps 1/200) at random in \
-                      their blocks",
-    },
-    BuiltinInfo {
-        usage: "@fig4:a..f",
-        description: "paper fig. 4: 10 x 10 x 3 m room; a: a 0.9 m table with four chairs in the middle; \
-                      b: 2 x 2 of them; c: 4 x 4 in the middle, d: 4 x 4 spread evenly, e: four 2 x 2 \
-                      blocks in the corners, f: 16 along the walls (e, f: 0.1 m from the walls)",
-    },
-    BuiltinInfo {
-        usage: "@fig5:a..f|T",
-        description: "paper fig. 5: 64 cubes of side 1/8 on a 4^3 lattice in the unit room, from gaps of \
-                      1/80 between them (a) to 1/64 from the walls (f), or at fraction T in [0, 1] of the \
-                      way; cubes finer: faces 2 x 2, walls 8 x 8 (1536 + 384 patches)",
-    },
-    BuiltinInfo {
-        usage: "@fig6:a..f|T",
-        description: "paper fig. 6: the scenes of @fig5 with walls finer: cube faces 1, walls 16 x 16 \
-                      (384 + 1536 patches)",
-    },
-    BuiltinInfo {
-        usage: "@labyrinth[:N]",
-        description: "paper fig. 9: perfect maze of N x N cells (default 11) with unit-high wall blocks \
-                      in a hall 2 high, unit-square patches (1634 for N = 11); every material has R + E = 1, \
-                      so the radiosity is 1 everywhere",
-    },
-];
-
-/// Builds a built-in scene from its name (`@cube:10`).
-pub fn build(spec: &str) -> Result<Scene, SceneError> {
-    let body = spec.strip_prefix('@').unwrap_or(spec);
-    let (name, param) = match body.split_once(':') {
-        Some((n, p)) => (n, Some(p)),
-        None => (body, None),
-    };
-    match name {
-        "cube" => cube(spec, parse_count(spec, param, 1, 2000)?),
-        "sphere" => sphere(spec, parse_count(spec, param.or(Some("3")), 0, 7)?),
-        "tetrahedron" => solid(spec, &tetrahedron(), parse_count(spec, param, 1, 1000)?),
-        "octahedron" => solid(spec, &octahedron(), parse_count(spec, param, 1, 1000)?),
-        "icosahedron" => solid(spec, &icosahedron(), parse_count(spec, param, 1, 1000)?),
-        "dodecahedron" => solid(spec, &dodecahedron(), parse_count(spec, param, 1, 1000)?),
-        "cornell" => super::cornell::build(spec, parse_count(spec, param, 1, 100)?, true),
-        "cornell-open" => super::cornell::build(spec, parse_count(spec, param, 1, 100)?, false),
-        "cubes512" => super::clutter::cubes512(spec, param),
-        "fig2" => super::paper::fig2(spec, param),
-        "fig4" => super::furniture::fig4(spec, param),
-        "fig5" => super::paper::fig56(spec, param, super::paper::Fig56Mesh::CubesFiner),
-        "fig6" => super::paper::fig56(spec, param, super::paper::Fig56Mesh::WallsFiner),
-        "labyrinth" => {
-            super::labyrinth::build(spec, parse_count(spec, param.or(Some("11")), 1, 100)?)
-        }
-        _ => Err(SceneError::Builtin(format!(
-            "{spec}: unknown built-in scene; `scx scenes` lists them ({})",
-            BUILTINS
-                .iter()
-                .map(|b| b.usage)
-                .collect::<Vec<_>>()
-                .join(", ")
-        ))),
-    }
-}
-
-/// Parses an optional whole-number parameter within `[min, max]` (absent: `min`).
-fn parse_count(
-    spec: &str,
-    param: Option<&str>,
-    min: usize,
-    max: usize,
-) -> Result<usize, SceneError> {
-    let Some(p) = param else {
-        return Ok(min);
-    };
-    match p.parse::<usize>() {
-        Ok(n) if (min..=max).contains(&n) => Ok(n),
-        _ => Err(SceneError::Builtin(format!(
-            "{spec}: the parameter must be a whole number from {min} to {max}, not `{p}`"
-        ))),
-    }
-}
+use crate::scene::{Scene, SceneBuilder, SceneError};
 
 /// The six faces of the unit cube as (corner, u axis, v axis), with `u x v` pointing inwards.
 const CUBE_FACES: [(DVec3, DVec3, DVec3); 6] = [
@@ -168,11 +28,7 @@ const CUBE_FACES: [(DVec3, DVec3, DVec3); 6] = [
 /// `patch = face * N^2 + i * N + j`, `i` along u and `j` along v.
 pub fn cube(spec: &str, n: usize) -> Result<Scene, SceneError> {
     let mut b = SceneBuilder::new(spec);
-    let m = b.material(Material {
-        name: "wall".into(),
-        emission: 0.0,
-        reflectance: 0.5,
-    });
+    let m = grey_wall(&mut b);
     for (face, (o, u, v)) in CUBE_FACES.iter().enumerate() {
         for i in 0..n {
             for j in 0..n {
@@ -196,18 +52,30 @@ struct Polyhedron {
     faces: Vec<Vec<usize>>,
 }
 
-fn wall_material(b: &mut SceneBuilder) -> u32 {
-    b.material(Material {
-        name: "wall".into(),
-        emission: 0.0,
-        reflectance: 0.5,
-    })
+/// The regular solids.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Solid {
+    /// 4 triangles.
+    Tetrahedron,
+    /// 8 triangles.
+    Octahedron,
+    /// 20 triangles.
+    Icosahedron,
+    /// 12 pentagons.
+    Dodecahedron,
 }
 
-/// The interior of a convex polyhedron: each face one patch (N = 1) or cut into triangles.
-fn solid(spec: &str, poly: &Polyhedron, n: usize) -> Result<Scene, SceneError> {
+/// The interior of a regular solid of circumradius 1: each face one patch (`n` = 1) or cut into
+/// triangles (see the module documentation).
+pub fn solid(spec: &str, which: Solid, n: usize) -> Result<Scene, SceneError> {
+    let poly = match which {
+        Solid::Tetrahedron => tetrahedron(),
+        Solid::Octahedron => octahedron(),
+        Solid::Icosahedron => icosahedron(),
+        Solid::Dodecahedron => dodecahedron(),
+    };
     let mut b = SceneBuilder::new(spec);
-    let m = wall_material(&mut b);
+    let m = grey_wall(&mut b);
     for (f, face) in poly.faces.iter().enumerate() {
         let pts = facing_inwards(face.iter().map(|&v| poly.vertices[v]).collect());
         if n == 1 {
@@ -281,7 +149,7 @@ pub fn sphere(spec: &str, levels: usize) -> Result<Scene, SceneError> {
             .collect();
     }
     let mut b = SceneBuilder::new(spec);
-    let m = wall_material(&mut b);
+    let m = grey_wall(&mut b);
     for (k, t) in tris.iter().enumerate() {
         let idx = t.map(|p| b.vertex(p));
         b.polygon(&idx, m, format!("triangle {k}"));
@@ -377,7 +245,6 @@ fn triangles_with_edge(v: &[Point], edge: f64) -> Vec<Vec<usize>> {
 
 #[cfg(test)]
 mod tests {
-    use super::*;
 
     #[test]
     fn solids_have_the_right_face_counts_and_inward_normals() {
@@ -392,20 +259,12 @@ mod tests {
             ("@tetrahedron:3", 36),
             ("@dodecahedron:2", 240),
         ] {
-            let s = build(spec).unwrap();
+            let s = crate::scenes::build(spec).unwrap();
             assert_eq!(s.patch_count(), faces, "{spec}");
             for p in &s.patches {
                 // Inward: the plane offset n . x is negative for a face around the origin.
                 assert!(p.offset < 0.0, "{spec}: a patch faces outwards");
             }
-        }
-    }
-
-    #[test]
-    fn bad_names_and_parameters_are_clear_errors() {
-        for bad in ["@cub", "@cube:0", "@cube:x", "@sphere:9", "@tetrahedron:-1"] {
-            let e = build(bad).unwrap_err().to_string();
-            assert!(e.starts_with(bad), "{e}");
         }
     }
 }

@@ -35,8 +35,8 @@
 //! right wall 1 each, left wall 2, blocks 5 each), 28 in the open one. `@cornell:N` cuts every quad into
 //! an N x N grid and every triangle into N^2 triangles, so it has N^2 times as many patches.
 
-use super::{Material, Scene, SceneBuilder, SceneError};
 use crate::geom::{DVec3, Point};
+use crate::scene::{Material, Scene, SceneBuilder, SceneError};
 
 /// Mean of the published spectral reflectance of the white paint (76 samples, 400-700 nm).
 pub const WHITE: f64 = 0.722_671_052_631_578_8;

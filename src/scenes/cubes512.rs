@@ -11,10 +11,11 @@
 //! 6 + 512 * 6 = 3078 patches (more than [`crate::sample::counts::DENSE_MAX_PATCHES`], so its pair counts
 //! use the sparse layout), 6156 triangles.
 
-use rand::RngCore;
 use rand_pcg::Pcg64;
 
-use super::{Material, Scene, SceneBuilder, SceneError};
+use super::parts::grey_wall;
+use crate::geom::{uniform01, DVec3, Point};
+use crate::scene::{Scene, SceneBuilder, SceneError};
 
 /// Cells along each axis.
 pub const CELLS: usize = 8;
@@ -26,11 +27,13 @@ pub const CELL_GAP: f64 = 1.0 / 128.0;
 pub const SEED: u64 = 512;
 
 /// The corner of a box (bits: x = 1, y = 2, z = 4).
-fn corner(lo: [f64; 3], hi: [f64; 3], bits: usize) -> [f64; 3] {
-    [0, 1, 2].map(|a| if bits & (1 << a) == 0 { lo[a] } else { hi[a] })
+fn corner(lo: Point, hi: Point, bits: usize) -> Point {
+    DVec3::from_array([0, 1, 2].map(|a| if bits & (1 << a) == 0 { lo[a] } else { hi[a] }))
 }
 
-/// The faces of a box as corner-bit quads, counter-clockwise seen from outside.
+/// The faces of this scene's boxes as corner-bit quads, counter-clockwise seen from outside. Their
+/// first corners differ from [`crate::geom::shapes::box_faces`]'s, and so do the diagonals their
+/// triangles share: the scene keeps the faces it was first published with, so that its numbers stay.
 const BOX_FACES: [[usize; 4]; 6] = [
     [0, 4, 6, 2], // x = lo
     [1, 3, 7, 5], // x = hi
@@ -41,7 +44,7 @@ const BOX_FACES: [[usize; 4]; 6] = [
 ];
 
 /// Adds a box as six patches, facing out (`inward == false`) or in.
-fn add_box(b: &mut SceneBuilder, lo: [f64; 3], hi: [f64; 3], inward: bool, m: u32, name: &str) {
+fn add_box(b: &mut SceneBuilder, lo: Point, hi: Point, inward: bool, m: u32, name: &str) {
     for (f, quad) in BOX_FACES.iter().enumerate() {
         let mut idx: Vec<u32> = quad.iter().map(|&c| b.vertex(corner(lo, hi, c))).collect();
         if inward {
@@ -51,13 +54,8 @@ fn add_box(b: &mut SceneBuilder, lo: [f64; 3], hi: [f64; 3], inward: bool, m: u3
     }
 }
 
-/// A uniform double in [0, 1).
-fn unit(rng: &mut Pcg64) -> f64 {
-    (rng.next_u64() >> 11) as f64 / (1u64 << 53) as f64
-}
-
 /// The lower corners of the 512 small cubes, cell by cell (x fastest, then y, then z).
-pub fn cube_corners() -> Vec<[f64; 3]> {
+pub fn cube_corners() -> Vec<Point> {
     let mut rng = Pcg64::new(u128::from(SEED), 0xc1u128);
     let cell = 1.0 / CELLS as f64;
     let slack = cell - CUBE_SIDE - 2.0 * CELL_GAP;
@@ -66,7 +64,9 @@ pub fn cube_corners() -> Vec<[f64; 3]> {
         for j in 0..CELLS {
             for i in 0..CELLS {
                 let cell_lo = [i, j, k].map(|c| c as f64 * cell);
-                corners.push(cell_lo.map(|c| c + CELL_GAP + slack * unit(&mut rng)));
+                corners.push(DVec3::from_array(
+                    cell_lo.map(|c| c + CELL_GAP + slack * uniform01(&mut rng)),
+                ));
             }
         }
     }
@@ -82,14 +82,10 @@ pub fn cubes512(spec: &str, param: Option<&str>) -> Result<Scene, SceneError> {
         )));
     }
     let mut b = SceneBuilder::new(spec);
-    let m = b.material(Material {
-        name: "wall".into(),
-        emission: 0.0,
-        reflectance: 0.5,
-    });
-    add_box(&mut b, [0.0; 3], [1.0; 3], true, m, "room");
+    let m = grey_wall(&mut b);
+    add_box(&mut b, DVec3::ZERO, DVec3::ONE, true, m, "room");
     for (n, lo) in cube_corners().into_iter().enumerate() {
-        let hi = lo.map(|c| c + CUBE_SIDE);
+        let hi = lo + CUBE_SIDE;
         add_box(&mut b, lo, hi, false, m, &format!("cube {n}"));
     }
     b.build()
@@ -133,12 +129,12 @@ mod tests {
         let corners = cube_corners();
         for (k, p) in s.patches.iter().enumerate() {
             let centre = if k < 6 {
-                [0.5; 3]
+                DVec3::splat(0.5)
             } else {
-                corners[(k - 6) / 6].map(|c| c + CUBE_SIDE / 2.0)
+                corners[(k - 6) / 6] + CUBE_SIDE / 2.0
             };
             let v = s.vertices[s.triangles[p.first_triangle as usize][0] as usize];
-            let side: f64 = (0..3).map(|a| p.normal[a] * (centre[a] - v[a])).sum();
+            let side = p.normal.dot(centre - v);
             assert_eq!(side > 0.0, k < 6, "patch {k}");
         }
     }

@@ -27,8 +27,9 @@
 //!
 //! Material: the grey `wall` of the other built-ins (R = 0.5, no light).
 
-use super::paper::{add_rect, Rect};
-use super::{Material, Scene, SceneBuilder, SceneError};
+use super::parts::{add_rect, grey_wall};
+use crate::geom::shapes::Rect;
+use crate::scene::{Scene, SceneBuilder, SceneError};
 
 /// Side of the square room.
 pub const ROOM_SIDE: f64 = 10.0;
@@ -109,11 +110,7 @@ pub fn fig4(spec: &str, param: Option<&str>) -> Result<Scene, SceneError> {
             ))
         })?;
     let mut b = SceneBuilder::new(spec);
-    let m = b.material(Material {
-        name: "wall".into(),
-        emission: 0.0,
-        reflectance: 0.5,
-    });
+    let m = grey_wall(&mut b);
     let mut f = Furnisher { b: &mut b, m };
     f.room();
     for (k, c) in centres.iter().enumerate() {
