@@ -1,6 +1,6 @@
 //! Hit-for-hit comparison of two tracers on the same global lines, and of the measures they lead to.
 //!
-//! Both tracers see exactly the lines an analysis with the same seed casts ([`BatchPlan`], one PCG stream
+//! Both tracers see exactly the lines an analysis with the same seed casts ([`crate::run::LineStream`], one PCG stream
 //! per batch), and their canonical hit lists ([`Tracer::all_hits`]) are compared line by line:
 //!
 //! * the number of hits must be equal;

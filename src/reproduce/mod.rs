@@ -1,15 +1,15 @@
 //! `scx reproduce`: the paper's Tables 1 to 9 regenerated with scx, each printed beside the paper's
-//! values ([`paper`]) with the lines and seconds used, plug-in and bias-corrected estimates with their
+//! values ([`published`]) with the lines and seconds used, plug-in and bias-corrected estimates with their
 //! standard errors, and a check of the paper's qualitative findings on our numbers ([`Finding`]).
 //!
 //! The scenes are the built-ins of the paper's figures (`scx scenes`): `@fig2:a|b|c` (Tables 1 and 3),
 //! `@cube:10|20|30` (Table 2), the regular solids, an icosphere and `@cornell` (Table 4), `@fig4:a..f`
 //! (Table 5), `@fig5:a..f` and `@fig6:a..f` (Tables 6 and 7), `@labyrinth` (Table 8), and `@cornell`
-//! refined by [`crate::refine`] (Table 9). Runs are cached within one call: a scene run twice at the same
+//! refined by [`crate::refine()`] (Table 9). Runs are cached within one call: a scene run twice at the same
 //! line count (Tables 1 and 3 share fig. 2a) is traced once, with identical numbers since the seed is the
 //! same.
 
-pub mod paper;
+pub mod published;
 mod tables;
 
 use crate::scenes;

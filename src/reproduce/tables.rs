@@ -3,7 +3,7 @@
 use crate::scenes;
 use std::time::Instant;
 
-use super::{est, lines_text, paper, Finding, ReproduceError, Run, Session, TableReport, Want};
+use super::{est, lines_text, published, Finding, ReproduceError, Run, Session, TableReport, Want};
 use crate::measure::radiosity::SolveOptions;
 use crate::measure::Estimate;
 use crate::refine::{refine, RefineConfig, Strategy};
@@ -154,7 +154,7 @@ fn table1(s: &mut Session) -> Result<TableReport, ReproduceError> {
         ],
     );
     let mut runs = Vec::new();
-    for &(p, lines, hs, is, mse) in &paper::TABLE1 {
+    for &(p, lines, hs, is, mse) in &published::TABLE1 {
         let r = s.run(&format!("@fig2:{p}"), lines, Want::Visibility)?;
         let v = &r.v;
         t.rows.push(vec![
@@ -177,7 +177,7 @@ fn table1(s: &mut Session) -> Result<TableReport, ReproduceError> {
     t.notes.push(format!(
         "H_p (eq. 19, exact from the areas) = {} for all three (paper: {}).",
         est(hp, 4),
-        paper::TABLE1_HP
+        published::TABLE1_HP
     ));
     let ratios: Vec<String> = runs
         .iter()
@@ -279,7 +279,7 @@ fn table2(s: &mut Session) -> Result<TableReport, ReproduceError> {
         ],
     );
     let mut runs = Vec::new();
-    for &(n, lines, hs, is, isc) in &paper::TABLE2 {
+    for &(n, lines, hs, is, isc) in &published::TABLE2 {
         let r = s.run(&format!("@cube:{n}"), lines, Want::Visibility)?;
         let v = &r.v;
         let fig = ["3a", "3b", "3c"][n / 10 - 1];
@@ -298,7 +298,7 @@ fn table2(s: &mut Session) -> Result<TableReport, ReproduceError> {
         ]);
         runs.push((n, lines, r));
     }
-    t.notes.extend(capped_note(s, &paper::TABLE2.map(|r| r.1)));
+    t.notes.extend(capped_note(s, &published::TABLE2.map(|r| r.1)));
     t.findings = table2_findings(s, &runs);
     Ok(t)
 }
@@ -383,7 +383,7 @@ fn table3(s: &mut Session) -> Result<TableReport, ReproduceError> {
         ],
     );
     let mut runs = Vec::new();
-    for &(lines, is, isc) in &paper::TABLE3 {
+    for &(lines, is, isc) in &published::TABLE3 {
         let r = s.run("@fig2:a", lines, Want::Visibility)?;
         let v = &r.v;
         t.rows.push(vec![
@@ -397,7 +397,7 @@ fn table3(s: &mut Session) -> Result<TableReport, ReproduceError> {
         ]);
         runs.push(r);
     }
-    t.notes.extend(capped_note(s, &paper::TABLE3.map(|r| r.0)));
+    t.notes.extend(capped_note(s, &published::TABLE3.map(|r| r.0)));
     let last = runs
         .last()
         .expect("four runs")
@@ -448,8 +448,8 @@ fn table4(s: &mut Session) -> Result<TableReport, ReproduceError> {
         &["scene", "scx scene", "lines", "s", "I_s^c", "I_s^c paper"],
     );
     let mut isc = Vec::new();
-    for (&(name, value), spec) in paper::TABLE4.iter().zip(TABLE4_SCENES) {
-        let r = s.run(spec, paper::TABLE45_LINES, Want::Continuous)?;
+    for (&(name, value), spec) in published::TABLE4.iter().zip(TABLE4_SCENES) {
+        let r = s.run(spec, published::TABLE45_LINES, Want::Continuous)?;
         let c = r.v.continuous_mutual_information;
         t.rows.push(vec![
             name.into(),
@@ -466,7 +466,7 @@ fn table4(s: &mut Session) -> Result<TableReport, ReproduceError> {
          is subdivided; `@cornell` is the closed box (see `scx scenes`)."
             .into(),
     );
-    t.notes.extend(capped_note(s, &[paper::TABLE45_LINES]));
+    t.notes.extend(capped_note(s, &[published::TABLE45_LINES]));
     let solids: Vec<f64> = isc[..6].iter().map(|&e| val(e)).collect();
     let ranked = solids.windows(2).all(|w| w[0] < w[1]);
     t.findings.push(finding(
@@ -489,10 +489,10 @@ fn table5(s: &mut Session) -> Result<TableReport, ReproduceError> {
         &["scene", "lines", "s", "I_s^c", "I_s^c paper"],
     );
     let mut isc = Vec::new();
-    for &(p, value) in &paper::TABLE5 {
+    for &(p, value) in &published::TABLE5 {
         let r = s.run(
             &format!("@fig4:{p}"),
-            paper::TABLE45_LINES,
+            published::TABLE45_LINES,
             Want::Continuous,
         )?;
         let c = r.v.continuous_mutual_information;
@@ -510,7 +510,7 @@ fn table5(s: &mut Session) -> Result<TableReport, ReproduceError> {
          evenly; e: four 2 x 2 blocks in the corners; f: 16 along the walls (our layouts, `scx scenes`)."
             .into(),
     );
-    t.notes.extend(capped_note(s, &[paper::TABLE45_LINES]));
+    t.notes.extend(capped_note(s, &[published::TABLE45_LINES]));
     let v: Vec<f64> = isc.iter().map(|&e| val(e)).collect();
     t.findings.push(finding(
         "introducing objects increases the complexity (a < b < c)",
@@ -520,7 +520,7 @@ fn table5(s: &mut Session) -> Result<TableReport, ReproduceError> {
     let spread = |x: &[f64]| {
         x.iter().cloned().fold(f64::MIN, f64::max) - x.iter().cloned().fold(f64::MAX, f64::min)
     };
-    let paper_v: Vec<f64> = paper::TABLE5
+    let paper_v: Vec<f64> = published::TABLE5
         .iter()
         .map(|r| r.1.parse().unwrap_or(f64::NAN))
         .collect();
@@ -541,11 +541,11 @@ fn table5(s: &mut Session) -> Result<TableReport, ReproduceError> {
 
 fn table67(s: &mut Session, number: u8) -> Result<TableReport, ReproduceError> {
     let (fig, data, what) = if number == 6 {
-        ("5", &paper::TABLE6, "cubes finer: faces 2 x 2, walls 8 x 8")
+        ("5", &published::TABLE6, "cubes finer: faces 2 x 2, walls 8 x 8")
     } else {
         (
             "6",
-            &paper::TABLE7,
+            &published::TABLE7,
             "walls finer: faces 1 x 1, walls 16 x 16",
         )
     };
@@ -573,7 +573,7 @@ fn table67(s: &mut Session, number: u8) -> Result<TableReport, ReproduceError> {
         let stage = "abcdef".as_bytes()[k] as char;
         let r = s.run(
             &format!("@fig{fig}:{stage}"),
-            paper::TABLE67_LINES,
+            published::TABLE67_LINES,
             Want::Visibility,
         )?;
         let v = &r.v;
@@ -592,7 +592,7 @@ fn table67(s: &mut Session, number: u8) -> Result<TableReport, ReproduceError> {
         ]);
         runs.push(r);
     }
-    t.notes.extend(capped_note(s, &[paper::TABLE67_LINES]));
+    t.notes.extend(capped_note(s, &[published::TABLE67_LINES]));
     let isc: Vec<f64> = runs
         .iter()
         .map(|r| val(r.v.continuous_mutual_information))
@@ -630,8 +630,8 @@ fn table67(s: &mut Session, number: u8) -> Result<TableReport, ReproduceError> {
 /// Fig. 5a against 6a and 6f against 5f: the finer cubes win when the cubes are close together, the finer
 /// walls when the cubes are near the walls.
 fn compare_meshes(s: &mut Session, fig6: &[Run]) -> Result<Finding, ReproduceError> {
-    let a5 = s.run("@fig5:a", paper::TABLE67_LINES, Want::Visibility)?;
-    let f5 = s.run("@fig5:f", paper::TABLE67_LINES, Want::Visibility)?;
+    let a5 = s.run("@fig5:a", published::TABLE67_LINES, Want::Visibility)?;
+    let f5 = s.run("@fig5:f", published::TABLE67_LINES, Want::Visibility)?;
     let wins = |f: Pick| val(f(&a5.v)) > val(f(&fig6[0].v)) && val(f(&fig6[5].v)) > val(f(&f5.v));
     let (plug, corr) = (wins(|v| v.accuracy), wins(|v| v.accuracy_corrected));
     Ok(finding(
@@ -669,7 +669,7 @@ fn table8(s: &mut Session) -> Result<TableReport, ReproduceError> {
     );
     let r = s.run("@labyrinth", super::UNSTATED_LINES, Want::Radiosity)?;
     let v = &r.v;
-    let (ph, ps, pi) = paper::TABLE8_VISIBILITY;
+    let (ph, ps, pi) = published::TABLE8_VISIBILITY;
     t.rows.push(vec![
         "Visibility".into(),
         lines_text(r.lines),
@@ -688,7 +688,7 @@ fn table8(s: &mut Session) -> Result<TableReport, ReproduceError> {
             .push("The radiosity measures could not be computed.".into());
         return Ok(t);
     };
-    let (qh, qs, qi) = paper::TABLE8_RADIOSITY;
+    let (qh, qs, qi) = published::TABLE8_RADIOSITY;
     t.rows.push(vec![
         "Radiosity".into(),
         lines_text(r.lines),
@@ -763,7 +763,7 @@ fn table9(s: &mut Session) -> Result<TableReport, ReproduceError> {
     );
     let base = scenes::load("@cornell")?;
     let mut mi = Vec::new();
-    for &(fig, mesh, patches, lines, hp, hs, is) in &paper::TABLE9 {
+    for &(fig, mesh, patches, lines, hp, hs, is) in &published::TABLE9 {
         let strategy = match mesh {
             "uniform" => Strategy::Uniform,
             "power" => Strategy::Power,

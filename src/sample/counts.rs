@@ -59,7 +59,7 @@ impl PairCounts {
     }
 
     /// Counts for `patches` patches from the pair keys of several batches, in any order (integer sums do
-    /// not depend on it). Sparse counts radix-sort all the keys at once ([`sort_keys`]).
+    /// not depend on it). Sparse counts radix-sort all the keys at once.
     pub fn from_batches(patches: usize, batches: Vec<Vec<u64>>) -> Self {
         let mut counts = PairCounts::new(patches);
         match &mut counts {

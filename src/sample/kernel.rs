@@ -14,7 +14,7 @@ pub fn kernel_without_pi(cos_product: f64, distance: f64) -> Option<f64> {
 }
 
 /// The sum over pairs of log2(cos_x cos_y / d^2), the variable part of eq. (27), with one `log2` per
-/// [`Log2Sum::RUN`] pairs instead of one per pair: log2 of a product is the sum of the logs, and the
+/// run of 32 pairs instead of one per pair: log2 of a product is the sum of the logs, and the
 /// product is kept as an f64 mantissa in [1, 2^RUN) and a separate integer exponent, so it can neither
 /// overflow nor underflow. The rounding of RUN products costs ~RUN * 1e-16 relative, far below the
 /// statistical error.

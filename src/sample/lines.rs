@@ -76,7 +76,7 @@ impl LineSource {
     }
 
     /// Appends the `count` lines of batch `batch` to `out`; `count` must be a whole number of units
-    /// (bundles), as [`crate::sample::tally::BatchPlan::for_source`] makes it.
+    /// (bundles), as [`crate::run::BatchPlan::for_source`] makes it.
     pub fn batch_lines(
         &self,
         seed: u64,

@@ -65,10 +65,10 @@ pub fn segments(scene: &Scene, line: &Line, hits: &[Hit], visit: impl FnMut(Segm
 }
 
 /// [`segments`], also returning how many crossings met two coplanar overlapping surfaces facing the same
-/// way (of which only the first in the scene is seen; see [`super::order`]).
+/// way (of which only the first in the scene is seen).
 ///
 /// Hits too close for their f32 order to be trusted (surfaces almost or exactly touching) are first put
-/// in their true order ([`super::order`]); other lines pair their hits as they come.
+/// in their true order (by their f64 plane distances); other lines pair their hits as they come.
 pub fn segments_counting_overlaps(
     scene: &Scene,
     line: &Line,

@@ -69,7 +69,7 @@ const FLOOR_POINTS: [[f64; 2]; 12] = [
     [472.0, 406.0],
 ];
 
-/// The floor minus the blocks' footprints as convex pieces (indices into [`FLOOR_POINTS`]), counter-
+/// The floor minus the blocks' footprints as convex pieces (indices into the floor's points), counter-
 /// clockwise seen from above: a triangulation of the holed floor with pairs of triangles merged into
 /// convex quads where they form one.
 pub const FLOOR_PIECES: [&[usize]; 9] = [

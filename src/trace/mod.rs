@@ -13,6 +13,7 @@
 //!   closed mesh always has an even number of hits.
 
 #[cfg(feature = "embree")]
+#[allow(unsafe_code)]
 pub mod embree;
 mod rules;
 pub mod rust;

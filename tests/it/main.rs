@@ -10,7 +10,7 @@ mod crosscheck;
 mod embree_backend;
 mod errors;
 mod lines_and_tracers;
-mod paper;
+mod findings;
 mod radiosity;
 mod rust_bvh;
 mod stability;
