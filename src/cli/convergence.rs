@@ -1,14 +1,55 @@
 //! `scx convergence`: the same scene at growing line counts, every measure with its error against run
-//! time, as a table, a CSV file and a log-log plot.
+//! time, as a table or JSON, a CSV file and a log-log plot.
 
 use std::fmt::Write as _;
+use std::path::PathBuf;
 
+use clap::ValueEnum;
 use scene_complexity::measure::Estimate;
-use scene_complexity::run::Analysis;
+use scene_complexity::run::{Analysis, StopReason};
+use serde_json::json;
 
-use super::plot::{self, Curve};
+use super::args::{parse_count, ReportOutput, RunOptions};
+use super::output::{self, check_all, note};
+use super::plot::{self, Curve, Series};
 use super::report::{self, Row};
-use super::{write_stdout, ConvergenceArgs, Failure, Runner};
+use super::runner::Runner;
+use super::table::{fixed, Align, Table};
+use super::{Exit, Failure};
+
+/// Arguments of `scx convergence`.
+#[derive(clap::Args, Debug)]
+pub struct ConvergenceArgs {
+    /// A scene file, a built-in scene such as `@cube:30`, or `-` for an OBJ on standard input.
+    scene: String,
+    /// The line counts to run, comma separated (accepts `1e6`).
+    #[arg(long, value_delimiter = ',', value_parser = parse_count, default_value = "1e4,1e5,1e6,1e7",
+          allow_negative_numbers = true)]
+    lines: Vec<u64>,
+    /// Runs per line count (seeds seed, seed+1, ...).
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=1000))]
+    repeats: u32,
+    #[command(flatten)]
+    run: RunOptions,
+    /// Output format of the report: `table` or `json` (every run's measures with units and verdicts).
+    #[arg(long, value_enum, default_value_t = ConvergenceFormat::Table)]
+    format: ConvergenceFormat,
+    #[command(flatten)]
+    out: ReportOutput,
+    /// Also write every run's measures as CSV (the rows of `analyze --format csv`, with the run's
+    /// repeat and seconds).
+    #[arg(long)]
+    csv: Option<PathBuf>,
+    /// Also draw error against run time, log-log (.svg or .png).
+    #[arg(long)]
+    plot: Option<PathBuf>,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+enum ConvergenceFormat {
+    Table,
+    Json,
+}
 
 /// The measures followed, as (JSON key, short name, corrected?). The plot leaves H_s out: I_s = H_p - H_s
 /// with H_p exact, so their errors are the same.
@@ -64,112 +105,179 @@ fn mean(xs: impl Iterator<Item = f64>) -> f64 {
     }
 }
 
-/// Runs the command.
-pub fn run(args: &ConvergenceArgs) -> Result<(), Failure> {
+/// Runs `scx convergence`.
+pub fn run(args: &ConvergenceArgs) -> Result<Exit, Failure> {
+    check_all(
+        [
+            args.out.output.as_deref(),
+            args.csv.as_deref(),
+            args.plot.as_deref(),
+        ]
+        .into_iter()
+        .flatten(),
+    )?;
+    if let Some(p) = &args.plot {
+        plot::check_target(p).map_err(Failure::bad_input)?;
+    }
     let runner = Runner::new(&args.scene, &args.run)?;
     let mut counts = args.lines.clone();
     counts.sort_unstable();
     counts.dedup();
     let mut levels = Vec::new();
-    let mut csv =
-        String::from("lines,repeat,seed,seconds,measure,value,stderr,corrected,corrected_stderr\n");
-    for &lines in &counts {
+    let mut interrupted = false;
+    let total_runs = counts.len() as u32 * args.repeats;
+    'counts: for (k, &lines) in counts.iter().enumerate() {
         let mut runs = Vec::new();
         for r in 0..args.repeats {
             let seed = args.run.seed + u64::from(r);
-            let mut a = runner.analyze(&runner.config(&args.run, lines, seed), Some(lines))?;
-            append_csv(&mut csv, &a, r);
+            let label = format!(
+                "run {} of {total_runs}: {lines:.0e} lines, seed {seed}",
+                k as u32 * args.repeats + r + 1
+            );
+            let mut a =
+                runner.analyze(&runner.config(&args.run, lines, seed), Some(lines), &label)?;
             // The counts are not needed any more; keep the measures only.
             a.tally.counts = None;
-            let interrupted = a.stop_reason != scene_complexity::run::StopReason::Lines;
+            let stopped = a.stop_reason != StopReason::Lines;
             runs.push(a);
-            if interrupted {
-                break;
+            if stopped {
+                interrupted = true;
+                levels.push(Level { lines, runs });
+                break 'counts;
             }
         }
-        let interrupted = runs.last().is_some_and(|a| a.lines < lines);
         levels.push(Level { lines, runs });
-        if interrupted {
-            eprintln!("scx: interrupted: reporting the line counts gathered so far");
-            break;
-        }
     }
+    if interrupted {
+        note("interrupted: reporting the runs finished so far");
+    }
+    let info = runner.info();
     if let Some(path) = &args.csv {
-        std::fs::write(path, &csv).map_err(|e| Failure {
-            code: 1,
-            message: format!("{}: cannot write: {e}", path.display()),
-        })?;
+        output::write_file(path, csv(&info, &levels).as_bytes())?;
     }
     if let Some(path) = &args.plot {
         let title = format!(
-            "{}: error against run time ({} tracer)",
+            "{}: error against run time ({} tracer, {} thread(s))",
             runner.scene.name,
-            runner.tracer.name()
+            runner.tracer.name(),
+            runner.threads
         );
-        plot::write(path, &title, &curves(&levels))
-            .map_err(|message| Failure { code: 1, message })?;
+        plot::write(path, &title, &curves(&levels)).map_err(|message| Failure {
+            code: Exit::Io,
+            message,
+        })?;
+        output::wrote(path);
     }
-    write_stdout(&table(&runner, &levels, args.repeats))
+    let text = match args.format {
+        ConvergenceFormat::Table => table(&info, &levels, args.repeats),
+        ConvergenceFormat::Json => json_report(&info, &levels, args.repeats),
+    };
+    output::emit(args.out.output.as_deref(), &text)?;
+    Ok(if interrupted {
+        Exit::Interrupted
+    } else {
+        Exit::Ok
+    })
 }
 
-fn append_csv(csv: &mut String, a: &Analysis, repeat: u32) {
-    for r in report::measures(a) {
-        let Some(e) = r.estimate else { continue };
-        let num = |x: Option<f64>| x.map(|v| v.to_string()).unwrap_or_default();
-        let _ = writeln!(
-            csv,
-            "{},{repeat},{},{},{},{},{},{},{}",
-            a.lines,
-            a.seed,
-            a.seconds,
-            r.key,
-            e.value,
-            num(e.stderr),
-            num(r.corrected.map(|c| c.value)),
-            num(r.corrected.and_then(|c| c.stderr)),
-        );
+/// Every run's `analyze --format csv` rows, with the repeat and the seconds in front.
+fn csv(info: &report::RunInfo, levels: &[Level]) -> String {
+    let mut out = String::new();
+    for (k, l) in levels.iter().enumerate() {
+        for (r, a) in l.runs.iter().enumerate() {
+            let rows = report::csv(info, a);
+            for (n, line) in rows.lines().enumerate() {
+                if n == 0 {
+                    if k == 0 && r == 0 {
+                        let _ = writeln!(out, "repeat,seconds,{line}");
+                    }
+                    continue;
+                }
+                let _ = writeln!(out, "{r},{},{line}", a.seconds);
+            }
+        }
     }
+    out
 }
 
-/// For each followed measure: its standard error (solid) and its distance to the largest run (dashed).
+/// Every run as JSON: the settings, then each run's lines, seed, seconds and followed measures.
+fn json_report(info: &report::RunInfo, levels: &[Level], repeats: u32) -> String {
+    let runs: Vec<serde_json::Value> = levels
+        .iter()
+        .flat_map(|l| l.runs.iter())
+        .map(|a| {
+            let mut measures = serde_json::Map::new();
+            for (key, name, corrected) in FOLLOWED {
+                if let Some(e) = pick(a, key, corrected) {
+                    measures.insert(
+                        name.replace(' ', "_"),
+                        json!({"value": e.value, "stderr": e.stderr, "unit": "bit"}),
+                    );
+                }
+            }
+            json!({
+                "lines": a.lines,
+                "seed": a.seed,
+                "seconds": a.seconds,
+                "stop_reason": a.stop_reason.name(),
+                "measures": measures,
+            })
+        })
+        .collect();
+    let doc = json!({
+        "scx_version": env!("CARGO_PKG_VERSION"),
+        "command_line": std::env::args().collect::<Vec<_>>(),
+        "unit": "bit",
+        "scene": info.scene.name,
+        "patches": info.scene.patch_count(),
+        "tracer": info.tracer,
+        "threads": info.threads,
+        "repeats": repeats,
+        "runs": runs,
+    });
+    let mut s = serde_json::to_string_pretty(&doc).expect("a JSON value always serialises");
+    s.push('\n');
+    s
+}
+
+/// For each followed measure: its standard error (solid) and its distance to the largest run (dashed),
+/// each point labelled with its line count.
 fn curves(levels: &[Level]) -> Vec<Curve> {
     let mut out = Vec::new();
     let Some(last) = levels.last() else {
         return out;
     };
-    for (colour, &(key, name, corrected)) in FOLLOWED
-        .iter()
-        .enumerate()
-        .filter(|(_, f)| f.0 != "entropy")
+    for (series, &(key, name, corrected)) in
+        FOLLOWED.iter().filter(|f| f.0 != "entropy").enumerate()
     {
         let Some((reference, _)) = last.measure(key, corrected) else {
             continue;
         };
-        let stderr: Vec<(f64, f64)> = levels
+        let label_of = |l: &Level| format!("{:.0e}", l.lines as f64);
+        let stderr: Vec<(f64, f64, String)> = levels
             .iter()
-            .filter_map(|l| Some((l.seconds(), l.measure(key, corrected)?.1)))
-            .filter(|&(s, e)| s > 0.0 && e > 0.0)
+            .filter_map(|l| Some((l.seconds(), l.measure(key, corrected)?.1, label_of(l))))
+            .filter(|&(s, e, _)| s > 0.0 && e > 0.0)
             .collect();
-        let distance: Vec<(f64, f64)> = levels[..levels.len() - 1]
+        let distance: Vec<(f64, f64, String)> = levels[..levels.len() - 1]
             .iter()
             .filter_map(|l| {
-                Some((
-                    l.seconds(),
-                    (l.measure(key, corrected)?.0 - reference).abs(),
-                ))
+                let d = (l.measure(key, corrected)?.0 - reference).abs();
+                Some((l.seconds(), d, label_of(l)))
             })
-            .filter(|&(s, e)| s > 0.0 && e > 0.0)
+            .filter(|&(s, e, _)| s > 0.0 && e > 0.0)
             .collect();
+        let name = plot_name(name);
         out.push(Curve {
             label: format!("{name}: standard error"),
-            colour,
+            series: Series(series),
             dashed: false,
             points: stderr,
         });
         if !distance.is_empty() {
             out.push(Curve {
-                label: format!("{name}: |value - largest run|"),
-                colour,
+                label: format!("{name}: distance to the largest run"),
+                series: Series(series),
                 dashed: true,
                 points: distance,
             });
@@ -178,32 +286,40 @@ fn curves(levels: &[Level]) -> Vec<Curve> {
     out
 }
 
-fn table(runner: &Runner, levels: &[Level], repeats: u32) -> String {
+/// A measure's name in words for the plot's legend.
+fn plot_name(short: &str) -> &'static str {
+    match short {
+        "I_s" => "mutual information I(s), plug-in",
+        "I_s corrected" => "mutual information I(s), corrected",
+        "I_s^c" => "continuous mutual information",
+        _ => "entropy",
+    }
+}
+
+fn table(info: &report::RunInfo, levels: &[Level], repeats: u32) -> String {
     let mut s = String::new();
-    let info = runner.info();
     let _ = writeln!(
         s,
-        "scene {} ({} patches), tracer {}, {} thread(s), {repeats} run(s) per line count (means shown)\n",
+        "scene {} ({} patches), tracer {}, {} thread(s), {repeats} run(s) per line count (means shown); \
+         measures in bits\n",
         info.scene.name,
         info.scene.patch_count(),
         info.tracer,
         info.threads
     );
-    let _ = write!(s, "{:>12} {:>9}", "lines", "seconds");
-    for (_, name, _) in FOLLOWED {
-        let _ = write!(s, " {:>22}", name);
-    }
-    let _ = writeln!(s);
+    let mut header = vec!["lines", "seconds"];
+    header.extend(FOLLOWED.iter().map(|f| f.1));
+    let mut t = Table::new(&header, &vec![Align::Right; header.len()]);
     for l in levels {
-        let _ = write!(s, "{:>12} {:>9.3}", l.lines, l.seconds());
+        let mut row = vec![l.lines.to_string(), format!("{:.3}", l.seconds())];
         for (key, _, corrected) in FOLLOWED {
-            let cell = match l.measure(key, corrected) {
-                Some((v, e)) => format!("{v:.5} +- {e:.5}"),
+            row.push(match l.measure(key, corrected) {
+                Some((v, e)) => format!("{} +- {}", fixed(v), fixed(e)),
                 None => "-".into(),
-            };
-            let _ = write!(s, " {cell:>22}");
+            });
         }
-        let _ = writeln!(s);
+        t.row(row);
     }
+    s += &t.render();
     s
 }

@@ -1,45 +1,83 @@
-//! The convergence plot: error against run time, log-log, one line per measure (plotters).
+//! The convergence plot: error against run time, log-log, one series per measure (plotters).
+//!
+//! Readable by everyone: the Okabe–Ito colours (safe for the common colour-vision deficiencies), and a
+//! marker shape per measure besides its colour; standard errors solid, distances to the largest run
+//! dashed; every point labelled with its line count; ticks in one notation; axes with their units.
 
 use std::path::Path;
 
 use plotters::prelude::*;
 use plotters::style::FontStyle;
 
+/// Which measure a curve belongs to: its colour and marker.
+#[derive(Clone, Copy, Debug)]
+pub struct Series(pub usize);
+
 /// One curve: a measure's error (standard error, or distance to the largest run) against seconds.
 pub struct Curve {
     /// Legend text.
     pub label: String,
-    /// Colour index (the same for a measure's two curves).
-    pub colour: usize,
+    /// The measure (the same for a measure's two curves).
+    pub series: Series,
     /// Dashed (distance to the largest run) or solid (standard error).
     pub dashed: bool,
-    /// (seconds, error) points, both positive.
-    pub points: Vec<(f64, f64)>,
+    /// (seconds, error, label) points, both numbers positive.
+    pub points: Vec<(f64, f64, String)>,
 }
+
+/// Okabe and Ito's colour-blind-safe palette (blue, vermillion, bluish green, orange, reddish purple).
+const OKABE_ITO: [RGBColor; 5] = [
+    RGBColor(0, 114, 178),
+    RGBColor(213, 94, 0),
+    RGBColor(0, 158, 115),
+    RGBColor(230, 159, 0),
+    RGBColor(204, 121, 167),
+];
 
 /// Fonts tried for the labels, unless `SCX_FONT` names one.
 const FONT_PATHS: &[&str] = &[
     "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf",
     "/usr/share/fonts/TTF/DejaVuSans.ttf",
+    "/usr/share/fonts/dejavu/DejaVuSans.ttf",
     "/usr/share/fonts/truetype/liberation/LiberationSans-Regular.ttf",
     "/usr/share/fonts/truetype/freefont/FreeSans.ttf",
 ];
 
-/// Loads a TrueType font for the labels (plotters draws text with it, SVG and PNG alike).
-fn register_font() -> Result<(), String> {
-    let candidates: Vec<String> = std::env::var("SCX_FONT")
+/// Checks, before any work, that a plot can be drawn to `path`: its extension and a font.
+pub fn check_target(path: &Path) -> Result<(), String> {
+    let ext = extension(path);
+    if ext != "svg" && ext != "png" {
+        return Err(format!(
+            "{}: the plot must be a .svg or .png file",
+            path.display()
+        ));
+    }
+    font_path().map(drop)
+}
+
+fn extension(path: &Path) -> String {
+    path.extension()
+        .and_then(|e| e.to_str())
+        .unwrap_or("")
+        .to_ascii_lowercase()
+}
+
+fn font_path() -> Result<String, String> {
+    std::env::var("SCX_FONT")
         .into_iter()
         .chain(FONT_PATHS.iter().map(|s| s.to_string()))
-        .collect();
-    let path = candidates
-        .iter()
         .find(|p| Path::new(p).exists())
         .ok_or_else(|| {
             "a plot needs a TrueType font for its labels: install fonts-dejavu-core, or name a .ttf file in \
              SCX_FONT"
                 .to_string()
-        })?;
-    let bytes = std::fs::read(path).map_err(|e| format!("{path}: {e}"))?;
+        })
+}
+
+/// Loads a TrueType font for the labels (plotters draws text with it, SVG and PNG alike).
+fn register_font() -> Result<(), String> {
+    let path = font_path()?;
+    let bytes = std::fs::read(&path).map_err(|e| format!("{path}: {e}"))?;
     // plotters keeps fonts for the life of the process.
     let bytes: &'static [u8] = Box::leak(bytes.into_boxed_slice());
     plotters::style::register_font("sans-serif", FontStyle::Normal, bytes)
@@ -48,45 +86,38 @@ fn register_font() -> Result<(), String> {
 
 /// Writes the plot to `path`, SVG or PNG by its extension.
 pub fn write(path: &Path, title: &str, curves: &[Curve]) -> Result<(), String> {
+    check_target(path)?;
     register_font()?;
-    let ext = path
-        .extension()
-        .and_then(|e| e.to_str())
-        .unwrap_or("")
-        .to_ascii_lowercase();
     let shown = path.display().to_string();
-    let fail = |e: &dyn std::fmt::Display| format!("{shown}: {e}");
-    match ext.as_str() {
-        "svg" => draw(
-            SVGBackend::new(path, (960, 640)).into_drawing_area(),
+    let fail = |e: &dyn std::fmt::Display| format!("cannot draw {shown}: {e}");
+    if extension(path) == "svg" {
+        draw(
+            SVGBackend::new(path, (1000, 680)).into_drawing_area(),
             title,
             curves,
         )
-        .map_err(|e| fail(&e)),
-        "png" => draw(
-            BitMapBackend::new(path, (960, 640)).into_drawing_area(),
+        .map_err(|e| fail(&e))
+    } else {
+        draw(
+            BitMapBackend::new(path, (1000, 680)).into_drawing_area(),
             title,
             curves,
         )
-        .map_err(|e| fail(&e)),
-        _ => Err(format!("{shown}: the plot must be a .svg or .png file")),
+        .map_err(|e| fail(&e))
     }
 }
 
-/// A compact tick label: 0.2, 15, 3e-4.
+/// A tick label in one notation for the whole axis: powers of ten as `1e-3`, other values with the
+/// mantissa (`2e-3`, `5e1`).
 fn tick(v: f64) -> String {
-    if (1e-2..1e4).contains(&v.abs()) {
-        let s = format!("{v:.3}");
-        s.trim_end_matches('0').trim_end_matches('.').to_string()
-    } else {
-        format!("{v:.0e}")
-    }
+    let s = format!("{v:.0e}");
+    s.replace("e0", "")
 }
 
 fn bounds(curves: &[Curve]) -> ((f64, f64), (f64, f64)) {
     let pts = curves.iter().flat_map(|c| c.points.iter());
     let (mut x0, mut x1, mut y0, mut y1) = (f64::INFINITY, 0.0f64, f64::INFINITY, 0.0f64);
-    for &(x, y) in pts {
+    for &(x, y, _) in pts {
         x0 = x0.min(x);
         x1 = x1.max(x);
         y0 = y0.min(y);
@@ -95,7 +126,24 @@ fn bounds(curves: &[Curve]) -> ((f64, f64), (f64, f64)) {
     if !(x0.is_finite() && y0.is_finite()) {
         return ((0.01, 1.0), (1e-4, 1.0));
     }
-    ((x0 / 1.5, x1 * 1.5), (y0 / 2.0, y1 * 2.0))
+    ((x0 / 1.6, x1 * 2.5), (y0 / 2.5, y1 * 2.5))
+}
+
+/// The marker of a series: circle, triangle, square, diamond, cross.
+fn marker<DB: DrawingBackend>(
+    series: Series,
+    at: (i32, i32),
+    colour: RGBColor,
+) -> DynElement<'static, DB, (i32, i32)> {
+    let style = colour.filled();
+    let (x, y) = at;
+    match series.0 % 5 {
+        0 => Circle::new(at, 5, style).into_dyn(),
+        1 => TriangleMarker::new(at, 6, style).into_dyn(),
+        2 => Rectangle::new([(x - 4, y - 4), (x + 4, y + 4)], style).into_dyn(),
+        3 => Polygon::new(vec![(x, y - 6), (x + 6, y), (x, y + 6), (x - 6, y)], style).into_dyn(),
+        _ => Cross::new(at, 5, colour.stroke_width(2)).into_dyn(),
+    }
 }
 
 fn draw<DB: DrawingBackend>(
@@ -108,53 +156,73 @@ fn draw<DB: DrawingBackend>(
     let mut chart = ChartBuilder::on(&area)
         .caption(title, ("sans-serif", 22))
         .margin(16)
-        .x_label_area_size(48)
-        .y_label_area_size(72)
+        .x_label_area_size(52)
+        .y_label_area_size(76)
         .build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())?;
     chart
         .configure_mesh()
-        .x_desc("run time (seconds, log scale)")
-        .y_desc("error in bits (log scale)")
+        .x_desc("run time (s, log scale)")
+        .y_desc("error (bits, log scale)")
         .x_label_formatter(&|x| tick(*x))
         .y_label_formatter(&|y| tick(*y))
         .label_style(("sans-serif", 14))
         .axis_desc_style(("sans-serif", 16))
         .draw()?;
     for c in curves {
-        let colour = Palette99::pick(c.colour).to_rgba();
+        let colour = OKABE_ITO[c.series.0 % OKABE_ITO.len()];
         let style = ShapeStyle::from(colour).stroke_width(2);
-        let series = if c.dashed {
-            chart.draw_series(DashedLineSeries::new(c.points.iter().copied(), 8, 5, style))?
+        let line = c.points.iter().map(|p| (p.0, p.1));
+        let drawn = if c.dashed {
+            chart.draw_series(DashedLineSeries::new(line, 9, 6, style))?
         } else {
-            chart.draw_series(LineSeries::new(c.points.iter().copied(), style))?
+            chart.draw_series(LineSeries::new(line, style))?
         };
-        // Markers tell the two kinds apart in the legend too: circles for the standard error, triangles
-        // for the distance to the largest run.
+        let series = c.series;
         let dashed = c.dashed;
-        series.label(c.label.clone()).legend(move |(x, y)| {
-            let marker: DynElement<'static, DB, (i32, i32)> = if dashed {
-                TriangleMarker::new((x + 10, y), 5, colour.filled()).into_dyn()
-            } else {
-                Circle::new((x + 10, y), 4, colour.filled()).into_dyn()
-            };
-            EmptyElement::at((0, 0)) + PathElement::new(vec![(x, y), (x + 20, y)], style) + marker
+        drawn.label(c.label.clone()).legend(move |(x, y)| {
+            // Three pieces: apart for a dashed curve, overlapping into one line for a solid one.
+            let (len, step) = if dashed { (6, 11) } else { (10, 9) };
+            let piece =
+                |k: i32| PathElement::new(vec![(x + k * step, y), (x + k * step + len, y)], style);
+            EmptyElement::at((0, 0))
+                + piece(0)
+                + piece(1)
+                + piece(2)
+                + marker::<DB>(series, (x + 14, y), colour)
         });
-        if dashed {
-            chart.draw_series(
-                c.points
-                    .iter()
-                    .map(|&p| TriangleMarker::new(p, 5, colour.filled())),
-            )?;
-        } else {
-            chart.draw_series(c.points.iter().map(|&p| Circle::new(p, 4, colour.filled())))?;
+        chart.draw_series(
+            c.points
+                .iter()
+                .map(|p| EmptyElement::at((p.0, p.1)) + marker::<DB>(c.series, (0, 0), colour)),
+        )?;
+        // Line counts beside the standard-error points (the distances share their x).
+        if !c.dashed {
+            chart.draw_series(c.points.iter().map(|p| {
+                EmptyElement::at((p.0, p.1))
+                    + Text::new(p.2.clone(), (7, -16), ("sans-serif", 12).into_font())
+            }))?;
         }
     }
     chart
         .configure_series_labels()
-        .background_style(WHITE.mix(0.85))
+        .background_style(WHITE.mix(0.9))
         .border_style(BLACK)
         .label_font(("sans-serif", 13))
-        .position(SeriesLabelPosition::UpperRight)
+        .position(SeriesLabelPosition::LowerLeft)
         .draw()?;
     area.present()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn ticks_use_one_notation() {
+        assert_eq!(tick(0.001), "1e-3");
+        assert_eq!(tick(0.01), "1e-2");
+        assert_eq!(tick(1.0), "1");
+        assert_eq!(tick(100.0), "1e2");
+        assert_eq!(tick(0.002), "2e-3");
+    }
 }

@@ -1,17 +1,23 @@
-//! Reports of an analysis: a table for people, JSON and CSV for programs.
+//! Reports of an analysis: a table for people, JSON and CSV for programs. Every reading carries its
+//! unit, its standard error and its reliability verdict; a reading that breaks a bound of the theory is
+//! marked, never printed bare.
 
 use std::fmt::Write;
 
 use scene_complexity::measure::Estimate;
 use scene_complexity::run::{
-    Analysis, ErrorMethod, RadiosityEstimates, RadiosityOutcome, StopReason,
+    Analysis, ErrorMethod, RadiosityEstimates, RadiosityOutcome, Reliability, StopReason,
+    TargetOutcome, Verdict,
 };
 use scene_complexity::scene::Scene;
 use scene_complexity::trace::Query;
 use serde_json::{json, Value};
 
-/// JSON schema version of `analyze --format json`.
-pub const SCHEMA_VERSION: u32 = 1;
+use super::table::{fixed, Align, Table};
+
+/// JSON schema version of `analyze --format json` (2: units, reliability, sampling, target, command
+/// line, CPU).
+pub const SCHEMA_VERSION: u32 = 2;
 
 /// Facts about the run that the analysis itself does not hold.
 pub struct RunInfo<'a> {
@@ -23,102 +29,263 @@ pub struct RunInfo<'a> {
     pub bundle: u32,
 }
 
-/// One row of the report: JSON key, table label, paper reference, plug-in and bias-corrected estimates.
-pub(super) struct Row {
+/// A reading's unit.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Unit {
+    /// Entropies and mutual information.
+    Bit,
+    /// Accuracies and relative errors.
+    Ratio,
+    /// E(MSE) of a single line.
+    PerLine,
+}
+
+impl Unit {
+    pub fn name(self) -> &'static str {
+        match self {
+            Unit::Bit => "bit",
+            Unit::Ratio => "ratio",
+            Unit::PerLine => "per line",
+        }
+    }
+}
+
+/// One row of the report: JSON key, table label, unit, paper reference, plug-in and bias-corrected
+/// estimates, and their verdicts.
+pub struct Row<'a> {
     pub key: &'static str,
     pub label: &'static str,
+    pub unit: Unit,
     pub reference: &'static str,
     pub estimate: Option<Estimate>,
     pub corrected: Option<Estimate>,
+    pub reliability: Option<&'a Reliability>,
+    pub corrected_reliability: Option<&'a Reliability>,
 }
 
 /// The visibility measures in report order.
-pub(super) fn measures(a: &Analysis) -> Vec<Row> {
+pub fn measures(a: &Analysis) -> Vec<Row<'_>> {
     let v = &a.visibility;
-    let row = |key, label, reference, estimate, corrected| Row {
+    let r = &a.reliability;
+    let row = |key, label, unit, reference, estimate, corrected, rel, crel| Row {
         key,
         label,
+        unit,
         reference,
         estimate,
         corrected,
+        reliability: rel,
+        corrected_reliability: crel,
     };
     vec![
         row(
             "positional_entropy",
             "positional entropy H_p",
+            Unit::Bit,
             "eq. 19",
             v.positional_entropy,
+            None,
+            None,
             None,
         ),
         row(
             "entropy",
             "visibility entropy H_s",
+            Unit::Bit,
             "eq. 17",
             v.entropy,
             v.entropy_corrected,
+            r.entropy.as_ref(),
+            r.entropy_corrected.as_ref(),
         ),
         row(
             "joint_entropy",
             "joint entropy H(X,Y)",
+            Unit::Bit,
             "eq. 7",
             v.joint_entropy,
+            None,
+            r.joint_entropy.as_ref(),
             None,
         ),
         row(
             "mutual_information",
             "mutual information I_s",
+            Unit::Bit,
             "eq. 21",
             v.mutual_information,
             v.mutual_information_corrected,
+            r.mutual_information.as_ref(),
+            r.mutual_information_corrected.as_ref(),
         ),
         row(
             "continuous_mutual_information",
             "continuous mutual information I_s^c",
+            Unit::Bit,
             "eq. 27",
             v.continuous_mutual_information,
+            None,
+            r.continuous_mutual_information.as_ref(),
             None,
         ),
         row(
             "accuracy",
             "discretisation accuracy I_s/I_s^c",
+            Unit::Ratio,
             "sec. 3.3",
             v.accuracy,
             v.accuracy_corrected,
+            r.accuracy.as_ref(),
+            r.accuracy_corrected.as_ref(),
         ),
         row(
             "relative_error",
             "discretisation relative error",
+            Unit::Ratio,
             "sec. 3.3",
             v.relative_error,
+            None,
+            r.relative_error.as_ref(),
             None,
         ),
         row(
             "mse_per_line",
-            "form-factor E(MSE) per line",
+            "form-factor E(MSE)",
+            Unit::PerLine,
             "eq. 22",
             v.mse_per_line,
+            None,
+            r.mse_per_line.as_ref(),
             None,
         ),
     ]
 }
 
-fn estimate_json(e: Option<Estimate>) -> Value {
-    match e {
-        Some(e) => json!({"value": finite(e.value), "stderr": e.stderr.and_then(finite)}),
+/// The radiosity measures in report order.
+fn radiosity_measures(r: &RadiosityEstimates) -> [Row<'_>; 3] {
+    let rel = &r.reliability;
+    [
+        Row {
+            key: "positional_entropy",
+            label: "radiosity positional entropy H_p",
+            unit: Unit::Bit,
+            reference: "eq. 33",
+            estimate: Some(r.positional_entropy),
+            corrected: None,
+            reliability: None,
+            corrected_reliability: None,
+        },
+        Row {
+            key: "entropy",
+            label: "radiosity entropy H_s",
+            unit: Unit::Bit,
+            reference: "eq. 34",
+            estimate: Some(r.entropy),
+            corrected: Some(r.entropy_corrected),
+            reliability: Some(&rel.entropy),
+            corrected_reliability: Some(&rel.entropy_corrected),
+        },
+        Row {
+            key: "mutual_information",
+            label: "radiosity mutual information I_s",
+            unit: Unit::Bit,
+            reference: "eq. 35",
+            estimate: Some(r.mutual_information),
+            corrected: Some(r.mutual_information_corrected),
+            reliability: Some(&rel.mutual_information),
+            corrected_reliability: Some(&rel.mutual_information_corrected),
+        },
+    ]
+}
+
+/// `-0.0` as `0.0`, so that no report shows a negative zero.
+fn positive_zero(x: f64) -> f64 {
+    x + 0.0
+}
+
+/// A finite number for JSON (`null` otherwise).
+fn finite(x: f64) -> Option<f64> {
+    x.is_finite().then_some(positive_zero(x))
+}
+
+fn reliability_json(r: Option<&Reliability>) -> Value {
+    match r {
         None => Value::Null,
+        Some(r) => json!({
+            "verdict": r.verdict.name(),
+            "estimated_bias": r.estimated_bias.and_then(finite),
+            "lines_needed": r.lines_needed,
+            "flags": r.flags,
+        }),
     }
 }
 
+fn estimate_json(e: Estimate, unit: Unit, r: Option<&Reliability>) -> Value {
+    json!({
+        "value": finite(e.value),
+        "stderr": e.stderr.and_then(finite),
+        "unit": unit.name(),
+        "reliability": reliability_json(r),
+    })
+}
+
 fn row_json(r: &Row) -> Value {
-    let mut v = estimate_json(r.estimate);
+    let Some(e) = r.estimate else {
+        return Value::Null;
+    };
+    let mut v = estimate_json(e, r.unit, r.reliability);
     if let (Value::Object(map), Some(c)) = (&mut v, r.corrected) {
-        map.insert("corrected".into(), estimate_json(Some(c)));
+        map.insert(
+            "corrected".into(),
+            estimate_json(c, r.unit, r.corrected_reliability),
+        );
     }
     v
 }
 
-fn finite(x: f64) -> Option<f64> {
-    x.is_finite().then_some(x)
+/// The CPU's model name (Linux), else its architecture.
+fn cpu() -> String {
+    std::fs::read_to_string("/proc/cpuinfo")
+        .ok()
+        .and_then(|text| {
+            text.lines()
+                .find(|l| l.starts_with("model name"))
+                .and_then(|l| l.split_once(':'))
+                .map(|(_, name)| name.trim().to_string())
+        })
+        .unwrap_or_else(|| std::env::consts::ARCH.to_string())
+}
+
+/// The command line as given.
+fn command_line() -> Vec<String> {
+    std::env::args().collect()
+}
+
+fn sampling_json(a: &Analysis) -> Value {
+    match &a.sampling {
+        None => Value::Null,
+        Some(s) => json!({
+            "rows": s.sampling.rows,
+            "sampled_rows": s.sampling.sampled_rows,
+            "segments_per_row": finite(s.sampling.segments_per_row),
+            "coverage": finite(s.sampling.coverage),
+            "singleton_share": finite(s.sampling.singleton_share),
+            "lines_for_coverage_0_99": s.lines_for_coverage,
+        }),
+    }
+}
+
+fn target_json(t: &Option<TargetOutcome>) -> Value {
+    match t {
+        None => Value::Null,
+        Some(t) => json!({
+            "measure": t.measure.name(),
+            "stderr_goal": t.stderr_goal,
+            "stderr": t.stderr.and_then(finite),
+            "verdict": t.verdict.map(Verdict::name),
+            "met": t.met(),
+        }),
+    }
 }
 
 /// The JSON document of `analyze --format json`.
@@ -130,6 +297,9 @@ pub fn json(run: &RunInfo, a: &Analysis) -> String {
     let doc = json!({
         "schema_version": SCHEMA_VERSION,
         "scx_version": env!("CARGO_PKG_VERSION"),
+        "command_line": command_line(),
+        "cpu": cpu(),
+        "unit": "bit",
         "scene": run.scene.name,
         "patches": run.scene.patch_count(),
         "triangles": run.scene.triangles.len(),
@@ -144,6 +314,7 @@ pub fn json(run: &RunInfo, a: &Analysis) -> String {
         "seconds": a.seconds,
         "stop_reason": a.stop_reason.name(),
         "interrupted": a.stop_reason == StopReason::Interrupted,
+        "target": target_json(&a.target),
         "estimator": a.estimator.name(),
         "errors": a.errors.name(),
         "hits": a.hits,
@@ -153,10 +324,13 @@ pub fn json(run: &RunInfo, a: &Analysis) -> String {
         "escape_fraction": a.escape_fraction(),
         "degenerate_pairs": a.degenerate_pairs,
         "coincident_crossings": a.tally.counters.coincident_crossings,
-        "environment_area": estimate_json(a.environment_area),
+        "environment_area": a.environment_area.map(|e| json!({
+            "value": finite(e.value), "stderr": e.stderr.and_then(finite), "unit": "scene units^2"
+        })),
         "distinct_pairs": a.distinct_pairs,
         "unsampled_patches": a.unsampled.map(|u| u.0),
         "unsampled_area_fraction": a.unsampled.map(|u| u.1),
+        "sampling": sampling_json(a),
         "visibility": Value::Object(visibility),
         "radiosity": radiosity_json(&a.radiosity),
         "radiosity_skipped": skipped_reason(&a.radiosity).map_or(Value::Null, Value::from),
@@ -167,38 +341,13 @@ pub fn json(run: &RunInfo, a: &Analysis) -> String {
     s
 }
 
-/// The radiosity measures in report order.
-fn radiosity_measures(r: &RadiosityEstimates) -> [Row; 3] {
-    let row = |key, label, reference, estimate, corrected| Row {
-        key,
-        label,
-        reference,
-        estimate: Some(estimate),
-        corrected,
-    };
-    [
-        row(
-            "positional_entropy",
-            "radiosity positional entropy H_p",
-            "eq. 33",
-            r.positional_entropy,
-            None,
-        ),
-        row(
-            "entropy",
-            "radiosity entropy H_s",
-            "eq. 34",
-            r.entropy,
-            Some(r.entropy_corrected),
-        ),
-        row(
-            "mutual_information",
-            "radiosity mutual information I_s",
-            "eq. 35",
-            r.mutual_information,
-            Some(r.mutual_information_corrected),
-        ),
-    ]
+/// Why the radiosity measures were left out (`None` when computed).
+fn skipped_reason(outcome: &RadiosityOutcome) -> Option<&str> {
+    match outcome {
+        RadiosityOutcome::Computed(_) => None,
+        RadiosityOutcome::NotRequested => Some("not requested (--measures leaves radiosity out)"),
+        RadiosityOutcome::Skipped(reason) => Some(reason),
+    }
 }
 
 /// The `radiosity` object of the JSON report (`null` when skipped).
@@ -221,65 +370,102 @@ fn radiosity_json(outcome: &RadiosityOutcome) -> Value {
     Value::Object(m)
 }
 
-/// Why the radiosity measures were left out (`None` when computed).
-fn skipped_reason(outcome: &RadiosityOutcome) -> Option<&str> {
-    match outcome {
-        RadiosityOutcome::Computed(_) => None,
-        RadiosityOutcome::NotRequested => Some("not requested (--measures leaves radiosity out)"),
-        RadiosityOutcome::Skipped(reason) => Some(reason),
-    }
-}
-
-/// The radiosity lines of the table.
-fn radiosity_table(s: &mut String, outcome: &RadiosityOutcome) {
-    match outcome {
-        RadiosityOutcome::NotRequested | RadiosityOutcome::Skipped(_) => {
-            let reason = skipped_reason(outcome).unwrap_or_default();
-            let _ = writeln!(s, "\nradiosity measures left out: {reason}");
-        }
-        RadiosityOutcome::Computed(r) => {
-            let _ = writeln!(s);
-            for row in radiosity_measures(r) {
-                table_row(s, &row);
-            }
-            let _ = writeln!(
-                s,
-                "radiosity: B = E + R F B solved by Gauss-Seidel to relative residual {:.1e} (tolerance {:.0e}) \
-                 in {} sweeps; {} patch(es) ({:.4}% of the area) receive or send no light and leave the channel",
-                r.solver_residual,
-                r.solver_tolerance,
-                r.solver_sweeps,
-                r.excluded_patches,
-                100.0 * r.excluded_area_fraction
-            );
-        }
-    }
-}
-
-/// `measure,value,stderr` rows with a header.
-pub fn csv(a: &Analysis) -> String {
-    let mut s = String::from("measure,value,stderr,corrected,corrected_stderr\n");
-    let field = |e: Option<Estimate>| {
-        (
-            e.map(|e| e.value.to_string()).unwrap_or_default(),
-            e.and_then(|e| e.stderr)
-                .map(|x| x.to_string())
-                .unwrap_or_default(),
-        )
-    };
-    for r in measures(a) {
-        if r.estimate.is_some() {
-            let ((v, se), (c, cse)) = (field(r.estimate), field(r.corrected));
-            let _ = writeln!(s, "{},{v},{se},{c},{cse}", r.key);
-        }
-    }
+/// One CSV row per reading, with the run's scene, lines, seed and tracer, so that files combine.
+pub fn csv(run: &RunInfo, a: &Analysis) -> String {
+    let mut w = csv::Writer::from_writer(Vec::new());
+    let header = [
+        "scene",
+        "lines",
+        "seed",
+        "tracer",
+        "family",
+        "measure",
+        "unit",
+        "value",
+        "stderr",
+        "reliability",
+        "corrected",
+        "corrected_stderr",
+        "corrected_reliability",
+    ];
+    w.write_record(header).expect("writing to memory");
+    let num = |x: Option<f64>| x.map(|v| positive_zero(v).to_string()).unwrap_or_default();
+    let verdict = |r: Option<&Reliability>| r.map_or("", |r| r.verdict.name()).to_string();
+    let mut rows: Vec<(&str, Row)> = measures(a).into_iter().map(|r| ("visibility", r)).collect();
     if let RadiosityOutcome::Computed(r) = &a.radiosity {
-        for row in radiosity_measures(r) {
-            let ((v, se), (c, cse)) = (field(row.estimate), field(row.corrected));
-            let _ = writeln!(s, "radiosity_{},{v},{se},{c},{cse}", row.key);
+        rows.extend(radiosity_measures(r).into_iter().map(|r| ("radiosity", r)));
+    }
+    for (family, r) in rows {
+        let Some(e) = r.estimate else { continue };
+        w.write_record([
+            run.scene.name.clone(),
+            a.lines.to_string(),
+            a.seed.to_string(),
+            run.tracer.to_string(),
+            family.to_string(),
+            r.key.to_string(),
+            r.unit.name().to_string(),
+            num(Some(e.value)),
+            num(e.stderr),
+            verdict(r.reliability),
+            num(r.corrected.map(|c| c.value)),
+            num(r.corrected.and_then(|c| c.stderr)),
+            verdict(r.corrected_reliability),
+        ])
+        .expect("writing to memory");
+    }
+    String::from_utf8(w.into_inner().expect("writing to memory")).expect("CSV of UTF-8 text")
+}
+
+/// The text of a value with a mark when it breaks a bound of the theory (unmarked values keep the same
+/// width, so that the digits stay aligned).
+fn marked(e: Estimate, r: Option<&Reliability>) -> String {
+    let flagged = r.is_some_and(|r| !r.flags.is_empty());
+    format!("{}{}", fixed(e.value), if flagged { " !" } else { "  " })
+}
+
+fn stderr_text(e: Estimate) -> String {
+    e.stderr.map_or_else(|| "n/a".into(), fixed)
+}
+
+fn verdict_text(e: Estimate, r: Option<&Reliability>) -> String {
+    match r {
+        Some(r) => r.verdict.name().into(),
+        None if e.stderr == Some(0.0) => "exact".into(),
+        None => String::new(),
+    }
+}
+
+/// Adds the table rows of `rows`, collecting the flags of marked readings into `notes`.
+fn add_rows(t: &mut Table, rows: &[Row], notes: &mut Vec<String>) {
+    for r in rows {
+        let Some(e) = r.estimate else { continue };
+        let (c, cse, cverdict) = match r.corrected {
+            Some(c) => (
+                marked(c, r.corrected_reliability),
+                stderr_text(c),
+                verdict_text(c, r.corrected_reliability),
+            ),
+            None => Default::default(),
+        };
+        t.row(vec![
+            r.label.into(),
+            r.unit.name().into(),
+            marked(e, r.reliability),
+            stderr_text(e),
+            verdict_text(e, r.reliability),
+            c,
+            cse,
+            cverdict,
+            r.reference.into(),
+        ]);
+        for rel in [r.reliability, r.corrected_reliability]
+            .into_iter()
+            .flatten()
+        {
+            notes.extend(rel.flags.iter().map(|f| format!("! {f}")));
         }
     }
-    s
 }
 
 /// A readable table.
@@ -321,6 +507,17 @@ pub fn table(run: &RunInfo, a: &Analysis) -> String {
             .map(|d| format!("; {d} distinct patch pairs"))
             .unwrap_or_default()
     );
+    if let Some(smp) = &a.sampling {
+        let _ = writeln!(
+            s,
+            "sampling {:.0} segments per row over {} rows; coverage {:.4}; {:.1}% of the outcomes seen once{}",
+            smp.sampling.segments_per_row,
+            smp.sampling.rows,
+            smp.sampling.coverage,
+            100.0 * smp.sampling.singleton_share,
+            String::new()
+        );
+    }
     if let Some(env) = a.environment_area {
         let r = scene.normalization.scale;
         let _ = writeln!(
@@ -333,15 +530,41 @@ pub fn table(run: &RunInfo, a: &Analysis) -> String {
         );
     }
     let _ = writeln!(s);
-    let _ = writeln!(
-        s,
-        "{:<36} {:>12} {:>10}  {:>12} {:>10}",
-        "measure", "plug-in", "stderr", "corrected", "stderr"
+    let mut t = Table::new(
+        &[
+            "measure",
+            "unit",
+            "plug-in",
+            "stderr",
+            "reliability",
+            "corrected",
+            "stderr",
+            "reliability",
+            "",
+        ],
+        &[
+            Align::Left,
+            Align::Left,
+            Align::Right,
+            Align::Right,
+            Align::Left,
+            Align::Right,
+            Align::Right,
+            Align::Left,
+            Align::Left,
+        ],
     );
-    for r in measures(a) {
-        table_row(&mut s, &r);
+    let mut notes = Vec::new();
+    add_rows(&mut t, &measures(a), &mut notes);
+    if let RadiosityOutcome::Computed(r) = &a.radiosity {
+        t.separator();
+        add_rows(&mut t, &radiosity_measures(r), &mut notes);
     }
-    radiosity_table(&mut s, &a.radiosity);
+    s += &t.render();
+    for n in &notes {
+        let _ = writeln!(s, "{n}");
+    }
+    radiosity_lines(&mut s, &a.radiosity);
     let errors = match a.errors {
         ErrorMethod::Groups => format!(
             "spread of {} independent groups of lines / sqrt({})",
@@ -359,6 +582,7 @@ pub fn table(run: &RunInfo, a: &Analysis) -> String {
          undersampled.",
         a.estimator.name()
     );
+    reliability_summary(&mut s, a);
     if run.bundle > 0 && a.visibility.mutual_information_corrected.is_some() {
         // Measured: 8 x 8 bundles moved the corrected I_s of @cube:30 by 7.7 standard errors (README).
         let _ = writeln!(
@@ -368,41 +592,103 @@ pub fn table(run: &RunInfo, a: &Analysis) -> String {
              values, I_s^c and E(MSE) stay unbiased)."
         );
     }
+    if let Some(t) = &a.target {
+        let _ = writeln!(s, "{}", target_text(t));
+    }
     if a.stop_reason != StopReason::Lines {
         let _ = writeln!(s, "stopped by: {}", stop_text(a.stop_reason));
     }
     s
 }
 
-/// One measure's line of the table: plug-in and corrected values with their standard errors.
-fn table_row(s: &mut String, r: &Row) {
-    if let Some(e) = r.estimate {
-        let corrected = r
-            .corrected
-            .map(|c| format!("{:>12.6} {:>10}", c.value, stderr_text(c)))
-            .unwrap_or_else(|| format!("{:>23}", ""));
+/// The radiosity solver's line, or why the radiosity measures were left out.
+fn radiosity_lines(s: &mut String, outcome: &RadiosityOutcome) {
+    match outcome {
+        RadiosityOutcome::Computed(r) => {
+            let _ = writeln!(
+                s,
+                "radiosity: B = E + R F B solved by Gauss-Seidel to relative residual {:.1e} (tolerance {:.0e}) \
+                 in {} sweeps; {} patch(es) ({:.4}% of the area) receive or send no light and leave the channel",
+                r.solver_residual,
+                r.solver_tolerance,
+                r.solver_sweeps,
+                r.excluded_patches,
+                100.0 * r.excluded_area_fraction
+            );
+        }
+        _ => {
+            let reason = skipped_reason(outcome).unwrap_or_default();
+            let _ = writeln!(s, "\nradiosity measures left out: {reason}");
+        }
+    }
+}
+
+/// One line on what the verdicts mean, when some reading is not ok.
+fn reliability_summary(s: &mut String, a: &Analysis) {
+    let r = &a.reliability;
+    let all = [
+        &r.entropy,
+        &r.entropy_corrected,
+        &r.mutual_information,
+        &r.mutual_information_corrected,
+        &r.continuous_mutual_information,
+        &r.mse_per_line,
+    ];
+    let worst = all
+        .iter()
+        .filter_map(|r| r.as_ref())
+        .map(|r| r.verdict)
+        .max();
+    if worst.is_some_and(|v| v != Verdict::Ok) {
+        let needed = a
+            .sampling
+            .as_ref()
+            .filter(|smp| smp.sampling.coverage < 0.99)
+            .map(|smp| match smp.lines_for_coverage {
+                Some(n) => format!(
+                    "; the corrected readings need a coverage of 0.99, at least about {n:.1e} lines \
+                     (an extrapolation, good to about twice the lines cast)"
+                ),
+                None => "; a coverage of 0.99 is beyond reach of the extrapolation".into(),
+            })
+            .unwrap_or_default();
         let _ = writeln!(
             s,
-            "{:<36} {:>12.6} {:>10}  {corrected}  {}",
-            r.label,
-            e.value,
-            stderr_text(e),
-            r.reference
+            "reliability: an `undersampled` reading is biased beyond its standard error, an `unusable` one \
+             cannot be trusted (rows' coverage below 0.5){needed} (README, \"Reading the reliability \
+             verdict\")."
         );
     }
 }
 
-fn stderr_text(e: Estimate) -> String {
-    e.stderr
-        .map(|x| format!("{x:.6}"))
-        .unwrap_or_else(|| "n/a".into())
+/// What became of a precision target.
+fn target_text(t: &TargetOutcome) -> String {
+    let se = t.stderr.map_or_else(
+        || "no standard error".into(),
+        |e| format!("standard error {e:.3e}"),
+    );
+    let verdict = t.verdict.map_or("no verdict", Verdict::name);
+    if t.met() {
+        format!(
+            "precision target met: {} {se} <= {:.3e}, and the reading is {verdict}",
+            t.measure.name(),
+            t.stderr_goal
+        )
+    } else {
+        format!(
+            "precision target NOT met: {} {se} (goal {:.3e}), reading {verdict}: a target counts only when \
+             the standard error is small enough and the reading is ok",
+            t.measure.name(),
+            t.stderr_goal
+        )
+    }
 }
 
 fn stop_text(r: StopReason) -> &'static str {
     match r {
         StopReason::Lines => "all lines cast",
         StopReason::Seconds => "the time budget (--seconds)",
-        StopReason::Target => "the precision target (--target-stderr) was reached",
+        StopReason::Target => "the precision target (--target-stderr) was met",
         StopReason::Interrupted => {
             "interrupted (Ctrl-C): the report covers the lines gathered so far"
         }

@@ -6,7 +6,10 @@ use std::time::Instant;
 use scene_complexity::reproduce::{reproduce, LinePlan, ReproduceConfig, TableReport, TABLES};
 use scene_complexity::trace::Backend;
 
-use super::{thread_pool, write_stdout, Failure, TracerArg};
+use super::args::{parse_seed, parse_threads, ReportOutput, TracerArg};
+use super::output::{self, check_all};
+use super::runner::thread_pool;
+use super::{Exit, Failure};
 
 /// Arguments of `scx reproduce`.
 #[derive(clap::Args, Debug)]
@@ -18,19 +21,23 @@ pub struct ReproduceArgs {
     /// 1e9 included), a factor on the defaults (`x0.1`), or one count for every run (`1e6`).
     #[arg(long, default_value = "default", value_parser = LinePlan::parse)]
     lines: LinePlan,
-    /// Seed of every run's lines.
-    #[arg(long, default_value_t = 1)]
+    /// Seed of every run's lines (a whole number >= 0).
+    #[arg(long, default_value = "1", value_parser = parse_seed, allow_negative_numbers = true)]
     seed: u64,
-    /// Worker threads (default: all cores). Results do not depend on it.
-    #[arg(long)]
+    /// Worker threads; 0 or absent: all cores. Results do not depend on it.
+    #[arg(long, value_parser = parse_threads, allow_negative_numbers = true)]
     threads: Option<usize>,
     /// Tracing backend (default: embree when built in).
     #[arg(long, value_enum)]
     tracer: Option<TracerArg>,
+    #[command(flatten)]
+    out: ReportOutput,
 }
 
-/// Runs `scx reproduce`.
-pub fn run(args: &ReproduceArgs) -> Result<(), Failure> {
+/// Runs `scx reproduce`: the Markdown goes to standard output as each table finishes, or to `-o FILE`
+/// at the end.
+pub fn run(args: &ReproduceArgs) -> Result<Exit, Failure> {
+    check_all(args.out.output.as_deref())?;
     let tables = if args.table.is_empty() {
         TABLES.collect()
     } else {
@@ -40,15 +47,21 @@ pub fn run(args: &ReproduceArgs) -> Result<(), Failure> {
         tables,
         lines: args.lines,
         seed: args.seed,
-        backend: match args.tracer {
-            Some(TracerArg::Embree) => Backend::Embree,
-            Some(TracerArg::Rust) => Backend::Rust,
-            None => Backend::default_available(),
-        },
+        backend: TracerArg::backend(args.tracer),
     };
     let (threads, pool) = thread_pool(args.threads)?;
     let start = Instant::now();
-    write_stdout(&format!(
+    let mut document = String::new();
+    let to_file = args.out.output.is_some();
+    let mut print = |text: &str| -> Result<(), Failure> {
+        if to_file {
+            document.push_str(text);
+            Ok(())
+        } else {
+            output::emit(None, text)
+        }
+    };
+    print(&format!(
         "`scx reproduce`: lines {}, seed {}, tracer {}, {threads} \
          threads. Each value is `estimate ± standard error`; `corr.` is the bias-corrected estimate \
          (chao-wang-jost row entropies); `paper` is the published value.\n\n",
@@ -62,19 +75,27 @@ pub fn run(args: &ReproduceArgs) -> Result<(), Failure> {
     let mut printed: Result<(), Failure> = Ok(());
     let mut on_table = |t: &TableReport| {
         if printed.is_ok() {
-            printed = write_stdout(&t.markdown());
+            printed = print(&t.markdown());
         }
     };
-    let mut log = |m: &str| eprintln!("scx reproduce: {m}");
+    let mut log = |m: &str| output::note(&format!("reproduce: {m}"));
     pool.install(|| reproduce(&cfg, &mut log, &mut on_table))
         .map_err(|e| Failure {
-            code: if e.is_bad_input() { 2 } else { 1 },
+            code: if e.is_bad_input() {
+                Exit::BadInput
+            } else {
+                Exit::Failed
+            },
             message: e.to_string(),
         })?;
     printed?;
-    write_stdout(&format!(
+    print(&format!(
         "Total: {:.1} s ({:.1} min).\n",
         start.elapsed().as_secs_f64(),
         start.elapsed().as_secs_f64() / 60.0
-    ))
+    ))?;
+    if let Some(path) = &args.out.output {
+        output::write_file(path, document.as_bytes())?;
+    }
+    Ok(Exit::Ok)
 }

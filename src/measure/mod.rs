@@ -9,6 +9,7 @@ pub mod estimate;
 pub mod estimators;
 pub mod radiosity;
 pub mod rows;
+pub mod sampling;
 pub mod visibility;
 
 pub use estimate::Estimate;

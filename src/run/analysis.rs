@@ -17,6 +17,8 @@ use super::control::{Budget, RunControl, StopReason, TargetMeasure};
 use super::errors::{ErrorMethod, Spread};
 use super::plan::{BatchPlan, MAX_ROUND_LINES};
 use super::radiosity::{self, RadiosityOutcome, SolveFailure};
+use super::readings::VisibilityEstimates;
+use super::reliability::{self, SamplingReport, Verdict, VisibilityReliability, COVERAGE_OK};
 use super::state::{FinishedRun, RunState, TracedBatches};
 use super::warnings::{self, RunWarning};
 use crate::measure::bias::{self, CorrectedValues};
@@ -25,6 +27,7 @@ use crate::measure::entropy::xlog2x;
 use crate::measure::estimators::EntropyEstimator;
 use crate::measure::radiosity::{MaterialError, PatchMaterials, SolveOptions};
 use crate::measure::rows::Rows;
+use crate::measure::sampling::{lines_factor_for_coverage, Sampling};
 use crate::measure::visibility::{self, ContinuousValues, DiscreteValues};
 use crate::measure::Estimate;
 use crate::sample::lines::LineSource;
@@ -134,45 +137,6 @@ impl AnalysisError {
     }
 }
 
-/// The visibility measures of a run, each with its standard error; `None` when not computed.
-#[derive(Clone, Debug, Default)]
-pub struct VisibilityEstimates {
-    /// Eq. (19), exact.
-    pub positional_entropy: Option<Estimate>,
-    /// Eq. (17), plug-in.
-    pub entropy: Option<Estimate>,
-    /// Eq. (17) with bias-corrected row entropies ([`crate::measure::bias`]).
-    pub entropy_corrected: Option<Estimate>,
-    /// H(X, Y).
-    pub joint_entropy: Option<Estimate>,
-    /// Eq. (21), plug-in.
-    pub mutual_information: Option<Estimate>,
-    /// Eq. (20) with the bias-corrected H_s.
-    pub mutual_information_corrected: Option<Estimate>,
-    /// Eq. (27).
-    pub continuous_mutual_information: Option<Estimate>,
-    /// Sec. 3.3: discretisation accuracy I_s / I_s^c (plug-in I_s).
-    pub accuracy: Option<Estimate>,
-    /// Sec. 3.3 with the bias-corrected I_s.
-    pub accuracy_corrected: Option<Estimate>,
-    /// Sec. 3.3: discretisation relative error (I_s^c - I_s) / I_s^c.
-    pub relative_error: Option<Estimate>,
-    /// Eq. (22), per line.
-    pub mse_per_line: Option<Estimate>,
-}
-
-impl VisibilityEstimates {
-    /// The estimate a precision target watches.
-    pub fn of(&self, measure: TargetMeasure) -> Option<Estimate> {
-        match measure {
-            TargetMeasure::Entropy => self.entropy,
-            TargetMeasure::MutualInformation => self.mutual_information,
-            TargetMeasure::ContinuousMutualInformation => self.continuous_mutual_information,
-            TargetMeasure::Accuracy => self.accuracy,
-        }
-    }
-}
-
 /// Everything a run found.
 #[derive(Clone, Debug)]
 pub struct Analysis {
@@ -210,6 +174,12 @@ pub struct Analysis {
     pub environment_area: Option<Estimate>,
     /// The visibility measures.
     pub visibility: VisibilityEstimates,
+    /// How well the lines sampled the rows of F (when the discrete measures were counted).
+    pub sampling: Option<SamplingReport>,
+    /// The verdict on every visibility reading.
+    pub reliability: VisibilityReliability,
+    /// The precision target, when there was one, and whether it was met.
+    pub target: Option<TargetOutcome>,
     /// The radiosity measures, or why there are none.
     pub radiosity: RadiosityOutcome,
     /// What the user must know about these numbers (an open scene, unsampled patches, ...).
@@ -226,6 +196,27 @@ impl Analysis {
     }
 }
 
+/// A precision target at the end of a run: met only when the standard error is small enough *and* the
+/// reading is reliable.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TargetOutcome {
+    /// The measure watched.
+    pub measure: TargetMeasure,
+    /// The standard error asked for.
+    pub stderr_goal: f64,
+    /// The standard error reached (`None`: none could be estimated).
+    pub stderr: Option<f64>,
+    /// The verdict on the reading (`None`: not computed).
+    pub verdict: Option<Verdict>,
+}
+
+impl TargetOutcome {
+    /// Whether the target was met: the standard error within the goal and the reading reliable.
+    pub fn met(&self) -> bool {
+        self.stderr.is_some_and(|se| se <= self.stderr_goal) && self.verdict == Some(Verdict::Ok)
+    }
+}
+
 /// Measures of one group, of one group left out, or of the whole run.
 #[derive(Clone, Copy, Debug)]
 struct GroupValues {
@@ -234,41 +225,56 @@ struct GroupValues {
     continuous: Option<ContinuousValues>,
     /// The environment patch's area (tracing space), when enclosed.
     environment_area: Option<f64>,
+    /// How the rows were sampled (when counted).
+    sampling: Option<Sampling>,
+    /// The factor on the lines for a coverage of [`COVERAGE_OK`] (the whole run's values only).
+    lines_factor: Option<f64>,
 }
 
 impl GroupValues {
     /// The values of a tally; of the enclosed scene when `enclose` ([`Tally::enclosed`]).
-    fn of(scene: &Scene, t: &Tally, estimator: EntropyEstimator, enclose: bool) -> Self {
+    /// The values of a tally; of the enclosed scene when `enclose` ([`Tally::enclosed`]); with the
+    /// extrapolation of the rows' coverage when `extrapolate` (the whole run's).
+    fn of(
+        scene: &Scene,
+        t: &Tally,
+        estimator: EntropyEstimator,
+        enclose: bool,
+        extrapolate: bool,
+    ) -> Self {
         if enclose {
             let (enclosed, areas) = t.enclosed(scene);
             return GroupValues {
                 environment_area: Some(t.environment_area(scene)),
-                ..GroupValues::plain(&areas, &enclosed, estimator)
+                ..GroupValues::plain(&areas, &enclosed, estimator, extrapolate)
             };
         }
-        GroupValues::plain(&areas(scene), t, estimator)
+        GroupValues::plain(&areas(scene), t, estimator, extrapolate)
     }
 
-    fn plain(areas: &[f64], t: &Tally, estimator: EntropyEstimator) -> Self {
-        let counted = t.counts.as_ref().filter(|_| t.counters.lines > 0);
-        // One pass over the counts serves both the plug-in and the corrected measures.
-        let (discrete, corrected) = counted
-            .map(|c| {
-                let a = channel::area_distribution(areas);
-                let a = a.as_slice().expect("a fresh array is contiguous");
-                let rows = Rows::gather(a, c, &t.escapes_by_patch, estimator);
-                (
-                    visibility::discrete_from_rows(a, &rows.sums),
-                    bias::corrected_from_rows(a, &rows, c, &t.escapes_by_patch),
-                )
-            })
-            .unzip();
-        GroupValues {
-            discrete,
-            corrected,
+    fn plain(areas: &[f64], t: &Tally, estimator: EntropyEstimator, extrapolate: bool) -> Self {
+        let mut values = GroupValues {
+            discrete: None,
+            corrected: None,
             continuous: ContinuousValues::from_sum(t.counters.cmi_sum, t.counters.cmi_pairs),
             environment_area: None,
+            sampling: None,
+            lines_factor: None,
+        };
+        let Some(c) = t.counts.as_ref().filter(|_| t.counters.lines > 0) else {
+            return values;
+        };
+        // One pass over the counts serves the plug-in and the corrected measures and the sampling.
+        let a = channel::area_distribution(areas);
+        let a = a.as_slice().expect("a fresh array is contiguous");
+        let rows = Rows::gather(a, c, &t.escapes_by_patch, estimator);
+        values.discrete = Some(visibility::discrete_from_rows(a, &rows.sums));
+        values.corrected = Some(bias::corrected_from_rows(a, &rows, c, &t.escapes_by_patch));
+        values.sampling = Some(Sampling::of_rows(a, &rows.sums));
+        if extrapolate {
+            values.lines_factor = lines_factor_for_coverage(a, &rows.sums, COVERAGE_OK);
         }
+        values
     }
 
     fn accuracy(&self) -> Option<f64> {
@@ -315,6 +321,12 @@ pub fn analyze(
         && cfg.estimator != EntropyEstimator::ChaoShen
         && run.groups.len() >= 2;
     let visibility = visibility_estimates(scene, &run, cfg.estimator, enclose, jackknife, wanted);
+    let target = cfg.budget.target.map(|t| TargetOutcome {
+        measure: t.measure,
+        stderr_goal: t.stderr,
+        stderr: visibility.estimates.of(t.measure).and_then(|e| e.stderr),
+        verdict: visibility.reliability.of(t.measure).map(|r| r.verdict),
+    });
     let radiosity = match &materials {
         None => RadiosityOutcome::NotRequested,
         Some(_) if !lit => RadiosityOutcome::Skipped(radiosity::NOTHING_EMITS.into()),
@@ -325,6 +337,10 @@ pub fn analyze(
             &cfg.solve,
             cfg.estimator,
             visibility.jackknifed,
+            visibility
+                .sampling
+                .as_ref()
+                .expect("radiosity counts the pairs"),
         )?,
     };
     let FinishedRun { total, .. } = run;
@@ -355,6 +371,9 @@ pub fn analyze(
         distinct_pairs: total.counts.as_ref().map(|c| c.distinct_pairs()),
         unsampled: visibility.unsampled,
         visibility: visibility.estimates,
+        sampling: visibility.sampling,
+        reliability: visibility.reliability,
+        target,
         radiosity,
         warnings,
         tally: total,
@@ -441,14 +460,17 @@ fn cast(
         }
         if let Some(target) = cfg.budget.target {
             let done = state.batches_done();
-            match current_stderr(scene, &state, cfg, wanted, target.measure) {
-                Some(se) if se <= target.stderr => break StopReason::Target,
+            let (se, verdict) = current_reading(scene, &state, cfg, wanted, target.measure);
+            let reliable = verdict == Some(Verdict::Ok);
+            match se {
+                Some(se) if se <= target.stderr && reliable => break StopReason::Target,
                 // stderr ~ 1/sqrt(lines): aim 10% past the predicted need, at most doubling per round.
-                Some(se) => {
+                Some(se) if se > target.stderr => {
                     let need = done as f64 * (se / target.stderr).powi(2) * 1.1;
                     round = ((need as u64).saturating_sub(done)).clamp(1, done.max(1));
                 }
-                None => round = done.max(1),
+                // Small enough an error on a biased reading: double, since the bias falls faster.
+                _ => round = done.max(1),
             }
         } else {
             // Doubling: few rounds, and a time budget is checked before every batch anyway.
@@ -459,31 +481,23 @@ fn cast(
     Ok((state, stop_reason))
 }
 
-/// The standard error of `measure` from the groups so far (batch means: the jackknife needs the total's
-/// counts, which a dense run merges only at the end; batch means are larger where they differ, so a
-/// target is never met early).
-fn current_stderr(
+/// The standard error of `measure` and the verdict on its reading, from the run so far. Batch means:
+/// the jackknife needs the total's counts, which a dense run merges only at the end; batch means are
+/// larger where they differ, so a target is never met early.
+fn current_reading(
     scene: &Scene,
     state: &RunState,
     cfg: &AnalysisConfig,
     wanted: Wanted,
     measure: TargetMeasure,
-) -> Option<f64> {
-    let filled = state.filled_groups();
-    let enclose = cfg.enclose && filled.iter().any(|t| t.counters.escapes > 0);
-    let values: Vec<GroupValues> = filled
-        .par_iter()
-        .map(|t| GroupValues::of(scene, t, cfg.estimator, enclose))
-        .collect();
-    // The total's value does not change the spread of the groups; any stand-in does.
-    let spread = Spread {
-        all: values.first()?,
-        groups: &values,
-        replicates: None,
-    };
-    estimates(&areas(scene), &spread, wanted)
-        .of(measure)?
-        .stderr
+) -> (Option<f64>, Option<Verdict>) {
+    let run = state.snapshot(scene);
+    let enclose = cfg.enclose && run.groups.iter().any(|t| t.counters.escapes > 0);
+    let v = visibility_estimates(scene, &run, cfg.estimator, enclose, false, wanted);
+    (
+        v.estimates.of(measure).and_then(|e| e.stderr),
+        v.reliability.of(measure).map(|r| r.verdict),
+    )
 }
 
 /// The visibility side of a finished run.
@@ -497,6 +511,10 @@ struct VisibilityOfRun {
     environment_area: Option<Estimate>,
     /// Whether the standard errors came from the jackknife.
     jackknifed: bool,
+    /// How the rows were sampled (when counted).
+    sampling: Option<SamplingReport>,
+    /// The verdict on every reading.
+    reliability: VisibilityReliability,
 }
 
 /// Every visibility measure of a finished run with its standard error (by the jackknife when asked and
@@ -509,9 +527,9 @@ fn visibility_estimates(
     jackknife: bool,
     wanted: Wanted,
 ) -> VisibilityOfRun {
-    let values_of = |t: &Tally| GroupValues::of(scene, t, estimator, enclose);
+    let values_of = |t: &Tally| GroupValues::of(scene, t, estimator, enclose, false);
     let (all, per_group): (GroupValues, Vec<GroupValues>) = rayon::join(
-        || values_of(&run.total),
+        || GroupValues::of(scene, &run.total, estimator, enclose, true),
         || run.groups.par_iter().map(values_of).collect(),
     );
     let replicates = jackknife
@@ -538,8 +556,21 @@ fn visibility_estimates(
         let scale2 = scene.normalization.scale.powi(2);
         environment_area = spread.batch_means(|g| Some(g.environment_area? * scale2));
     }
+    let lines = run.total.counters.lines;
+    let sampling = all.sampling.map(|sampling| SamplingReport {
+        sampling,
+        lines_for_coverage: all.lines_factor.map(|k| (k * lines as f64).ceil() as u64),
+    });
+    let reliability = reliability::visibility(
+        &estimates,
+        sampling.as_ref(),
+        lines,
+        run.total.counters.pairs,
+    );
     VisibilityOfRun {
         estimates,
+        sampling,
+        reliability,
         groups: per_group.len(),
         unsampled: all
             .discrete
@@ -586,6 +617,8 @@ fn jackknife_replicates(
                     total.counters.cmi_pairs - g.counters.cmi_pairs,
                 ),
                 environment_area: None,
+                sampling: None,
+                lines_factor: None,
             })
         })
         .collect()

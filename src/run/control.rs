@@ -31,27 +31,47 @@ pub struct Target {
 /// A measure a precision target can watch (named as in the JSON report).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum TargetMeasure {
-    /// H_s, eq. (17).
+    /// H_s, eq. (17), plug-in.
     Entropy,
-    /// I_s, eq. (21).
+    /// H_s with bias-corrected rows.
+    EntropyCorrected,
+    /// I_s, eq. (21), plug-in.
     MutualInformation,
+    /// I_s with bias-corrected rows: the default, the better reading of I_s.
+    MutualInformationCorrected,
     /// I_s^c, eq. (27).
     ContinuousMutualInformation,
-    /// I_s / I_s^c.
+    /// I_s / I_s^c, plug-in.
     Accuracy,
+    /// I_s / I_s^c with the corrected I_s.
+    AccuracyCorrected,
 }
 
 impl TargetMeasure {
     /// Every target measure with its name.
-    pub const NAMES: [(&'static str, TargetMeasure); 4] = [
+    pub const NAMES: [(&'static str, TargetMeasure); 7] = [
         ("entropy", TargetMeasure::Entropy),
+        ("entropy_corrected", TargetMeasure::EntropyCorrected),
         ("mutual_information", TargetMeasure::MutualInformation),
+        (
+            "mutual_information_corrected",
+            TargetMeasure::MutualInformationCorrected,
+        ),
         (
             "continuous_mutual_information",
             TargetMeasure::ContinuousMutualInformation,
         ),
         ("accuracy", TargetMeasure::Accuracy),
+        ("accuracy_corrected", TargetMeasure::AccuracyCorrected),
     ];
+
+    /// The name as in the JSON report.
+    pub fn name(self) -> &'static str {
+        Self::NAMES
+            .iter()
+            .find(|(_, m)| *m == self)
+            .map_or("", |(n, _)| n)
+    }
 
     /// Parses a name as in the JSON report (`mutual_information`).
     pub fn from_name(name: &str) -> Option<Self> {

@@ -15,17 +15,23 @@ pub mod control;
 pub mod errors;
 pub mod plan;
 pub mod radiosity;
+pub mod readings;
+pub mod reliability;
 pub mod state;
 pub mod warnings;
 
+pub use analysis::TargetOutcome;
 pub use analysis::{
-    analyze, Analysis, AnalysisConfig, AnalysisError, Measures, VisibilityEstimates,
-    DEFAULT_ESTIMATOR, DEFAULT_GROUPS,
+    analyze, Analysis, AnalysisConfig, AnalysisError, Measures, DEFAULT_ESTIMATOR, DEFAULT_GROUPS,
 };
 pub use batches::{map_batches, map_traced_batches, Batch, LineStream, TraceBuffers};
 pub use control::{Budget, RunControl, StopReason, Target, TargetMeasure};
 pub use errors::{ErrorMethod, Spread};
 pub use plan::BatchPlan;
-pub use radiosity::{RadiosityEstimates, RadiosityOutcome, SolveFailure, NOTHING_EMITS};
+pub use radiosity::{
+    RadiosityEstimates, RadiosityOutcome, RadiosityReliability, SolveFailure, NOTHING_EMITS,
+};
+pub use readings::VisibilityEstimates;
+pub use reliability::{Reliability, SamplingReport, Verdict, VisibilityReliability};
 pub use state::{FinishedRun, RunState, TracedBatches};
 pub use warnings::{RunWarning, RunWarningKind};

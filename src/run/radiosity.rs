@@ -8,6 +8,7 @@
 use rayon::prelude::*;
 
 use super::errors::Spread;
+use super::reliability::{coverage_verdict, plug_in, Reliability, SamplingReport};
 use super::state::FinishedRun;
 use crate::measure::bias::row_corrections;
 use crate::measure::estimators::EntropyEstimator;
@@ -41,6 +42,22 @@ pub struct RadiosityEstimates {
     pub excluded_patches: usize,
     /// Their share of the scene's area.
     pub excluded_area_fraction: f64,
+    /// The verdicts on eqs. (34) and (35), plug-in and corrected, as for the visibility measures: the
+    /// rows are those of F, reweighted by the radiosities.
+    pub reliability: RadiosityReliability,
+}
+
+/// The verdicts on the radiosity readings.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RadiosityReliability {
+    /// Eq. (34), plug-in.
+    pub entropy: Reliability,
+    /// Eq. (34), corrected.
+    pub entropy_corrected: Reliability,
+    /// Eq. (35), plug-in.
+    pub mutual_information: Reliability,
+    /// Eq. (35), corrected.
+    pub mutual_information_corrected: Reliability,
 }
 
 /// The radiosity measures, or why there are none.
@@ -78,6 +95,7 @@ pub(crate) fn estimates(
     opts: &SolveOptions,
     estimator: EntropyEstimator,
     jackknife: bool,
+    sampling: &SamplingReport,
 ) -> Result<RadiosityOutcome, SolveFailure> {
     let areas: Vec<f64> = scene.patches.iter().map(|p| p.area).collect();
     let solve = |t: &Tally| solve_tally(&areas, materials, t, opts, estimator);
@@ -120,12 +138,24 @@ pub(crate) fn estimates(
             .expect("the whole run has radiosity values")
     };
     let all = all.as_ref().expect("solved above");
+    let (entropy, entropy_corrected) = (est(|v| v.entropy), est(|v| v.entropy_corrected));
+    let mutual_information = est(|v| v.mutual_information);
+    // As for H_s: the plug-in reads low by about the correction, 𝓘_s high by as much.
+    let bias = entropy.value - entropy_corrected.value;
+    let lines = run.total.counters.lines;
+    let reliability = RadiosityReliability {
+        entropy: plug_in(entropy, bias, sampling, lines),
+        entropy_corrected: coverage_verdict(sampling),
+        mutual_information: plug_in(mutual_information, -bias, sampling, lines),
+        mutual_information_corrected: coverage_verdict(sampling),
+    };
     Ok(RadiosityOutcome::Computed(RadiosityEstimates {
         positional_entropy: est(|v| v.positional_entropy),
-        entropy: est(|v| v.entropy),
-        mutual_information: est(|v| v.mutual_information),
-        entropy_corrected: est(|v| v.entropy_corrected),
+        entropy,
+        mutual_information,
+        entropy_corrected,
         mutual_information_corrected: est(|v| v.mutual_information_corrected),
+        reliability,
         solver_residual: solution.residual,
         solver_tolerance: opts.tolerance,
         solver_sweeps: solution.sweeps,

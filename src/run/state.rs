@@ -192,6 +192,11 @@ impl RunState {
         self.batches_done += batches;
     }
 
+    /// The run so far as if it ended now (a copy: the run goes on).
+    pub fn snapshot(&self, scene: &Scene) -> FinishedRun {
+        self.clone().finish(scene)
+    }
+
     /// The total of every group, and the groups with lines.
     pub fn finish(self, scene: &Scene) -> FinishedRun {
         let groups: Vec<Tally> = self.groups.into_iter().flatten().collect();

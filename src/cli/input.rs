@@ -1,0 +1,39 @@
+//! Reading a scene: a built-in (`@cube:10`), a file, or `-` for standard input.
+
+use std::io::Read;
+use std::path::Path;
+
+use scene_complexity::scene::{obj, Scene};
+use scene_complexity::scenes;
+
+use super::output::warn;
+use super::{Exit, Failure};
+
+/// Loads the scene a command names, printing its loading warnings; bad input is exit code 2.
+pub fn load_scene(spec: &str) -> Result<Scene, Failure> {
+    let scene = if spec == "-" {
+        from_stdin()?
+    } else {
+        scenes::load(spec).map_err(|e| Failure::bad_input(e.to_string()))?
+    };
+    for w in &scene.warnings {
+        warn(w);
+    }
+    Ok(scene)
+}
+
+/// An OBJ scene from standard input; an `mtllib` is looked for in the current folder.
+fn from_stdin() -> Result<Scene, Failure> {
+    let mut text = String::new();
+    std::io::stdin()
+        .read_to_string(&mut text)
+        .map_err(|e| Failure {
+            code: Exit::Io,
+            message: format!("cannot read the scene from standard input: {e}"),
+        })?;
+    obj::load_text("<stdin>", &text, &|mtl: &Path| {
+        let text = std::fs::read_to_string(mtl).map_err(|e| e.to_string())?;
+        Ok((mtl.display().to_string(), text))
+    })
+    .map_err(|e| Failure::bad_input(e.to_string()))
+}

@@ -1,0 +1,122 @@
+//! `scx refine`: a scene's patches refined by a meshing strategy (paper Table 9), written as OBJ + MTL.
+
+use std::path::PathBuf;
+
+use clap::ValueEnum;
+use scene_complexity::measure::radiosity::SolveOptions;
+use scene_complexity::refine::{refine, RefineConfig, RefineRound, Strategy};
+use scene_complexity::scene::obj;
+use scene_complexity::trace::{make_tracer, Query};
+
+use super::args::{parse_count, parse_positive, parse_seed, parse_threads, TracerArg};
+use super::input::load_scene;
+use super::output::{self, check_all, note};
+use super::runner::thread_pool;
+use super::{Exit, Failure};
+
+/// Arguments of `scx refine`.
+#[derive(clap::Args, Debug)]
+pub struct RefineArgs {
+    /// A scene file, a built-in scene such as `@cornell`, or `-` for an OBJ on standard input.
+    scene: String,
+    /// Which patches to split: uniform (all, largest first), power (A_i B_i), smoothness (variation of
+    /// received radiosity over the patch), information (loss of information transfer).
+    #[arg(long, value_enum)]
+    strategy: StrategyArg,
+    /// Stop at about this many patches (at most 2 over).
+    #[arg(long, value_parser = parse_count, allow_negative_numbers = true)]
+    patches: u64,
+    /// The OBJ file to write; the MTL library goes beside it (both checked writable first).
+    #[arg(short, long)]
+    output: PathBuf,
+    /// Global lines per refinement round (accepts `1e6`).
+    #[arg(long, default_value = "1e6", value_parser = parse_count, allow_negative_numbers = true)]
+    lines: u64,
+    /// Each round grows the mesh by at most this factor (above 1).
+    #[arg(long, default_value_t = 1.5, value_parser = parse_positive, allow_negative_numbers = true)]
+    growth: f64,
+    /// Seed of the first round's lines (a whole number >= 0).
+    #[arg(long, default_value = "1", value_parser = parse_seed, allow_negative_numbers = true)]
+    seed: u64,
+    /// Worker threads; 0 or absent: all cores.
+    #[arg(long, value_parser = parse_threads, allow_negative_numbers = true)]
+    threads: Option<usize>,
+    /// Tracing backend.
+    #[arg(long, value_enum)]
+    tracer: Option<TracerArg>,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+enum StrategyArg {
+    Uniform,
+    Power,
+    Smoothness,
+    Information,
+}
+
+/// Runs `scx refine`.
+pub fn run(args: &RefineArgs) -> Result<Exit, Failure> {
+    let mtl = args.output.with_extension("mtl");
+    check_all([args.output.as_path(), mtl.as_path()])?;
+    let scene = load_scene(&args.scene)?;
+    let backend = TracerArg::backend(args.tracer);
+    // Check the backend once up front, so that an unavailable one is a clear input error.
+    make_tracer(backend, &scene, Query::Single).map_err(Failure::bad_input)?;
+    let strategy = match args.strategy {
+        StrategyArg::Uniform => Strategy::Uniform,
+        StrategyArg::Power => Strategy::Power,
+        StrategyArg::Smoothness => Strategy::Smoothness,
+        StrategyArg::Information => Strategy::Information,
+    };
+    let cfg = RefineConfig {
+        strategy,
+        target_patches: usize::try_from(args.patches).unwrap_or(usize::MAX),
+        lines_per_round: args.lines,
+        seed: args.seed,
+        growth: args.growth,
+        solve: SolveOptions::default(),
+    };
+    let (_, pool) = thread_pool(args.threads)?;
+    let started = std::time::Instant::now();
+    let mut log = |r: &RefineRound| {
+        let mi = r
+            .radiosity_mutual_information
+            .map(|x| format!(", radiosity I_s {x:.4} bits (plug-in, this round's lines only)"))
+            .unwrap_or_default();
+        note(&format!(
+            "refine {strategy}: {} -> {} patches, {} lines, {:.2} s{mi}",
+            r.patches_before, r.patches_after, r.lines, r.seconds
+        ));
+    };
+    let refined = pool
+        .install(|| {
+            refine(
+                &scene,
+                &|s| make_tracer(backend, s, Query::Single),
+                &cfg,
+                &mut log,
+            )
+        })
+        .map_err(|e| Failure {
+            code: if e.is_bad_input() {
+                Exit::BadInput
+            } else {
+                Exit::Failed
+            },
+            message: e.to_string(),
+        })?;
+    obj::write(&refined.scene, &args.output).map_err(|e| Failure {
+        code: Exit::Io,
+        message: e.to_string(),
+    })?;
+    let lines: u64 = refined.rounds.iter().map(|r| r.lines).sum();
+    output::note(&format!(
+        "wrote {} ({} patches) and {}: {} rounds, {lines} lines, {:.2} s",
+        args.output.display(),
+        refined.scene.patch_count(),
+        mtl.display(),
+        refined.rounds.len(),
+        started.elapsed().as_secs_f64()
+    ));
+    Ok(Exit::Ok)
+}

@@ -1,0 +1,115 @@
+//! A scene ready to run: its tracer, a thread pool, and the Ctrl-C handler that stops a run cleanly.
+
+use std::sync::Arc;
+
+use scene_complexity::run::{analyze, Analysis, AnalysisConfig, Measures, RunControl};
+use scene_complexity::scene::Scene;
+use scene_complexity::trace::{make_tracer, Query, Tracer};
+
+use super::args::{RunOptions, TracerArg};
+use super::input::load_scene;
+use super::{progress, report, Exit, Failure};
+
+/// A scene with its tracer and thread pool, ready to run analyses.
+pub struct Runner {
+    pub scene: Scene,
+    pub tracer: Box<dyn Tracer>,
+    pool: rayon::ThreadPool,
+    pub threads: usize,
+    query: Query,
+    pub control: Arc<RunControl>,
+}
+
+impl Runner {
+    /// Loads the scene and builds its tracer and thread pool.
+    pub fn new(spec: &str, opts: &RunOptions) -> Result<Runner, Failure> {
+        let scene = load_scene(spec)?;
+        let tracer = make_tracer(TracerArg::backend(opts.tracer), &scene, opts.query)
+            .map_err(Failure::bad_input)?;
+        let (threads, pool) = thread_pool(opts.threads)?;
+        let control = Arc::new(RunControl::default());
+        watch_ctrl_c(&control);
+        Ok(Runner {
+            scene,
+            tracer,
+            pool,
+            threads,
+            query: opts.query,
+            control,
+        })
+    }
+
+    /// Runs one analysis with a progress bar (of `total` lines when known; `label` says which run).
+    pub fn analyze(
+        &self,
+        cfg: &AnalysisConfig,
+        total: Option<u64>,
+        label: &str,
+    ) -> Result<Analysis, Failure> {
+        progress::while_running(&self.control, total, label, || {
+            self.pool
+                .install(|| analyze(&self.scene, self.tracer.as_ref(), cfg, &self.control))
+        })
+        .map_err(|e| Failure {
+            code: if e.is_bad_input() {
+                Exit::BadInput
+            } else {
+                Exit::Failed
+            },
+            message: e.to_string(),
+        })
+    }
+
+    /// Facts about the run for the reports.
+    pub fn info(&self) -> report::RunInfo<'_> {
+        report::RunInfo {
+            scene: &self.scene,
+            tracer: self.tracer.name(),
+            query: self.query,
+            threads: self.threads,
+            bundle: 0,
+        }
+    }
+
+    /// A config for `lines` lines with these options (the visibility measures).
+    pub fn config(&self, opts: &RunOptions, lines: u64, seed: u64) -> AnalysisConfig {
+        AnalysisConfig {
+            measures: Measures::VISIBILITY,
+            groups: usize::from(opts.groups),
+            estimator: opts.estimator,
+            errors: opts.errors,
+            ..AnalysisConfig::new(lines, seed)
+        }
+    }
+}
+
+/// The worker threads (absent or 0: all cores) and a rayon pool of that size.
+pub fn thread_pool(threads: Option<usize>) -> Result<(usize, rayon::ThreadPool), Failure> {
+    let threads = threads.filter(|&t| t > 0).unwrap_or_else(|| {
+        std::thread::available_parallelism()
+            .map(|n| n.get())
+            .unwrap_or(1)
+    });
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .map_err(|e| Failure {
+            code: Exit::Failed,
+            message: format!("cannot start {threads} threads: {e}"),
+        })?;
+    Ok((threads, pool))
+}
+
+/// The first Ctrl-C asks the run to stop and report what it gathered; a second one ends the program.
+fn watch_ctrl_c(control: &Arc<RunControl>) {
+    let control = Arc::clone(control);
+    let presses = std::sync::atomic::AtomicU32::new(0);
+    // Failing to install the handler only loses the clean stop: Ctrl-C then ends the program as usual.
+    let _ = ctrlc::set_handler(move || {
+        if presses.fetch_add(1, std::sync::atomic::Ordering::SeqCst) > 0 {
+            std::process::exit(Exit::Interrupted as i32);
+        }
+        eprintln!("\nscx: stopping after the batches under way (Ctrl-C again to quit now)");
+        control.request_stop();
+    });
+}

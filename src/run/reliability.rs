@@ -1,0 +1,404 @@
+//! The reliability verdict of every reading: whether its standard error tells the whole story, and the
+//! bounds of the theory it breaks (README, "Reading the reliability verdict").
+//!
+//! The discrete measures of an undersampled run are biased (their standard errors do not include it):
+//! * a plug-in reading (H_s, H(X, Y), I_s and the accuracies built on them) is `ok` when the rows' sample
+//!   coverage is at least [`COVERAGE_OK`] and its estimated bias, the distance to the bias-corrected
+//!   reading, is within its standard error;
+//! * a bias-corrected reading is `ok` when the coverage is at least [`COVERAGE_OK`];
+//! * any discrete reading is `unusable` below [`COVERAGE_UNUSABLE`]: most of the rows' probability was
+//!   never drawn, and no estimator can see what was not drawn;
+//! * E(MSE) (eq. 22) has an unbiased estimate whatever the coverage: `ok` when its estimated bias is
+//!   within its standard error;
+//! * I_s^c (eq. 27) is a mean of independent terms: `ok` with enough pairs in every group.
+//!
+//! Independently, a reading that breaks a bound the theory guarantees (an entropy or mutual information
+//! below 0, I_s above I_s^c (Proposition 2), an accuracy outside [0, 1]) by more than twice its standard
+//! error is flagged, and is never `ok`.
+
+use super::control::TargetMeasure;
+use super::readings::VisibilityEstimates;
+use crate::measure::sampling::Sampling;
+use crate::measure::Estimate;
+
+/// Rows whose area-weighted sample coverage is at least this give `ok` bias-corrected readings.
+pub const COVERAGE_OK: f64 = 0.99;
+/// Below this coverage every discrete reading is `unusable`.
+pub const COVERAGE_UNUSABLE: f64 = 0.5;
+/// I_s^c needs at least this many pairs in the run to be `ok`.
+const MIN_PAIRS: u64 = 1000;
+
+/// What a reading is worth.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+pub enum Verdict {
+    /// Its standard error covers its error.
+    Ok,
+    /// It is biased beyond its standard error: cast more lines (see [`Reliability::lines_needed`]).
+    Undersampled,
+    /// It cannot be trusted at all.
+    Unusable,
+}
+
+impl Verdict {
+    /// The name in reports (`ok`, `undersampled`, `unusable`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Verdict::Ok => "ok",
+            Verdict::Undersampled => "undersampled",
+            Verdict::Unusable => "unusable",
+        }
+    }
+}
+
+/// The verdict on one reading, with the numbers behind it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Reliability {
+    /// The verdict.
+    pub verdict: Verdict,
+    /// The estimated bias of the reading (bits, or lines for E(MSE)), when there is an estimate.
+    pub estimated_bias: Option<f64>,
+    /// Roughly how many lines in all would make it `ok` (`None`: not estimated, or already ok).
+    pub lines_needed: Option<u64>,
+    /// The bounds of the theory it breaks, as sentences.
+    pub flags: Vec<String>,
+}
+
+impl Reliability {
+    fn new(verdict: Verdict) -> Self {
+        Reliability {
+            verdict,
+            estimated_bias: None,
+            lines_needed: None,
+            flags: Vec::new(),
+        }
+    }
+
+    /// Flags a broken bound: the reading is then at least undersampled.
+    fn flag(&mut self, sentence: String) {
+        self.flags.push(sentence);
+        self.verdict = self.verdict.max(Verdict::Undersampled);
+    }
+}
+
+/// How the rows were sampled, for the report.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SamplingReport {
+    /// The rows' sampling.
+    pub sampling: Sampling,
+    /// The lines in all for a coverage of [`COVERAGE_OK`] (`None`: beyond reach of the extrapolation).
+    pub lines_for_coverage: Option<u64>,
+}
+
+/// The verdicts on the visibility readings (each `None` when the reading is).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct VisibilityReliability {
+    /// H_s, plug-in.
+    pub entropy: Option<Reliability>,
+    /// H_s, corrected.
+    pub entropy_corrected: Option<Reliability>,
+    /// H(X, Y).
+    pub joint_entropy: Option<Reliability>,
+    /// I_s, plug-in.
+    pub mutual_information: Option<Reliability>,
+    /// I_s, corrected.
+    pub mutual_information_corrected: Option<Reliability>,
+    /// I_s^c.
+    pub continuous_mutual_information: Option<Reliability>,
+    /// I_s / I_s^c, plug-in.
+    pub accuracy: Option<Reliability>,
+    /// I_s / I_s^c, corrected.
+    pub accuracy_corrected: Option<Reliability>,
+    /// (I_s^c - I_s) / I_s^c.
+    pub relative_error: Option<Reliability>,
+    /// E(MSE) per line.
+    pub mse_per_line: Option<Reliability>,
+}
+
+impl VisibilityReliability {
+    /// The verdict on the reading a precision target watches.
+    pub fn of(&self, measure: TargetMeasure) -> Option<&Reliability> {
+        match measure {
+            TargetMeasure::Entropy => self.entropy.as_ref(),
+            TargetMeasure::EntropyCorrected => self.entropy_corrected.as_ref(),
+            TargetMeasure::MutualInformation => self.mutual_information.as_ref(),
+            TargetMeasure::MutualInformationCorrected => self.mutual_information_corrected.as_ref(),
+            TargetMeasure::ContinuousMutualInformation => {
+                self.continuous_mutual_information.as_ref()
+            }
+            TargetMeasure::Accuracy => self.accuracy.as_ref(),
+            TargetMeasure::AccuracyCorrected => self.accuracy_corrected.as_ref(),
+        }
+    }
+}
+
+/// Whether `a` exceeds `b` by more than twice their combined standard error.
+fn clearly_above(a: Estimate, b: Estimate) -> bool {
+    let se = (a.stderr.unwrap_or(0.0).powi(2) + b.stderr.unwrap_or(0.0).powi(2)).sqrt();
+    a.value - b.value > 2.0 * se
+}
+
+fn stderr(e: Estimate) -> f64 {
+    e.stderr.unwrap_or(f64::INFINITY)
+}
+
+/// The lines for a bias `bias` to fall within the standard error `se`: bias falls like 1 / lines, the
+/// standard error like 1 / sqrt(lines).
+fn lines_for_bias(lines: u64, bias: f64, se: f64) -> Option<u64> {
+    (se > 0.0 && se.is_finite() && bias.abs() > se)
+        .then(|| (lines as f64 * (bias / se).powi(2)).ceil() as u64)
+}
+
+/// The coverage part of a discrete reading's verdict.
+pub(crate) fn coverage_verdict(report: &SamplingReport) -> Reliability {
+    let c = report.sampling.coverage;
+    let mut r = Reliability::new(if c < COVERAGE_UNUSABLE {
+        Verdict::Unusable
+    } else if c < COVERAGE_OK {
+        Verdict::Undersampled
+    } else {
+        Verdict::Ok
+    });
+    if r.verdict != Verdict::Ok {
+        r.lines_needed = report.lines_for_coverage;
+    }
+    r
+}
+
+/// A plug-in reading with estimated bias `bias`.
+pub(crate) fn plug_in(e: Estimate, bias: f64, report: &SamplingReport, lines: u64) -> Reliability {
+    let mut r = coverage_verdict(report);
+    r.estimated_bias = Some(bias);
+    if bias.abs() > stderr(e) {
+        r.verdict = r.verdict.max(Verdict::Undersampled);
+        let for_bias = lines_for_bias(lines, bias, stderr(e));
+        r.lines_needed = r.lines_needed.max(for_bias);
+    }
+    r
+}
+
+/// Flags a reading below 0 (an entropy or mutual information).
+fn flag_negative(r: &mut Reliability, e: Estimate, what: &str) {
+    if e.value < -2.0 * e.stderr.unwrap_or(0.0) {
+        r.flag(format!("{what} is negative, which no scene allows"));
+    }
+}
+
+/// Flags a ratio outside [0, 1].
+fn flag_unit_interval(r: &mut Reliability, e: Estimate, what: &str) {
+    let se = e.stderr.unwrap_or(0.0);
+    if e.value < -2.0 * se || e.value > 1.0 + 2.0 * se {
+        r.flag(format!("{what} is outside [0, 1], which no scene allows"));
+    }
+}
+
+/// The verdicts on every visibility reading of a run of `lines` lines with `pairs` pairs; `sampling` is
+/// the rows' sampling when the discrete measures were counted.
+pub fn visibility(
+    v: &VisibilityEstimates,
+    sampling: Option<&SamplingReport>,
+    lines: u64,
+    pairs: u64,
+) -> VisibilityReliability {
+    let mut out = VisibilityReliability::default();
+    let isc = v.continuous_mutual_information;
+    if let Some(e) = isc {
+        let mut r = Reliability::new(if pairs >= MIN_PAIRS && e.stderr.is_some() {
+            Verdict::Ok
+        } else {
+            Verdict::Unusable
+        });
+        flag_negative(&mut r, e, "I_s^c");
+        out.continuous_mutual_information = Some(r);
+    }
+    let (Some(report), Some(h), Some(hc)) = (sampling, v.entropy, v.entropy_corrected) else {
+        return out;
+    };
+    // The plug-in H_s reads low by about the correction; I_s = X - H_s high by as much.
+    let bias = h.value - hc.value;
+    let isc_zero = isc.is_some_and(|c| c.value.abs() <= 3.0 * stderr(c));
+
+    let mut entropy = plug_in(h, bias, report, lines);
+    flag_negative(&mut entropy, h, "H_s");
+    out.entropy = Some(entropy);
+    let mut entropy_corrected = coverage_verdict(report);
+    flag_negative(&mut entropy_corrected, hc, "the corrected H_s");
+    out.entropy_corrected = Some(entropy_corrected);
+    out.joint_entropy = v.joint_entropy.map(|j| plug_in(j, bias, report, lines));
+
+    let mi_with = |e: Estimate, bias: Option<f64>, what: &str| {
+        let mut r = match bias {
+            Some(b) => plug_in(e, b, report, lines),
+            None => coverage_verdict(report),
+        };
+        flag_negative(&mut r, e, what);
+        if let Some(c) = isc.filter(|&c| clearly_above(e, c)) {
+            r.flag(format!(
+                "{what} {:.4} is above I_s^c {:.4}: Proposition 2 says I_s <= I_s^c; the rows are \
+                 undersampled",
+                e.value, c.value
+            ));
+        }
+        r
+    };
+    if let Some(mi) = v.mutual_information {
+        out.mutual_information = Some(mi_with(mi, Some(-bias), "I_s"));
+    }
+    if let Some(mi) = v.mutual_information_corrected {
+        out.mutual_information_corrected = Some(mi_with(mi, None, "the corrected I_s"));
+    }
+    let ratio = |e: Estimate, base: &Option<Reliability>, what: &str| {
+        // The ratio inherits the verdict of its I_s, not its flags (they are I_s's).
+        let mut r = base
+            .clone()
+            .unwrap_or_else(|| Reliability::new(Verdict::Unusable));
+        r.flags.clear();
+        r.estimated_bias = r.estimated_bias.zip(isc).map(|(b, c)| b / c.value);
+        flag_unit_interval(&mut r, e, what);
+        if isc_zero {
+            r.verdict = Verdict::Unusable;
+            r.flags
+                .push("I_s^c is not distinguishable from 0, so the ratio means nothing".into());
+        }
+        r
+    };
+    out.accuracy = v
+        .accuracy
+        .map(|e| ratio(e, &out.mutual_information, "the accuracy"));
+    out.accuracy_corrected = v.accuracy_corrected.map(|e| {
+        ratio(
+            e,
+            &out.mutual_information_corrected,
+            "the corrected accuracy",
+        )
+    });
+    out.relative_error = v.relative_error.map(|e| {
+        let mut r = ratio(e, &out.mutual_information, "the relative error");
+        r.estimated_bias = r.estimated_bias.map(|b| -b);
+        r
+    });
+    out.mse_per_line = v.mse_per_line.map(|e| {
+        let bias = report.sampling.mse_bias;
+        let mut r = Reliability::new(if bias.abs() <= stderr(e) {
+            Verdict::Ok
+        } else {
+            Verdict::Undersampled
+        });
+        r.estimated_bias = Some(bias);
+        r.lines_needed = lines_for_bias(lines, bias, stderr(e));
+        r
+    });
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn est(value: f64, stderr: f64) -> Option<Estimate> {
+        Some(Estimate {
+            value,
+            stderr: Some(stderr),
+        })
+    }
+
+    fn report(coverage: f64) -> SamplingReport {
+        SamplingReport {
+            sampling: Sampling {
+                rows: 100,
+                sampled_rows: 100,
+                segments_per_row: 1000.0,
+                coverage,
+                singleton_share: 0.1,
+                mse_bias: -0.001,
+            },
+            lines_for_coverage: Some(5_000_000),
+        }
+    }
+
+    fn readings(h: f64, hc: f64, isc: f64) -> VisibilityEstimates {
+        VisibilityEstimates {
+            positional_entropy: est(9.0, 0.0),
+            entropy: est(h, 0.001),
+            entropy_corrected: est(hc, 0.001),
+            joint_entropy: est(9.0 + h, 0.001),
+            mutual_information: est(9.0 - h, 0.001),
+            mutual_information_corrected: est(9.0 - hc, 0.001),
+            continuous_mutual_information: est(isc, 0.001),
+            accuracy: est((9.0 - h) / isc, 0.001),
+            accuracy_corrected: est((9.0 - hc) / isc, 0.001),
+            relative_error: est(1.0 - (9.0 - h) / isc, 0.001),
+            mse_per_line: est(500.0, 0.01),
+        }
+    }
+
+    /// Well sampled rows: every reading ok; a plug-in far from its correction: undersampled, with the
+    /// lines to fix it; low coverage: unusable.
+    #[test]
+    fn verdicts_follow_coverage_and_the_plug_in_bias() {
+        let r = visibility(
+            &readings(7.8, 7.8005, 1.6),
+            Some(&report(0.999)),
+            1_000_000,
+            1_000_000,
+        );
+        assert_eq!(r.mutual_information.as_ref().unwrap().verdict, Verdict::Ok);
+        assert_eq!(r.mutual_information_corrected.unwrap().verdict, Verdict::Ok);
+        assert_eq!(
+            r.continuous_mutual_information.unwrap().verdict,
+            Verdict::Ok
+        );
+
+        let r = visibility(
+            &readings(7.6, 7.8, 1.6),
+            Some(&report(0.999)),
+            1_000_000,
+            1_000_000,
+        );
+        let mi = r.mutual_information.unwrap();
+        assert_eq!(mi.verdict, Verdict::Undersampled);
+        assert!((mi.estimated_bias.unwrap() - 0.2).abs() < 1e-12);
+        // (0.2 / 0.001)^2 times the lines.
+        assert_eq!(mi.lines_needed, Some(40_000_000_000));
+        assert_eq!(r.mutual_information_corrected.unwrap().verdict, Verdict::Ok);
+
+        let r = visibility(
+            &readings(5.0, 7.5, 1.6),
+            Some(&report(0.3)),
+            100_000,
+            100_000,
+        );
+        assert_eq!(
+            r.mutual_information_corrected.unwrap().verdict,
+            Verdict::Unusable
+        );
+        assert_eq!(r.mse_per_line.unwrap().verdict, Verdict::Undersampled);
+    }
+
+    /// Readings beyond the theory's bounds are flagged and never ok.
+    #[test]
+    fn impossible_readings_are_flagged() {
+        // I_s = 3 > I_s^c = 1.6: Proposition 2 broken, accuracy 1.9 > 1.
+        let r = visibility(
+            &readings(6.0, 6.0, 1.6),
+            Some(&report(0.999)),
+            1_000_000,
+            1_000_000,
+        );
+        let mi = r.mutual_information.unwrap();
+        assert!(
+            mi.flags.iter().any(|f| f.contains("Proposition 2")),
+            "{mi:?}"
+        );
+        assert_ne!(mi.verdict, Verdict::Ok);
+        assert!(!r.accuracy.unwrap().flags.is_empty());
+        // A negative I_s^c, and a ratio over an I_s^c indistinguishable from 0.
+        let mut v = readings(7.8, 7.8, -0.5);
+        v.continuous_mutual_information = est(-0.5, 0.01);
+        let r = visibility(&v, Some(&report(0.999)), 100, 16);
+        assert!(!r.continuous_mutual_information.unwrap().flags.is_empty());
+        let mut v = readings(7.8, 7.8, 0.0005);
+        v.continuous_mutual_information = est(0.0005, 0.001);
+        let r = visibility(&v, Some(&report(0.999)), 1_000_000, 1_000_000);
+        assert_eq!(r.accuracy.unwrap().verdict, Verdict::Unusable);
+    }
+}
