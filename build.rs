@@ -31,8 +31,19 @@ mod embree {
         major: u32,
         /// The directory holding `embree{major}/rtcore.h`.
         include: PathBuf,
-        /// The directory holding the library, when found in a known place.
-        lib_dir: Option<PathBuf>,
+        /// The library, when found in the prefix.
+        library: Option<Library>,
+        /// Where the library was looked for (for the warning when it was not found).
+        looked_in: Vec<PathBuf>,
+    }
+
+    /// A library file found under a prefix.
+    struct Library {
+        dir: PathBuf,
+        /// `Some(file name)` when the linker cannot find it as `-lembree{major}`: a versioned name without
+        /// the development symlink (`libembree3.so.3`) or a Python wheel's suffixed one
+        /// (`libembree4-4aef3270.so.4`). It is then linked by its exact name.
+        verbatim: Option<String>,
     }
 
     pub fn build() {
@@ -71,11 +82,13 @@ mod embree {
             let include = prefix.join("include");
             for major in [4, 3] {
                 if include.join(format!("embree{major}/rtcore.h")).is_file() {
-                    let lib_dir = find_lib_dir(prefix, major);
+                    let looked_in = lib_dirs(prefix);
+                    let library = find_library(&looked_in, major);
                     return Ok(Embree {
                         major,
                         include,
-                        lib_dir,
+                        library,
+                        looked_in,
                     });
                 }
             }
@@ -90,20 +103,58 @@ mod embree {
         ))
     }
 
-    /// The library directory of a prefix that holds `libembree{major}`, if any.
-    fn find_lib_dir(prefix: &Path, major: u32) -> Option<PathBuf> {
+    /// The directories of a prefix that may hold the library.
+    fn lib_dirs(prefix: &Path) -> Vec<PathBuf> {
         let mut dirs = vec![prefix.join("lib"), prefix.join("lib64")];
         if let Some(multiarch) = multiarch() {
             dirs.push(prefix.join("lib").join(multiarch));
         }
-        let stem = format!("libembree{major}");
-        dirs.into_iter().find(|dir| {
-            let Ok(entries) = dir.read_dir() else {
-                return false;
-            };
-            entries.flatten().any(|e| {
-                let name = e.file_name().to_string_lossy().into_owned();
-                name.starts_with(&format!("{stem}.")) || name == format!("embree{major}.lib")
+        dirs
+    }
+
+    /// `libembree{major}` in the first of `dirs` that holds it, by preference: the name `-lembree{major}`
+    /// finds (`libembree4.so`, `libembree4.dylib`, `embree4.lib`), then a versioned one
+    /// (`libembree4.so.4`), then a wheel's suffixed one (`libembree4-<hash>.so.4`); within a kind, the
+    /// first in name order, so the choice does not depend on the directory's listing order.
+    fn find_library(dirs: &[PathBuf], major: u32) -> Option<Library> {
+        let plain = [
+            format!("libembree{major}.so"),
+            format!("libembree{major}.dylib"),
+            format!("embree{major}.lib"),
+        ];
+        let versioned = format!("libembree{major}.so.");
+        let versioned_mac = format!("libembree{major}.");
+        let suffixed = format!("libembree{major}-");
+        let rank = |name: &str| -> Option<u8> {
+            if plain.iter().any(|p| p == name) {
+                Some(0)
+            } else if name.starts_with(&versioned)
+                || (name.starts_with(&versioned_mac) && name.ends_with(".dylib"))
+            {
+                Some(1)
+            } else if name.starts_with(&suffixed)
+                && (name.contains(".so") || name.ends_with(".dylib"))
+            {
+                Some(2)
+            } else {
+                None
+            }
+        };
+        dirs.iter().find_map(|dir| {
+            let mut names: Vec<(u8, String)> = dir
+                .read_dir()
+                .ok()?
+                .flatten()
+                .filter_map(|e| {
+                    let name = e.file_name().into_string().ok()?;
+                    Some((rank(&name)?, name))
+                })
+                .collect();
+            names.sort();
+            let (rank, name) = names.into_iter().next()?;
+            Some(Library {
+                dir: dir.clone(),
+                verbatim: (rank > 0).then_some(name),
             })
         })
     }
@@ -186,21 +237,33 @@ mod embree {
     }
 
     fn link(embree: &Embree) {
-        match &embree.lib_dir {
-            Some(dir) => {
-                println!("cargo:rustc-link-search=native={}", dir.display());
-                // Outside the system directories the loader needs telling where the library is.
-                let system = dir.starts_with("/usr/lib") || dir.starts_with("/lib");
-                if !system && env::var("CARGO_CFG_TARGET_OS").as_deref() == Ok("linux") {
-                    println!("cargo:rustc-link-arg=-Wl,-rpath,{}", dir.display());
-                }
-            }
-            None => println!(
-                "cargo:warning=libembree{} not found next to {}; leaving it to the linker's search path",
-                embree.major,
-                embree.include.display()
-            ),
+        let major = embree.major;
+        let Some(library) = &embree.library else {
+            let looked: Vec<String> = embree
+                .looked_in
+                .iter()
+                .map(|d| d.display().to_string())
+                .collect();
+            println!(
+                "cargo:warning=libembree{major} not found in {} (looked for libembree{major}.so, \
+                 libembree{major}.so.N and libembree{major}-*.so*); leaving -lembree{major} to the linker's search path",
+                looked.join(", ")
+            );
+            println!("cargo:rustc-link-lib=embree{major}");
+            return;
+        };
+        let dir = &library.dir;
+        println!("cargo:rustc-link-search=native={}", dir.display());
+        // Outside the system directories the loader needs telling where the library is.
+        let system = dir.starts_with("/usr/lib") || dir.starts_with("/lib");
+        if !system && env::var("CARGO_CFG_TARGET_OS").as_deref() == Ok("linux") {
+            println!("cargo:rustc-link-arg=-Wl,-rpath,{}", dir.display());
         }
-        println!("cargo:rustc-link-lib=embree{}", embree.major);
+        match &library.verbatim {
+            // `-l:NAME` for the linker: the exact file, found through the search path above. Unlike a
+            // link argument, a link-lib also reaches the crates that depend on this one.
+            Some(name) => println!("cargo:rustc-link-lib=dylib:+verbatim={name}"),
+            None => println!("cargo:rustc-link-lib=embree{major}"),
+        }
     }
 }

@@ -1,8 +1,9 @@
 //! The evaluation behind the pure-Rust tracer's BVH (see `src/trace/rust/bvh.rs`), on the same inflated
 //! boxes and 10^6 global lines, each candidate decided by the watertight test, one thread:
 //!
-//! * obvhs's own all-hits traversals (`ray_traverse_anyhit`) of its compressed 8-wide BVH (CWBVH) and of
-//!   its binary BVH (`Bvh2`), leaves of at most 1 or 3 triangles;
+//! * obvhs's own traversals (`ray_traverse`, with a callback that never reports a hit, so that every
+//!   candidate within the line's span is offered) of its compressed 8-wide BVH (CWBVH) and of its binary
+//!   BVH (`Bvh2`), leaves of at most 1 or 3 triangles;
 //! * our tracer ([`BvhTracer::raw_hits`]: obvhs's CWBVH topology with exact f32 boxes, unordered
 //!   traversal) from several obvhs build presets and leaf sizes.
 //!
@@ -17,7 +18,11 @@ use scene_complexity::scenes;
 use std::time::Duration;
 
 use glam::Vec3A;
-use obvhs::{aabb::Aabb, ray::Ray, BvhBuildParams};
+use obvhs::{
+    aabb::Aabb,
+    ray::{Ray, RayHit},
+    BvhBuildParams,
+};
 use scene_complexity::sample::lines::batch_lines;
 use scene_complexity::scene::Scene;
 use scene_complexity::trace::rust::{bvh::margin, watertight::ShearedRay, BvhTracer};
@@ -69,7 +74,8 @@ fn main() -> anyhow::Result<()> {
     Ok(())
 }
 
-/// obvhs's `ray_traverse_anyhit` on its CWBVH and Bvh2 (medium build).
+/// obvhs's `ray_traverse` on its CWBVH and Bvh2 (medium build), as an all-hits traversal: the callback
+/// returns an infinite distance, so the line's span never shrinks and every crossed leaf is offered.
 fn obvhs_traversals(spec: &str, scene: &Scene, lines: &[Line]) {
     let tris: Vec<[[f32; 3]; 3]> = scene
         .triangles
@@ -78,13 +84,14 @@ fn obvhs_traversals(spec: &str, scene: &Scene, lines: &[Line]) {
         .collect();
     let boxes = inflated_boxes(scene, &tris);
     for leaf in [1u32, 3] {
-        let params = BvhBuildParams {
+        // A function, not a value: obvhs 0.2's parameters are neither Copy nor Clone.
+        let params = || BvhBuildParams {
             pre_split: false,
             max_prims_per_leaf: leaf,
             ..BvhBuildParams::medium_build()
         };
-        let cw = obvhs::cwbvh::builder::build_cwbvh(&boxes, params, &mut Duration::default());
-        let b2 = obvhs::bvh2::builder::build_bvh2(&boxes, params, &mut Duration::default());
+        let cw = obvhs::cwbvh::builder::build_cwbvh(&boxes, params(), &mut Duration::default());
+        let b2 = obvhs::bvh2::builder::build_bvh2(&boxes, params(), &mut Duration::default());
         for layout in ["cwbvh", "bvh2"] {
             let (mut hits, mut candidates) = (0usize, 0usize);
             let seconds = best_cpu_seconds(|| {
@@ -95,10 +102,17 @@ fn obvhs_traversals(spec: &str, scene: &Scene, lines: &[Line]) {
                         let [a, b, c] = tris[ids[slot] as usize];
                         hits += usize::from(sheared.intersect(a, b, c, 0.0, l.t_max).is_some());
                     };
+                    let mut no_hit = RayHit::none();
                     if layout == "cwbvh" {
-                        cw.ray_traverse_anyhit(ray(l), |_, id| decide(id, &cw.primitive_indices));
+                        cw.ray_traverse(ray(l), &mut no_hit, |_, id| {
+                            decide(id, &cw.primitive_indices);
+                            f32::INFINITY
+                        });
                     } else {
-                        b2.ray_traverse_anyhit(ray(l), |_, id| decide(id, &b2.primitive_indices));
+                        b2.ray_traverse(ray(l), &mut no_hit, |_, id| {
+                            decide(id, &b2.primitive_indices);
+                            f32::INFINITY
+                        });
                     }
                 }
             });

@@ -28,3 +28,7 @@ mod cli_reproduce;
 
 // The source's structure.
 mod layers;
+
+// The system-package setup script (`.ci/setup`), a bash script.
+#[cfg(unix)]
+mod setup;
