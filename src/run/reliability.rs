@@ -358,7 +358,8 @@ mod tests {
         assert_eq!(mi.verdict, Verdict::Undersampled);
         assert!((mi.estimated_bias.unwrap() - 0.2).abs() < 1e-12);
         // (0.2 / 0.001)^2 times the lines.
-        assert_eq!(mi.lines_needed, Some(40_000_000_000));
+        let needed = mi.lines_needed.unwrap() as f64;
+        assert!((needed / 4e10 - 1.0).abs() < 1e-9, "{needed}");
         assert_eq!(r.mutual_information_corrected.unwrap().verdict, Verdict::Ok);
 
         let r = visibility(
@@ -371,7 +372,8 @@ mod tests {
             r.mutual_information_corrected.unwrap().verdict,
             Verdict::Unusable
         );
-        assert_eq!(r.mse_per_line.unwrap().verdict, Verdict::Undersampled);
+        // E(MSE) has an unbiased estimate whatever the coverage: its bias (0.001) is within 0.01.
+        assert_eq!(r.mse_per_line.unwrap().verdict, Verdict::Ok);
     }
 
     /// Readings beyond the theory's bounds are flagged and never ok.

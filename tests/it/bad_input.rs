@@ -188,9 +188,16 @@ fn bad_arguments_and_built_in_names_are_errors() {
         &["analyze", "@cube", "--lines", "0"],
         &["--lines", "whole number from 1"],
     );
+    // A negative value reaches the parser (not "unexpected argument '-5'") and gets a sentence.
+    for args in [
+        &["analyze", "@cube", "--lines=-5"][..],
+        &["analyze", "@cube", "--lines", "-5"],
+    ] {
+        assert_rejected(args, &["--lines", "cannot be negative"]);
+    }
     assert_rejected(
-        &["analyze", "@cube", "--lines=-5"],
-        &["--lines", "whole number from 1"],
+        &["analyze", "@cube", "--seed", "-1"],
+        &["--seed", "cannot be negative"],
     );
     assert_rejected(
         &["analyze", "@nosuch"],

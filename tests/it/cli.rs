@@ -26,7 +26,10 @@ fn json_report_parses_and_carries_the_documented_fields() {
         String::from_utf8_lossy(&out.stderr)
     );
     let doc: serde_json::Value = serde_json::from_slice(&out.stdout).expect("valid JSON");
-    assert_eq!(doc["schema_version"], 1);
+    assert_eq!(doc["schema_version"], 2);
+    assert_eq!(doc["unit"], "bit");
+    assert_eq!(doc["command_line"][1], "analyze");
+    assert!(doc["cpu"].as_str().is_some_and(|c| !c.is_empty()));
     assert_eq!(doc["scene"], "@cube:3");
     assert_eq!(doc["patches"], 54);
     assert_eq!(doc["triangles"], 108);
@@ -250,7 +253,9 @@ fn ctrl_c_stops_cleanly_with_a_report_marked_interrupted() {
         .unwrap();
     assert!(status.success());
     let out = child.wait_with_output().unwrap();
-    let doc = json_of(&out);
+    // A report of a partial run must not look like success to a script.
+    assert_eq!(out.status.code(), Some(130));
+    let doc: serde_json::Value = serde_json::from_slice(&out.stdout).expect("valid JSON");
     assert_eq!(doc["interrupted"], true);
     assert_eq!(doc["stop_reason"], "interrupted");
     assert!(doc["lines"].as_u64().unwrap() > 0);
@@ -291,7 +296,11 @@ fn convergence_writes_a_table_a_csv_and_a_plot() {
     assert_eq!(rows.lines().count(), 1 + 2 * 2 * 8, "{rows}");
     let plot = std::fs::read_to_string(&svg).unwrap();
     assert!(
-        plot.starts_with("<svg") && plot.contains("run time") && plot.contains("I_s corrected")
+        plot.starts_with("<svg")
+            && plot.contains("run time (s, log scale)")
+            && plot.contains("error (bits, log scale)")
+            && plot.contains("mutual information I(s), corrected"),
+        "{plot}"
     );
 }
 

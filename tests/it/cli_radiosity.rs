@@ -74,7 +74,12 @@ fn table_and_csv_show_the_radiosity_measures() {
         "analyze", "@cornell", "--lines", "1e4", "--tracer", "rust", "--format", "csv",
     ]);
     let text = String::from_utf8_lossy(&csv.stdout);
-    assert!(text.contains("\nradiosity_mutual_information,"), "{text}");
+    let rows: Vec<&str> = text
+        .lines()
+        .filter(|l| l.contains(",radiosity,mutual_information,bit,"))
+        .collect();
+    assert_eq!(rows.len(), 1, "{text}");
+    assert!(rows[0].starts_with("@cornell,10000,1,rust,"), "{text}");
 }
 
 /// A closed room (unit cube, quads facing in) with one emitting wall, as OBJ + MTL.

@@ -3,10 +3,10 @@
 //!
 //! # Why obvhs's build, and our own traversal
 //!
-//! We need a well-kept BVH builder. `obvhs` (0.4, MIT/Apache-2.0, maintained, edition 2024: it needs
-//! Rust >= 1.85 and builds on our 1.95; pure Rust, no `unsafe` needed on our side) builds a binary BVH
+//! We need a well-kept BVH builder. `obvhs` (0.2, MIT/Apache-2.0, maintained; 0.3 and 0.4 need Rust
+//! 1.88, 0.2 builds with Debian 13's 1.85; pure Rust, no `unsafe` needed on our side) builds a binary BVH
 //! (`Bvh2`) and from it the 8-wide compressed BVH of Ylitie, Karras and Laine (HPG 2017, `CwBvh`), and traverses
-//! both with `ray_traverse_anyhit`, which offers every primitive whose box the ray crosses. That
+//! both with `ray_traverse`, which offers every primitive whose box the ray crosses. That
 //! traversal is made for nearest hits: at every node it decodes 8-bit quantized child boxes and orders
 //! the children by the ray's octant. A global line keeps every intersection, so order is worthless to us;
 //! we keep obvhs's CWBVH *topology* (its SAH collapse into 8-wide nodes and leaves of up to 3 triangles)
