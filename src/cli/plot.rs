@@ -2,7 +2,7 @@
 //!
 //! Readable by everyone: the Okabe–Ito colours (safe for the common colour-vision deficiencies), and a
 //! marker shape per measure besides its colour; standard errors solid, distances to the largest run
-//! dashed; every point labelled with its line count; ticks in one notation; axes with their units.
+//! dashed; the points labelled with their line counts; ticks in one notation; axes with their units.
 
 use std::path::Path;
 
@@ -195,8 +195,8 @@ fn draw<DB: DrawingBackend>(
                 .iter()
                 .map(|p| EmptyElement::at((p.0, p.1)) + marker::<DB>(c.series, (0, 0), colour)),
         )?;
-        // Line counts beside the standard-error points (the distances share their x).
-        if !c.dashed {
+        // Line counts beside the first curve's points (every curve shares their x, and run time).
+        if std::ptr::eq(c, &curves[0]) {
             chart.draw_series(c.points.iter().map(|p| {
                 EmptyElement::at((p.0, p.1))
                     + Text::new(p.2.clone(), (7, -16), ("sans-serif", 12).into_font())
@@ -208,7 +208,7 @@ fn draw<DB: DrawingBackend>(
         .background_style(WHITE.mix(0.9))
         .border_style(BLACK)
         .label_font(("sans-serif", 13))
-        .position(SeriesLabelPosition::LowerLeft)
+        .position(SeriesLabelPosition::UpperRight)
         .draw()?;
     area.present()
 }

@@ -463,7 +463,12 @@ fn add_rows(t: &mut Table, rows: &[Row], notes: &mut Vec<String>) {
             .into_iter()
             .flatten()
         {
-            notes.extend(rel.flags.iter().map(|f| format!("! {f}")));
+            for f in &rel.flags {
+                let note = format!("! {f}");
+                if !notes.contains(&note) {
+                    notes.push(note);
+                }
+            }
         }
     }
 }

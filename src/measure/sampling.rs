@@ -194,7 +194,12 @@ mod tests {
                 + a[1] * row_coverage(&rows[1], 50.0 * (k - 1.0))
         };
         // Found to 1%: reached at k, not at k / 1.01.
-        assert!(at(k) >= 0.99 && at(k / 1.01) < 0.99, "{} {}", at(k), at(k / 1.01));
+        assert!(
+            at(k) >= 0.99 && at(k / 1.01) < 0.99,
+            "{} {}",
+            at(k),
+            at(k / 1.01)
+        );
         assert_eq!(lines_factor_for_coverage(&a, &rows, 0.1), Some(1.0));
     }
 }

@@ -310,7 +310,7 @@ impl Session<'_> {
         };
         let a = analyze(scene, tracer.as_ref(), &cfg, &RunControl::default())?;
         let radiosity = match &a.radiosity {
-            RadiosityOutcome::Computed(r) => Some(r.clone()),
+            RadiosityOutcome::Computed(r) => Some((**r).clone()),
             _ => None,
         };
         let seconds = start.elapsed().as_secs_f64();

@@ -63,8 +63,8 @@ pub struct RadiosityReliability {
 /// The radiosity measures, or why there are none.
 #[derive(Clone, Debug, PartialEq)]
 pub enum RadiosityOutcome {
-    /// Computed.
-    Computed(RadiosityEstimates),
+    /// Computed (boxed: the estimates are large beside the other variants).
+    Computed(Box<RadiosityEstimates>),
     /// Not asked for.
     NotRequested,
     /// Left out, with the reason for the report.
@@ -149,7 +149,7 @@ pub(crate) fn estimates(
         mutual_information: plug_in(mutual_information, -bias, sampling, lines),
         mutual_information_corrected: coverage_verdict(sampling),
     };
-    Ok(RadiosityOutcome::Computed(RadiosityEstimates {
+    Ok(RadiosityOutcome::Computed(Box::new(RadiosityEstimates {
         positional_entropy: est(|v| v.positional_entropy),
         entropy,
         mutual_information,
@@ -161,7 +161,7 @@ pub(crate) fn estimates(
         solver_sweeps: solution.sweeps,
         excluded_patches: all.excluded_patches,
         excluded_area_fraction: all.excluded_area_fraction,
-    }))
+    })))
 }
 
 /// Solves the radiosity system on a tally's form factors and measures it; `Ok(None)` when no patch is

@@ -192,8 +192,44 @@ fn flag_unit_interval(r: &mut Reliability, e: Estimate, what: &str) {
 }
 
 /// The verdicts on every visibility reading of a run of `lines` lines with `pairs` pairs; `sampling` is
-/// the rows' sampling when the discrete measures were counted.
+/// the rows' sampling when the discrete measures were counted. A reading without a standard error (too
+/// few groups with lines) is `unusable`: nothing tells how far off it is.
 pub fn visibility(
+    v: &VisibilityEstimates,
+    sampling: Option<&SamplingReport>,
+    lines: u64,
+    pairs: u64,
+) -> VisibilityReliability {
+    let mut out = verdicts(v, sampling, lines, pairs);
+    let pairs_of = [
+        (v.entropy, &mut out.entropy),
+        (v.entropy_corrected, &mut out.entropy_corrected),
+        (v.joint_entropy, &mut out.joint_entropy),
+        (v.mutual_information, &mut out.mutual_information),
+        (
+            v.mutual_information_corrected,
+            &mut out.mutual_information_corrected,
+        ),
+        (
+            v.continuous_mutual_information,
+            &mut out.continuous_mutual_information,
+        ),
+        (v.accuracy, &mut out.accuracy),
+        (v.accuracy_corrected, &mut out.accuracy_corrected),
+        (v.relative_error, &mut out.relative_error),
+        (v.mse_per_line, &mut out.mse_per_line),
+    ];
+    for (e, r) in pairs_of {
+        if let (Some(e), Some(r)) = (e, r.as_mut()) {
+            if e.stderr.is_none() {
+                r.verdict = Verdict::Unusable;
+            }
+        }
+    }
+    out
+}
+
+fn verdicts(
     v: &VisibilityEstimates,
     sampling: Option<&SamplingReport>,
     lines: u64,

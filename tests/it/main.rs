@@ -22,6 +22,8 @@ mod bad_input;
 #[cfg(feature = "cli")]
 mod cli;
 #[cfg(feature = "cli")]
+mod cli_honest;
+#[cfg(feature = "cli")]
 mod cli_radiosity;
 #[cfg(feature = "cli")]
 mod cli_reproduce;
