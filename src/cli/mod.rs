@@ -7,6 +7,7 @@ mod crosscheck;
 mod docs;
 mod export;
 mod input;
+mod merge;
 mod output;
 mod plot;
 mod progress;
@@ -92,6 +93,14 @@ enum Command {
     /// for measure; exit 1 when a line differs beyond the tolerance.
     #[command(after_help = "Example:\n  scx crosscheck @cubes512 --lines 1e6")]
     Crosscheck(crosscheck::CrosscheckArgs),
+    /// Join the saved states of a run's shards (`analyze --shard K/M --save FILE`) into the report of the
+    /// whole run, identical to casting it at once.
+    #[command(after_help = concat!(
+        "Example:\n",
+        "  for k in 1 2 3 4; do scx analyze @cube:30 --lines 1e9 --shard $k/4 --save part-$k.scx & done; wait\n",
+        "  scx merge part-*.scx --format json -o cube30.json"
+    ))]
+    Merge(merge::MergeArgs),
     /// Regenerate the paper's Tables 1 to 9 and print each beside the published values (Markdown).
     #[command(after_help = "Example:\n  scx reproduce --table 4 --lines x0.1 -o table4.md")]
     Reproduce(reproduce::ReproduceArgs),
@@ -141,6 +150,7 @@ pub fn main() -> ExitCode {
         Command::Refine(args) => refine::run(&args),
         Command::Crosscheck(args) => crosscheck::run(&args),
         Command::Reproduce(args) => reproduce::run(&args),
+        Command::Merge(args) => merge::run(&args),
         Command::Completions(args) => docs::completions(&args),
         Command::Man(args) => docs::man(&args),
     };

@@ -27,6 +27,8 @@ mod cli_honest;
 mod cli_radiosity;
 #[cfg(feature = "cli")]
 mod cli_reproduce;
+#[cfg(feature = "cli")]
+mod runs;
 
 // The source's structure.
 mod layers;
