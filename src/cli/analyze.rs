@@ -6,9 +6,8 @@ use std::time::{Duration, Instant};
 use clap::ValueEnum;
 use scene_complexity::run::persist;
 use scene_complexity::run::{
-    cast, finish, plan_of, remaining_lines, start, AnalysisConfig, AnalysisError, Budget,
-    CastOptions, Measures, PersistError, RunControl, RunIdentity, RunState, Scope, StopReason,
-    Target, TargetMeasure,
+    cast, finish, plan_of, remaining_lines, start, AnalysisConfig, Budget, CastOptions, Measures,
+    PersistError, RunControl, RunIdentity, RunState, Scope, StopReason, Target, TargetMeasure,
 };
 use scene_complexity::sample::lines::LineSource;
 use scene_complexity::trace::{Backend, Query};
@@ -180,7 +179,7 @@ fn new_run(args: &AnalyzeArgs, spec: &str) -> Result<Prepared, Failure> {
              read it again): save the scene to a file",
         ));
     }
-    let state = start(&runner.scene, &cfg).map_err(analysis_failure)?;
+    let state = start(&runner.scene, &cfg).map_err(Failure::of)?;
     let identity = RunIdentity::of(
         spec,
         &runner.scene,
@@ -274,17 +273,6 @@ pub fn persist_failure(e: PersistError) -> Failure {
             Exit::BadInput
         } else {
             Exit::Io
-        },
-        message: e.to_string(),
-    }
-}
-
-fn analysis_failure(e: AnalysisError) -> Failure {
-    Failure {
-        code: if e.is_bad_input() {
-            Exit::BadInput
-        } else {
-            Exit::Failed
         },
         message: e.to_string(),
     }
@@ -386,8 +374,7 @@ pub fn run(args: &AnalyzeArgs) -> Result<Exit, Failure> {
         persist::save(path, &identity, &state, seconds).map_err(persist_failure)?;
         output::wrote(path);
     }
-    let analysis =
-        finish(&runner.scene, &cfg, state, stop_reason, seconds).map_err(analysis_failure)?;
+    let analysis = finish(&runner.scene, &cfg, state, stop_reason, seconds).map_err(Failure::of)?;
     for w in &analysis.warnings {
         warn(&w.message);
     }
@@ -396,11 +383,7 @@ pub fn run(args: &AnalyzeArgs) -> Result<Exit, Failure> {
         shard: identity.shard,
         ..runner.info()
     };
-    let text = match args.format {
-        Format::Table => report::table(&run, &analysis),
-        Format::Json => report::json(&run, &analysis),
-        Format::Csv => report::csv(&run, &analysis),
-    };
+    let text = report::render(args.format, &run, &analysis);
     output::emit(args.out.output.as_deref(), &text)?;
     Ok(if analysis.stop_reason == StopReason::Interrupted {
         Exit::Interrupted

@@ -140,14 +140,7 @@ pub fn run(args: &MergeArgs) -> Result<Exit, Failure> {
         .in_pool(None, "", || {
             finish(&runner.scene, &cfg, state, StopReason::Lines, seconds)
         })
-        .map_err(|e| Failure {
-            code: if e.is_bad_input() {
-                Exit::BadInput
-            } else {
-                Exit::Failed
-            },
-            message: e.to_string(),
-        })?;
+        .map_err(Failure::of)?;
     for w in &analysis.warnings {
         warn(&w.message);
     }
@@ -156,11 +149,7 @@ pub fn run(args: &MergeArgs) -> Result<Exit, Failure> {
         shard: None,
         ..runner.info()
     };
-    let text = match args.format {
-        Format::Table => report::table(&info, &analysis),
-        Format::Json => report::json(&info, &analysis),
-        Format::Csv => report::csv(&info, &analysis),
-    };
+    let text = report::render(args.format, &info, &analysis);
     output::emit(args.out.output.as_deref(), &text)?;
     Ok(Exit::Ok)
 }

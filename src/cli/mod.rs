@@ -128,7 +128,41 @@ pub struct Failure {
     message: String,
 }
 
+/// A library error that tells whether the user's input is at fault.
+pub trait InputError: std::fmt::Display {
+    /// Whether the input (a scene, materials, settings) is at fault, not the machinery.
+    fn is_bad_input(&self) -> bool;
+}
+
+macro_rules! input_errors {
+    ($($t:ty),*) => {$(
+        impl InputError for $t {
+            fn is_bad_input(&self) -> bool {
+                <$t>::is_bad_input(self)
+            }
+        }
+    )*};
+}
+
+input_errors!(
+    scene_complexity::run::AnalysisError,
+    scene_complexity::refine::RefineError,
+    scene_complexity::reproduce::ReproduceError
+);
+
 impl Failure {
+    /// A library error: bad input (2) when the input is at fault, else a failure (1).
+    pub fn of(e: impl InputError) -> Self {
+        Failure {
+            code: if e.is_bad_input() {
+                Exit::BadInput
+            } else {
+                Exit::Failed
+            },
+            message: e.to_string(),
+        }
+    }
+
     /// Bad input (exit code 2).
     pub fn bad_input(message: impl ToString) -> Self {
         Failure {

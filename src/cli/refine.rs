@@ -102,14 +102,7 @@ pub fn run(args: &RefineArgs) -> Result<Exit, Failure> {
                 &mut log,
             )
         })
-        .map_err(|e| Failure {
-            code: if e.is_bad_input() {
-                Exit::BadInput
-            } else {
-                Exit::Failed
-            },
-            message: e.to_string(),
-        })?;
+        .map_err(Failure::of)?;
     obj::write(&refined.scene, &args.output).map_err(|e| Failure {
         code: Exit::Io,
         message: e.to_string(),

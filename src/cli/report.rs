@@ -12,7 +12,17 @@ use scene_complexity::run::{
 use scene_complexity::scene::Scene;
 use serde_json::{json, Value};
 
+use super::analyze::Format;
 use super::table::{fixed, Align, Table};
+
+/// The report of an analysis in `format`.
+pub fn render(format: Format, run: &RunInfo, a: &Analysis) -> String {
+    match format {
+        Format::Table => table(run, a),
+        Format::Json => json(run, a),
+        Format::Csv => csv(run, a),
+    }
+}
 
 /// JSON schema version of `analyze --format json` (2: units, reliability, sampling, target, command
 /// line, CPU).

@@ -74,14 +74,7 @@ impl Runner {
             self.pool
                 .install(|| analyze(&self.scene, self.tracer.as_ref(), cfg, &self.control))
         })
-        .map_err(|e| Failure {
-            code: if e.is_bad_input() {
-                Exit::BadInput
-            } else {
-                Exit::Failed
-            },
-            message: e.to_string(),
-        })
+        .map_err(Failure::of)
     }
 
     /// Facts about the run for the reports.
