@@ -14,8 +14,9 @@ use scene_complexity::trace::{Backend, Query};
 
 use super::args::{parse_count, parse_positive, parse_target_measure, ReportOutput, RunOptions};
 use super::output::{self, warn};
+use super::report::{self, Format};
 use super::runner::Runner;
-use super::{report, Exit, Failure};
+use super::{Exit, Failure};
 
 /// Arguments of `scx analyze`.
 #[derive(clap::Args, Debug)]
@@ -91,17 +92,6 @@ enum MeasureArg {
     Discrete,
     Continuous,
     Radiosity,
-}
-
-/// Output formats of a report.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub enum Format {
-    /// A readable table.
-    Table,
-    /// One JSON document.
-    Json,
-    /// CSV rows with a header.
-    Csv,
 }
 
 /// A shard `K/M`, 1 <= K <= M.

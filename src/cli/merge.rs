@@ -7,9 +7,10 @@ use scene_complexity::run::persist;
 use scene_complexity::run::{finish, RunState, SavedRun, StopReason};
 use scene_complexity::trace::{Backend, Query};
 
-use super::analyze::{check_same_scene, persist_failure, Format};
+use super::analyze::{check_same_scene, persist_failure};
 use super::args::{parse_threads, ReportOutput};
 use super::output::{self, check_all, warn};
+use super::report::Format;
 use super::runner::Runner;
 use super::{report, Exit, Failure};
 

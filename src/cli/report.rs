@@ -4,6 +4,8 @@
 
 use std::fmt::Write;
 
+use clap::ValueEnum;
+
 use scene_complexity::measure::Estimate;
 use scene_complexity::run::{
     Analysis, ErrorMethod, RadiosityEstimates, RadiosityOutcome, Reliability, StopReason,
@@ -12,8 +14,18 @@ use scene_complexity::run::{
 use scene_complexity::scene::Scene;
 use serde_json::{json, Value};
 
-use super::analyze::Format;
 use super::table::{fixed, Align, Table};
+
+/// Output formats of a report.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum Format {
+    /// A readable table.
+    Table,
+    /// One JSON document.
+    Json,
+    /// CSV rows with a header.
+    Csv,
+}
 
 /// The report of an analysis in `format`.
 pub fn render(format: Format, run: &RunInfo, a: &Analysis) -> String {
