@@ -20,7 +20,7 @@ use scene_complexity::run::{
     TargetMeasure, DEFAULT_ESTIMATOR, DEFAULT_GROUPS,
 };
 use scene_complexity::sample::lines::LineSource;
-use scene_complexity::scene;
+use scene_complexity::scene::{self, ObjectSet, Planarity, SceneOptions, DEFAULT_PLANARITY};
 use scene_complexity::scenes;
 use scene_complexity::trace::{make_tracer, Backend, Query};
 
@@ -39,7 +39,7 @@ enum Command {
     Analyze(AnalyzeArgs),
     /// List the built-in scenes and their parameters.
     Scenes,
-    /// Write a scene (built-in or file) as OBJ + MTL.
+    /// Write a scene (built-in or file) as OBJ + MTL, or as glTF (`-o scene.gltf` or `.glb`).
     Export(ExportArgs),
     /// Run a scene at growing line counts: every measure with its error against run time.
     Convergence(ConvergenceArgs),
@@ -54,8 +54,10 @@ enum Command {
 
 #[derive(clap::Args, Debug)]
 struct CrosscheckArgs {
-    /// An OBJ file, or a built-in scene such as `@cube:10` (see `scx scenes`).
+    /// A scene file (OBJ, glTF, PLY, STL), or a built-in scene such as `@cube:10` (see `scx scenes`).
     scene: String,
+    #[command(flatten)]
+    input: SceneArgs,
     /// Number of global lines (accepts `1e6`).
     #[arg(long, default_value = "1e6", value_parser = parse_count)]
     lines: u64,
@@ -75,8 +77,10 @@ struct CrosscheckArgs {
 
 #[derive(clap::Args, Debug)]
 struct RefineArgs {
-    /// An OBJ file, or a built-in scene such as `@cornell`.
+    /// A scene file (OBJ, glTF, PLY, STL), or a built-in scene such as `@cornell`.
     scene: String,
+    #[command(flatten)]
+    input: SceneArgs,
     /// Which patches to split: uniform (all, largest first), power (A_i B_i), smoothness (variation of
     /// received radiosity over the patch), information (loss of information transfer).
     #[arg(long, value_enum)]
@@ -114,16 +118,61 @@ enum StrategyArg {
 
 #[derive(clap::Args, Debug)]
 struct ExportArgs {
-    /// An OBJ file, or a built-in scene such as `@cube:10`.
+    /// A scene file (OBJ, glTF, PLY, STL), or a built-in scene such as `@cube:10`.
     scene: String,
-    /// The OBJ file to write; the MTL library goes beside it.
+    #[command(flatten)]
+    input: SceneArgs,
+    /// The file to write: `.gltf` or `.glb` writes glTF 2.0, anything else OBJ with its MTL library
+    /// beside it.
     #[arg(short, long)]
     output: std::path::PathBuf,
+}
+
+/// How a scene file is read: non-planar polygons, and objects to flip or make two-sided.
+#[derive(clap::Args, Debug, Clone)]
+struct SceneArgs {
+    /// A polygon whose corners leave its plane by at most this fraction of its size is planar (one
+    /// patch); a less planar one is split into planar triangles (one warning per file).
+    #[arg(long, default_value_t = DEFAULT_PLANARITY, value_parser = parse_tolerance)]
+    planarity: f64,
+    /// Refuse non-planar polygons (exit 2, naming the first) instead of splitting them.
+    #[arg(long)]
+    strict_planarity: bool,
+    /// Reverse the normals of these objects (comma separated names: OBJ `o`/`g`, glTF node or mesh, the
+    /// file name for PLY and STL); without a list, of every object. Put it after the scene.
+    #[arg(long, value_name = "OBJECT,...", num_args = 0..=1, value_delimiter = ',', default_missing_value = "")]
+    flip_normals: Option<Vec<String>>,
+    /// Make these objects two-sided (two patches back to back, one per side, each with the face's area
+    /// and material); without a list, every object. Put it after the scene.
+    #[arg(long, value_name = "OBJECT,...", num_args = 0..=1, value_delimiter = ',', default_missing_value = "")]
+    two_sided: Option<Vec<String>>,
+}
+
+impl SceneArgs {
+    fn options(&self) -> SceneOptions {
+        let set = |names: &Option<Vec<String>>| match names {
+            None => ObjectSet::None,
+            Some(list) if list.iter().all(|n| n.is_empty()) => ObjectSet::All,
+            Some(list) => {
+                ObjectSet::Named(list.iter().filter(|n| !n.is_empty()).cloned().collect())
+            }
+        };
+        SceneOptions {
+            planarity: Planarity {
+                tolerance: self.planarity,
+                strict: self.strict_planarity,
+            },
+            flip_normals: set(&self.flip_normals),
+            two_sided: set(&self.two_sided),
+        }
+    }
 }
 
 /// Options shared by every command that casts lines.
 #[derive(clap::Args, Debug)]
 struct RunOptions {
+    #[command(flatten)]
+    input: SceneArgs,
     /// Seed of the random line streams.
     #[arg(long, default_value_t = 1)]
     seed: u64,
@@ -152,7 +201,7 @@ struct RunOptions {
 
 #[derive(clap::Args, Debug)]
 struct AnalyzeArgs {
-    /// An OBJ file, or a built-in scene such as `@cube:10` (see `scx scenes`).
+    /// A scene file (OBJ, glTF, PLY, STL), or a built-in scene such as `@cube:10` (see `scx scenes`).
     scene: String,
     /// Number of global lines (accepts `1e7`; default 1e6, or no limit with a budget).
     #[arg(long, value_parser = parse_count)]
@@ -190,7 +239,7 @@ struct AnalyzeArgs {
 
 #[derive(clap::Args, Debug)]
 struct ConvergenceArgs {
-    /// An OBJ file, or a built-in scene such as `@cube:30`.
+    /// A scene file (OBJ, glTF, PLY, STL), or a built-in scene such as `@cube:30`.
     scene: String,
     /// The line counts to run, comma separated.
     #[arg(long, value_delimiter = ',', value_parser = parse_count, default_value = "1e4,1e5,1e6,1e7")]
@@ -242,6 +291,15 @@ fn parse_count(s: &str) -> Result<u64, String> {
         return Err(format!("`{s}`: need a whole number from 1 to 1e15"));
     }
     Ok(v as u64)
+}
+
+fn parse_tolerance(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(v) if v.is_finite() && v >= 0.0 => Ok(v),
+        _ => Err(format!(
+            "`{s}`: need a number >= 0 (a fraction of the polygon's size)"
+        )),
+    }
 }
 
 fn parse_positive(s: &str) -> Result<f64, String> {
@@ -322,8 +380,8 @@ fn finish(result: Result<(), Failure>) -> ExitCode {
     }
 }
 
-fn load_scene(spec: &str) -> Result<scene::Scene, Failure> {
-    let scene = scenes::load(spec).map_err(bad_input)?;
+fn load_scene(spec: &str, input: &SceneArgs) -> Result<scene::Scene, Failure> {
+    let scene = scenes::load_with(spec, &input.options()).map_err(bad_input)?;
     for w in &scene.warnings {
         eprintln!("scx: warning: {w}");
     }
@@ -331,15 +389,25 @@ fn load_scene(spec: &str) -> Result<scene::Scene, Failure> {
 }
 
 fn try_export(args: &ExportArgs) -> Result<(), Failure> {
-    let scene = load_scene(&args.scene)?;
-    scene::obj::write(&scene, &args.output).map_err(|e| Failure {
+    let scene = load_scene(&args.scene, &args.input)?;
+    let gltf = args
+        .output
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("gltf") || e.eq_ignore_ascii_case("glb"));
+    let written = if gltf {
+        scene::gltf::write(&scene, &args.output)
+    } else {
+        scene::obj::write(&scene, &args.output)
+    };
+    written.map_err(|e| Failure {
         code: 1,
         message: e.to_string(),
     })?;
     eprintln!(
-        "scx: wrote {} ({} patches) and its MTL library",
+        "scx: wrote {} ({} patches){}",
         args.output.display(),
-        scene.patch_count()
+        scene.patch_count(),
+        if gltf { "" } else { " and its MTL library" }
     );
     Ok(())
 }
@@ -369,7 +437,7 @@ struct Runner {
 
 impl Runner {
     fn new(spec: &str, opts: &RunOptions) -> Result<Runner, Failure> {
-        let scene = load_scene(spec)?;
+        let scene = load_scene(spec, &opts.input)?;
         let backend = match opts.tracer {
             Some(TracerArg::Embree) => Backend::Embree,
             Some(TracerArg::Rust) => Backend::Rust,
@@ -471,7 +539,7 @@ fn try_analyze(args: &AnalyzeArgs) -> Result<(), Failure> {
 }
 
 fn try_refine(args: &RefineArgs) -> Result<(), Failure> {
-    let scene = load_scene(&args.scene)?;
+    let scene = load_scene(&args.scene, &args.input)?;
     let backend = match args.tracer {
         Some(TracerArg::Embree) => Backend::Embree,
         Some(TracerArg::Rust) => Backend::Rust,
@@ -540,7 +608,7 @@ fn try_crosscheck(args: &CrosscheckArgs) -> Result<(), Failure> {
             args.ulps
         )));
     }
-    let scene = load_scene(&args.scene)?;
+    let scene = load_scene(&args.scene, &args.input)?;
     let embree = make_tracer(Backend::Embree, &scene, Query::Single).map_err(bad_input)?;
     let rust = make_tracer(Backend::Rust, &scene, Query::Single).map_err(bad_input)?;
     let (_, pool) = thread_pool(args.threads)?;

@@ -298,7 +298,8 @@ fn table2(s: &mut Session) -> Result<TableReport, ReproduceError> {
         ]);
         runs.push((n, lines, r));
     }
-    t.notes.extend(capped_note(s, &published::TABLE2.map(|r| r.1)));
+    t.notes
+        .extend(capped_note(s, &published::TABLE2.map(|r| r.1)));
     t.findings = table2_findings(s, &runs);
     Ok(t)
 }
@@ -397,7 +398,8 @@ fn table3(s: &mut Session) -> Result<TableReport, ReproduceError> {
         ]);
         runs.push(r);
     }
-    t.notes.extend(capped_note(s, &published::TABLE3.map(|r| r.0)));
+    t.notes
+        .extend(capped_note(s, &published::TABLE3.map(|r| r.0)));
     let last = runs
         .last()
         .expect("four runs")
@@ -541,7 +543,11 @@ fn table5(s: &mut Session) -> Result<TableReport, ReproduceError> {
 
 fn table67(s: &mut Session, number: u8) -> Result<TableReport, ReproduceError> {
     let (fig, data, what) = if number == 6 {
-        ("5", &published::TABLE6, "cubes finer: faces 2 x 2, walls 8 x 8")
+        (
+            "5",
+            &published::TABLE6,
+            "cubes finer: faces 2 x 2, walls 8 x 8",
+        )
     } else {
         (
             "6",

@@ -9,8 +9,8 @@ mod crosscheck;
 #[cfg(feature = "embree")]
 mod embree_backend;
 mod errors;
-mod lines_and_tracers;
 mod findings;
+mod lines_and_tracers;
 mod radiosity;
 mod rust_bvh;
 mod stability;
