@@ -28,7 +28,7 @@ use crate::measure::rows::Rows;
 use crate::measure::visibility::{self, ContinuousValues, DiscreteValues};
 use crate::measure::Estimate;
 use crate::sample::lines::LineSource;
-use crate::sample::tally::{Tally, Wanted};
+use crate::sample::tally::{ObjectSides, Tally, Wanted};
 use crate::scene::Scene;
 use crate::trace::{TraceError, Tracer};
 
@@ -214,6 +214,8 @@ pub struct Analysis {
     pub radiosity: RadiosityOutcome,
     /// What the user must know about these numbers (an open scene, unsampled patches, ...).
     pub warnings: Vec<RunWarning>,
+    /// Per object of the scene: how lines met its sides (the evidence behind the orientation warnings).
+    pub orientation: Vec<ObjectSides>,
     /// The full-run counts, for form factors (when counted).
     pub tally: Tally,
 }
@@ -328,12 +330,17 @@ pub fn analyze(
         )?,
     };
     let FinishedRun { total, .. } = run;
-    let warnings = warnings::of_run(
+    let mut warnings = warnings::of_run(
         &scene.name,
         &total.counters,
         visibility.unsampled,
         visibility.environment_area,
     );
+    warnings.extend(super::orientation::warnings(scene, &total, enclose));
+    let mut visibility = visibility;
+    if total.counters.pairs == 0 && !enclose {
+        visibility.estimates = undefined_without_pairs(&visibility.estimates);
+    }
     Ok(Analysis {
         lines: total.counters.lines,
         seed: cfg.seed,
@@ -357,8 +364,19 @@ pub fn analyze(
         visibility: visibility.estimates,
         radiosity,
         warnings,
+        orientation: total.orientation.clone(),
         tally: total,
     })
+}
+
+/// The estimates of a run in which no segment joined two patches: only the positional entropy (exact,
+/// from the areas) is defined; every visibility measure has no pair to be computed from, and zeros would
+/// read as measurements.
+fn undefined_without_pairs(estimates: &VisibilityEstimates) -> VisibilityEstimates {
+    VisibilityEstimates {
+        positional_entropy: estimates.positional_entropy,
+        ..VisibilityEstimates::default()
+    }
 }
 
 /// Casts the lines of a run in rounds until its line count, budget or a stop request ends it.
