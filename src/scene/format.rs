@@ -2,6 +2,7 @@
 
 use std::path::Path;
 
+use super::stl::is_binary_stl;
 use super::{gltf, obj, ply, stl, Scene, SceneError, SceneOptions};
 
 /// The scene file formats scx reads.
@@ -64,15 +65,6 @@ pub fn detect(bytes: &[u8]) -> Option<Format> {
         return Some(Format::Obj);
     }
     None
-}
-
-/// An 80-byte header, a triangle count, and 50 bytes per triangle, exactly.
-fn is_binary_stl(bytes: &[u8]) -> bool {
-    if bytes.len() < 84 {
-        return false;
-    }
-    let count = u32::from_le_bytes([bytes[80], bytes[81], bytes[82], bytes[83]]) as u64;
-    bytes.len() as u64 == 84 + 50 * count
 }
 
 /// Text with OBJ statements (`v`, `f`, `o`, `usemtl`, ...) among its first ones; other statements

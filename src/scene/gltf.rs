@@ -73,14 +73,15 @@ fn load_document(
         Some(scene) => scene.nodes().collect(),
         None => gltf.nodes().collect(),
     };
-    let mut stack: Vec<(::gltf::Node, Matrix)> = roots.into_iter().map(|n| (n, IDENTITY)).collect();
+    // Depth first in document order (a stack, so pushed in reverse): objects come in the file's order.
+    let mut stack: Vec<(::gltf::Node, Matrix)> =
+        roots.into_iter().rev().map(|n| (n, IDENTITY)).collect();
     let mut primitives_seen = 0usize;
     let mut skipped_modes = 0usize;
     while let Some((node, parent)) = stack.pop() {
         let world = multiply(&parent, &to_f64(node.transform().matrix()));
-        for child in node.children() {
-            stack.push((child, world));
-        }
+        let children: Vec<::gltf::Node> = node.children().collect();
+        stack.extend(children.into_iter().rev().map(|child| (child, world)));
         let Some(mesh) = node.mesh() else {
             continue;
         };

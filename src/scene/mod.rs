@@ -128,6 +128,13 @@ pub struct Patch {
     pub polygon: Vec<u32>,
 }
 
+/// The object name of a single-object file (PLY, STL): its name without the extension.
+pub(crate) fn object_name(path: &std::path::Path) -> String {
+    path.file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "object".into())
+}
+
 /// How tracing space relates to the scene's own units: `original = center + scale * traced`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Normalization {

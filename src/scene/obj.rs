@@ -246,9 +246,17 @@ fn no_faces(shown: &str, prepared: &super::obj_check::Prepared) -> SceneError {
             ),
         };
     }
-    SceneError::Geometry {
-        scene: shown.to_string(),
-        message: "the scene is empty: no faces".into(),
+    match prepared.text.lines().count() {
+        0 => SceneError::Geometry {
+            scene: shown.to_string(),
+            message: "the scene is empty: no faces".into(),
+        },
+        lines => SceneError::File {
+            path: format!("{shown}:{lines}"),
+            message: format!(
+                "the scene is empty: no faces (`f`) in its {lines} line(s), up to this last one"
+            ),
+        },
     }
 }
 

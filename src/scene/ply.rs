@@ -11,7 +11,6 @@ use std::path::Path;
 use ply_rs_bw::parser::Parser;
 use ply_rs_bw::ply::{DefaultElement, Property};
 
-use super::stl::object_name;
 use super::{Material, Scene, SceneBuilder, SceneError, SceneOptions};
 
 /// Loads PLY bytes read from `path`.
@@ -39,7 +38,7 @@ pub(crate) fn load_bytes(
     }
 
     let mut b = SceneBuilder::new(shown);
-    b.object(&object_name(path));
+    b.object(&super::object_name(path));
     let mut ids = Vec::with_capacity(vertices.len());
     for (k, v) in vertices.iter().enumerate() {
         let coordinate = |name: &str| {

@@ -21,8 +21,7 @@ pub(crate) fn load_bytes(
     };
     // A binary STL's 80-byte header is free text, and some exporters start it with `solid`, which
     // stl_io would take for the ASCII form: hide the word from it (the header carries no geometry).
-    let binary_solid = super::format::detect(bytes) == Some(super::format::Format::StlBinary)
-        && bytes.starts_with(b"solid");
+    let binary_solid = is_binary_stl(bytes) && bytes.starts_with(b"solid");
     let mut owned;
     let bytes = if binary_solid {
         owned = bytes.to_vec();
@@ -35,7 +34,7 @@ pub(crate) fn load_bytes(
     let triangles = stl_io::create_stl_reader(&mut cursor)
         .map_err(|e| file_error(format!("not a readable STL file: {e}")))?;
     let mut b = SceneBuilder::new(shown);
-    b.object(&object_name(path));
+    b.object(&super::object_name(path));
     let material = b.material(Material::default());
     for (k, t) in triangles.enumerate() {
         let t = t.map_err(|e| file_error(format!("triangle {}: {e}", k + 1)))?;
@@ -45,9 +44,12 @@ pub(crate) fn load_bytes(
     b.build_with(options)
 }
 
-/// The object name of a single-object file: its name without the extension.
-pub(crate) fn object_name(path: &Path) -> String {
-    path.file_stem()
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_else(|| "object".into())
+/// Whether bytes are a binary STL by their size: an 80-byte header, a triangle count, and 50 bytes per
+/// triangle, exactly.
+pub(crate) fn is_binary_stl(bytes: &[u8]) -> bool {
+    if bytes.len() < 84 {
+        return false;
+    }
+    let count = u32::from_le_bytes([bytes[80], bytes[81], bytes[82], bytes[83]]) as u64;
+    bytes.len() as u64 == 84 + 50 * count
 }
