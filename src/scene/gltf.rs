@@ -8,7 +8,7 @@
 //! triangles two-sided (two patches back to back). Textures are not read (a warning says so). A primitive
 //! without a material gets scx's default material (reflectance 0.5), as an OBJ face without one does.
 //!
-//! Writing ([`write`]): one node and mesh per object, one primitive per material, f32 positions in the
+//! Writing ([`write()`]): one node and mesh per object, one primitive per material, f32 positions in the
 //! scene's units, every patch's triangles; `.glb` or `.gltf` (the buffer in a data URI) by the extension.
 
 use std::path::Path;

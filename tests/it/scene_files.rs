@@ -573,3 +573,74 @@ fn materials_keep_their_colours_through_export() {
         assert_eq!(back.patch_count(), scene.triangles.len(), "{path:?}");
     }
 }
+
+/// A line's ends, by hand: through a one-sided square from behind it is a single crossing arriving at the
+/// back: the escape is at the line's end (toward the sphere's exit), and the line's start met a back side.
+/// From the front, the escape is at the start. A second square behind the first, facing the same way,
+/// is reached from the first one's front at its back: a `BackSeen` segment.
+#[test]
+fn the_ends_of_a_line_and_back_sides_seen() {
+    use scene_complexity::sample::pairs::{segments, segments_and_ends, Segment};
+    use scene_complexity::trace::{Line, LineHits};
+    let dir = tempfile::tempdir().unwrap();
+    let obj = "o a\nv -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nf 1 2 3 4\n\
+               o b\nv -1 -1 1\nv 1 -1 1\nv 1 1 1\nv -1 1 1\nf 5 6 7 8\n";
+    let scene = load_file(
+        &write(dir.path(), "two.obj", obj.as_bytes()),
+        &SceneOptions::default(),
+    );
+    let tracer = make_tracer(Backend::Rust, &scene, Query::Single).unwrap();
+    let trace = |origin: [f32; 3], dir: [f32; 3]| {
+        let line = Line {
+            origin,
+            dir,
+            t_max: 4.0,
+        };
+        let (mut raw, mut hits) = (Vec::new(), LineHits::default());
+        tracer.all_hits(&[line], &mut raw, &mut hits).unwrap();
+        let row = hits.of_line(0).to_vec();
+        let mut seen = Vec::new();
+        let ends = segments_and_ends(&scene, &line, &row, |s| seen.push(s));
+        (seen, ends)
+    };
+    // Both squares face +z (tracing space: z from -1 to 1 after centring); upwards through both: arrive
+    // at a's back, leave its front, arrive at b's back (BackSeen b), leave b's front into open space.
+    let (seen, ends) = trace([0.1, 0.2, -2.0], [0.0, 0.0, 1.0]);
+    assert_eq!(
+        seen,
+        [
+            Segment::BackSeen { patch: 1 },
+            Segment::Escape {
+                patch: 1,
+                at_start: false
+            }
+        ]
+    );
+    assert_eq!((ends.back_first, ends.back_last), (Some(0), None));
+    // Downwards: arrive at b's front from open space (an escape at the start), leave its back, arrive at
+    // a's front: a segment from a back side to a front side (BackSeen b), and leave a's back.
+    let (seen, ends) = trace([0.1, 0.2, 2.0], [0.0, 0.0, -1.0]);
+    assert_eq!(
+        seen,
+        [
+            Segment::Escape {
+                patch: 1,
+                at_start: true
+            },
+            Segment::BackSeen { patch: 1 }
+        ]
+    );
+    assert_eq!((ends.back_first, ends.back_last), (None, Some(0)));
+    let mut count = 0;
+    segments(
+        &scene,
+        &Line {
+            origin: [5.0, 5.0, 5.0],
+            dir: [1.0, 0.0, 0.0],
+            t_max: 1.0,
+        },
+        &[],
+        |_| count += 1,
+    );
+    assert_eq!(count, 0);
+}
