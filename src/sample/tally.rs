@@ -86,7 +86,27 @@ pub struct ObjectSides {
     pub back_seen: u64,
 }
 
+/// One piece of orientation evidence of a batch: which object, and which of its [`ObjectSides`]
+/// counters. A batch keeps a list of them (its memory follows its lines, not the scene's objects).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct SideEvent {
+    /// The object.
+    pub object: u32,
+    /// Which counter: 0 `back_from_open`, 1 `back_to_open`, 2 `front_open`, 3 `back_seen`.
+    pub kind: u8,
+}
+
 impl ObjectSides {
+    /// Counts one event.
+    fn count(&mut self, kind: u8) {
+        match kind {
+            0 => self.back_from_open += 1,
+            1 => self.back_to_open += 1,
+            2 => self.front_open += 1,
+            _ => self.back_seen += 1,
+        }
+    }
+
     fn add(&mut self, other: &ObjectSides) {
         self.back_from_open += other.back_from_open;
         self.back_to_open += other.back_to_open;
@@ -211,7 +231,9 @@ impl Tally {
         let mut batch_keys = Vec::with_capacity(batches.len());
         for b in batches {
             tally.counters.add(&b.counters);
-            add_sides(&mut tally.orientation, &b.orientation);
+            for e in &b.side_events {
+                tally.orientation[e.object as usize].count(e.kind);
+            }
             for &p in &b.escape_patches {
                 tally.escapes_by_patch[p as usize] += 1;
             }
@@ -275,8 +297,8 @@ pub struct BatchTally {
     pub pair_keys: Vec<u64>,
     /// The patch of every escape, when the discrete measures are wanted.
     pub escape_patches: Vec<u32>,
-    /// How the batch's lines met each object's sides.
-    pub orientation: Vec<ObjectSides>,
+    /// How the batch's lines met the objects' sides, event by event.
+    pub side_events: Vec<SideEvent>,
 }
 
 /// Pairs the canonical hits of a batch of lines and tallies the segments (paper sec. 3.2.2): the hot
@@ -295,8 +317,10 @@ pub fn tally_lines(scene: &Scene, lines: &[Line], hits: &LineHits, wanted: Wante
         },
         ..BatchTally::default()
     };
-    t.orientation = vec![ObjectSides::default(); scene.objects.len()];
-    let object_of = |p: u32| scene.patches[p as usize].object as usize;
+    let event = |p: u32, kind: u8| SideEvent {
+        object: scene.patches[p as usize].object,
+        kind,
+    };
     let c = &mut t.counters;
     for (k, line) in lines.iter().enumerate() {
         let line_hits = hits.of_line(k);
@@ -305,7 +329,7 @@ pub fn tally_lines(scene: &Scene, lines: &[Line], hits: &LineHits, wanted: Wante
             env_sum.add(1.0, 2.0);
             continue;
         }
-        let orientation = &mut t.orientation;
+        let events = &mut t.side_events;
         let ends = segments_and_ends(scene, line, line_hits, |s| match s {
             Segment::Pair {
                 from,
@@ -327,21 +351,21 @@ pub fn tally_lines(scene: &Scene, lines: &[Line], hits: &LineHits, wanted: Wante
                 if wanted.discrete {
                     t.escape_patches.push(patch);
                 }
-                orientation[object_of(patch)].front_open += 1;
+                events.push(event(patch, 2));
                 let (cos_product, distance) = environment::escape(scene, line, patch, at_start);
                 env_sum.add(cos_product, distance);
             }
             Segment::BackSeen { patch } => {
                 c.unpaired += 1;
-                orientation[object_of(patch)].back_seen += 1;
+                events.push(event(patch, 3));
             }
             Segment::Unpaired => c.unpaired += 1,
         });
         if let Some(p) = ends.back_first {
-            orientation[object_of(p)].back_from_open += 1;
+            events.push(event(p, 0));
         }
         if let Some(p) = ends.back_last {
-            orientation[object_of(p)].back_to_open += 1;
+            events.push(event(p, 1));
         }
         c.coincident_crossings += ends.overlaps;
     }

@@ -142,6 +142,18 @@ fn unknown_format(path: &Path, bytes: &[u8]) -> String {
     if bytes.is_empty() {
         return "the file is empty".into();
     }
+    let stl = path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("stl"));
+    if stl && bytes.len() >= 84 {
+        let count = u32::from_le_bytes([bytes[80], bytes[81], bytes[82], bytes[83]]) as u64;
+        return format!(
+            "a binary STL of the wrong size: its header says {count} triangles ({} bytes), the file has \
+             {} bytes (cut short?)",
+            84 + 50 * count,
+            bytes.len()
+        );
+    }
     if std::str::from_utf8(&bytes[..bytes.len().min(4096)]).is_err() && !is_binary_stl(bytes) {
         return format!(
             "not a text file and in no binary format scx reads{ext}: it starts `{start}`; scx reads \

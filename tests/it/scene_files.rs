@@ -644,3 +644,30 @@ fn the_ends_of_a_line_and_back_sides_seen() {
     );
     assert_eq!(count, 0);
 }
+
+/// Every wall of the unit cube two-sided: one sheet of walls seen from both sides. Inside, the lines
+/// pair the inner sides exactly as in the one-sided cube (same seed, same pairs); outside, each line
+/// enters and leaves through an outer side (two escapes per line through the cube) and crosses each
+/// wall's zero thickness (an empty segment); no pair joins the two sides of a wall (d = 0).
+#[test]
+fn two_sided_walls_one_after_another_pair_as_thin_panels() {
+    let one_sided = load("@cube").unwrap();
+    let two_sided = load_with(
+        "@cube",
+        &SceneOptions {
+            two_sided: ObjectSet::All,
+            ..SceneOptions::default()
+        },
+    )
+    .unwrap();
+    assert_eq!(two_sided.patch_count(), 12);
+    let a = run(&one_sided, 100_000, 3, Measures::VISIBILITY);
+    let b = run(&two_sided, 100_000, 3, Measures::VISIBILITY);
+    assert_eq!(b.pairs, a.pairs);
+    // Lines grazing an edge of the cube from outside meet only outer sides: a few more escapes.
+    assert!((2 * a.pairs..2 * a.pairs + 10).contains(&b.escapes), "{}", b.escapes);
+    assert!((2 * a.pairs..2 * a.pairs + 10).contains(&b.unpaired), "{}", b.unpaired);
+    assert_eq!(b.degenerate_pairs, 0);
+    let e = b.visibility.continuous_mutual_information.unwrap();
+    assert!(e.value.is_finite());
+}
