@@ -32,6 +32,10 @@ pub(crate) fn warnings(scene: &Scene, total: &Tally, enclosed: bool) -> Vec<RunW
     if c.pairs == 0 && !enclosed {
         return vec![no_pairs(scene, total)];
     }
+    // The usual case, a consistently oriented scene, costs no pass over the pair counts.
+    if sides.iter().all(|s| s.back_seen < MIN_BACK_SEGMENTS) {
+        return Vec::new();
+    }
     let front = front_seen(scene, total);
     let mut inside_out = Vec::new();
     let mut one_sided = Vec::new();

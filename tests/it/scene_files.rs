@@ -665,8 +665,16 @@ fn two_sided_walls_one_after_another_pair_as_thin_panels() {
     let b = run(&two_sided, 100_000, 3, Measures::VISIBILITY);
     assert_eq!(b.pairs, a.pairs);
     // Lines grazing an edge of the cube from outside meet only outer sides: a few more escapes.
-    assert!((2 * a.pairs..2 * a.pairs + 10).contains(&b.escapes), "{}", b.escapes);
-    assert!((2 * a.pairs..2 * a.pairs + 10).contains(&b.unpaired), "{}", b.unpaired);
+    assert!(
+        (2 * a.pairs..2 * a.pairs + 10).contains(&b.escapes),
+        "{}",
+        b.escapes
+    );
+    assert!(
+        (2 * a.pairs..2 * a.pairs + 10).contains(&b.unpaired),
+        "{}",
+        b.unpaired
+    );
     assert_eq!(b.degenerate_pairs, 0);
     let e = b.visibility.continuous_mutual_information.unwrap();
     assert!(e.value.is_finite());
