@@ -62,6 +62,8 @@ pub use run::{
     Target, TargetMeasure, VisibilityEstimates,
 };
 pub use sample::lines::LineSource;
-pub use scene::{Material, Patch, Scene, SceneBuilder, SceneError};
-pub use scenes::load;
+pub use scene::{
+    Material, ObjectSet, Patch, Planarity, Scene, SceneBuilder, SceneError, SceneOptions,
+};
+pub use scenes::{load, load_with};
 pub use trace::{make_tracer, Backend, Query, TraceError, Tracer};

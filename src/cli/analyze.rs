@@ -21,7 +21,7 @@ use super::{Exit, Failure};
 /// Arguments of `scx analyze`.
 #[derive(clap::Args, Debug)]
 pub struct AnalyzeArgs {
-    /// A scene file (OBJ), a built-in scene such as `@cube:10` (see `scx scenes`), or `-` to read an OBJ
+    /// A scene file (OBJ, glTF, PLY, STL), a built-in scene such as `@cube:10` (see `scx scenes`), or `-` to read an OBJ
     /// from standard input. With --resume, the saved run's scene (given again, it must be the same).
     #[arg(required_unless_present = "resume")]
     scene: Option<String>,
@@ -83,7 +83,8 @@ pub struct AnalyzeArgs {
     /// (more lines than first asked are fine), and save it back to FILE as it goes.
     #[arg(long, value_name = "FILE", conflicts_with_all = [
         "seed", "tracer", "query", "groups", "estimator", "errors", "measures", "seconds",
-        "target_stderr", "target_measure", "bundle", "enclose", "shard"])]
+        "target_stderr", "target_measure", "bundle", "enclose", "shard", "planarity",
+        "strict_planarity", "flip_normals", "two_sided"])]
     resume: Option<PathBuf>,
 }
 
@@ -172,6 +173,7 @@ fn new_run(args: &AnalyzeArgs, spec: &str) -> Result<Prepared, Failure> {
     let state = start(&runner.scene, &cfg).map_err(Failure::of)?;
     let identity = RunIdentity::of(
         spec,
+        &args.run.input.options(),
         &runner.scene,
         &cfg,
         runner.tracer.name(),
@@ -197,7 +199,7 @@ fn resumed_run(args: &AnalyzeArgs, file: &Path) -> Result<Prepared, Failure> {
         _ => Backend::Rust,
     };
     let query = Query::parse(&identity.query).map_err(Failure::bad_input)?;
-    let runner = Runner::with(&spec, backend, query, args.run.threads)?;
+    let runner = Runner::with(&spec, &identity.reading, backend, query, args.run.threads)?;
     check_same_scene(&file.display().to_string(), &identity, &runner)?;
     let mut cfg = identity
         .config()

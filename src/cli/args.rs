@@ -6,11 +6,55 @@ use std::path::PathBuf;
 use clap::ValueEnum;
 use scene_complexity::measure::estimators::EntropyEstimator;
 use scene_complexity::run::{ErrorMethod, TargetMeasure, DEFAULT_ESTIMATOR, DEFAULT_GROUPS};
+use scene_complexity::scene::{ObjectSet, Planarity, SceneOptions, DEFAULT_PLANARITY};
 use scene_complexity::trace::{Backend, Query};
+
+/// How a scene file is read: non-planar polygons, and objects to flip or make two-sided.
+#[derive(clap::Args, Debug, Clone)]
+pub struct SceneArgs {
+    /// A polygon whose corners leave its plane by at most this fraction of its size is planar (one
+    /// patch); a less planar one is split into planar triangles (one warning per file).
+    #[arg(long, default_value_t = DEFAULT_PLANARITY, value_parser = parse_tolerance)]
+    pub planarity: f64,
+    /// Refuse non-planar polygons (exit 2, naming the first) instead of splitting them.
+    #[arg(long)]
+    pub strict_planarity: bool,
+    /// Reverse the normals of these objects (comma separated names: OBJ `o`/`g`, glTF node or mesh, the
+    /// file name for PLY and STL); without a list, of every object. Put it after the scene.
+    #[arg(long, value_name = "OBJECT,...", num_args = 0..=1, value_delimiter = ',', default_missing_value = "")]
+    pub flip_normals: Option<Vec<String>>,
+    /// Make these objects two-sided (two patches back to back, one per side, each with the face's area
+    /// and material); without a list, every object. Put it after the scene.
+    #[arg(long, value_name = "OBJECT,...", num_args = 0..=1, value_delimiter = ',', default_missing_value = "")]
+    pub two_sided: Option<Vec<String>>,
+}
+
+impl SceneArgs {
+    /// The loading options these flags ask for.
+    pub fn options(&self) -> SceneOptions {
+        let set = |names: &Option<Vec<String>>| match names {
+            None => ObjectSet::None,
+            Some(list) if list.iter().all(|n| n.is_empty()) => ObjectSet::All,
+            Some(list) => {
+                ObjectSet::Named(list.iter().filter(|n| !n.is_empty()).cloned().collect())
+            }
+        };
+        SceneOptions {
+            planarity: Planarity {
+                tolerance: self.planarity,
+                strict: self.strict_planarity,
+            },
+            flip_normals: set(&self.flip_normals),
+            two_sided: set(&self.two_sided),
+        }
+    }
+}
 
 /// Options of every command that casts lines.
 #[derive(clap::Args, Debug)]
 pub struct RunOptions {
+    #[command(flatten)]
+    pub input: SceneArgs,
     /// Seed of the random line streams (a whole number >= 0; accepts `1e3`).
     #[arg(long, default_value = "1", value_parser = parse_seed, allow_negative_numbers = true)]
     pub seed: u64,
@@ -101,6 +145,16 @@ pub fn parse_threads(s: &str) -> Result<usize, String> {
         return Err(format!("`{s}`: at most 4096 threads"));
     }
     Ok(n as usize)
+}
+
+/// A planarity tolerance: a fraction of a polygon's size, >= 0.
+fn parse_tolerance(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(v) if v.is_finite() && v >= 0.0 => Ok(v),
+        _ => Err(format!(
+            "`{s}`: need a number >= 0 (a fraction of the polygon's size)"
+        )),
+    }
 }
 
 /// A positive number (seconds, a standard error).

@@ -20,7 +20,7 @@ use super::{Exit, Failure};
 /// Arguments of `scx convergence`.
 #[derive(clap::Args, Debug)]
 pub struct ConvergenceArgs {
-    /// A scene file, a built-in scene such as `@cube:30`, or `-` for an OBJ on standard input.
+    /// A scene file (OBJ, glTF, PLY, STL), a built-in scene such as `@cube:30`, or `-` for an OBJ on standard input.
     scene: String,
     /// The line counts to run, comma separated (accepts `1e6`).
     #[arg(long, value_delimiter = ',', value_parser = parse_count, default_value = "1e4,1e5,1e6,1e7",

@@ -4,6 +4,7 @@ use scene_complexity::crosscheck::{self, CrossCheckConfig, Tolerance};
 use scene_complexity::run::DEFAULT_GROUPS;
 use scene_complexity::trace::{make_tracer, Backend, Query};
 
+use super::args::SceneArgs;
 use super::args::{parse_count, parse_seed, parse_threads, ReportOutput};
 use super::input::load_scene;
 use super::output::{self, check_all};
@@ -13,9 +14,11 @@ use super::{Exit, Failure};
 /// Arguments of `scx crosscheck`.
 #[derive(clap::Args, Debug)]
 pub struct CrosscheckArgs {
-    /// A scene file, a built-in scene such as `@cube:10` (see `scx scenes`), or `-` for an OBJ on
+    /// A scene file (OBJ, glTF, PLY, STL), a built-in scene such as `@cube:10` (see `scx scenes`), or `-` for an OBJ on
     /// standard input.
     scene: String,
+    #[command(flatten)]
+    input: SceneArgs,
     /// Number of global lines (accepts `1e6`).
     #[arg(long, default_value = "1e6", value_parser = parse_count, allow_negative_numbers = true)]
     lines: u64,
@@ -44,7 +47,7 @@ pub fn run(args: &CrosscheckArgs) -> Result<Exit, Failure> {
         )));
     }
     check_all(args.out.output.as_deref())?;
-    let scene = load_scene(&args.scene)?;
+    let scene = load_scene(&args.scene, &args.input.options())?;
     let embree = make_tracer(Backend::Embree, &scene, Query::Single).map_err(Failure::bad_input)?;
     let rust = make_tracer(Backend::Rust, &scene, Query::Single).map_err(Failure::bad_input)?;
     let (_, pool) = thread_pool(args.threads)?;

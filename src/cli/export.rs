@@ -1,9 +1,10 @@
-//! `scx export`: a scene (built-in or file) written as OBJ + MTL.
+//! `scx export`: a scene (built-in or file) written as OBJ + MTL, or as glTF 2.0.
 
 use std::path::PathBuf;
 
-use scene_complexity::scene::obj;
+use scene_complexity::scene::{gltf, obj};
 
+use super::args::SceneArgs;
 use super::input::load_scene;
 use super::output::{self, check_all};
 use super::{Exit, Failure};
@@ -11,27 +12,50 @@ use super::{Exit, Failure};
 /// Arguments of `scx export`.
 #[derive(clap::Args, Debug)]
 pub struct ExportArgs {
-    /// A scene file, a built-in scene such as `@cube:10`, or `-` for an OBJ on standard input.
+    /// A scene file (OBJ, glTF, PLY, STL), a built-in scene such as `@cube:10`, or `-` for an OBJ on standard input.
     scene: String,
-    /// The OBJ file to write; the MTL library goes beside it (both checked writable first).
+    #[command(flatten)]
+    input: SceneArgs,
+    /// The file to write: `.gltf` or `.glb` writes glTF 2.0, anything else OBJ with its MTL library
+    /// beside it (checked writable first).
     #[arg(short, long)]
     output: PathBuf,
 }
 
 /// Runs `scx export`.
 pub fn run(args: &ExportArgs) -> Result<Exit, Failure> {
+    let gltf = is_gltf(&args.output);
     let mtl = args.output.with_extension("mtl");
-    check_all([args.output.as_path(), mtl.as_path()])?;
-    let scene = load_scene(&args.scene)?;
-    obj::write(&scene, &args.output).map_err(|e| Failure {
+    if gltf {
+        check_all([args.output.as_path()])?;
+    } else {
+        check_all([args.output.as_path(), mtl.as_path()])?;
+    }
+    let scene = load_scene(&args.scene, &args.input.options())?;
+    let written = if gltf {
+        gltf::write(&scene, &args.output)
+    } else {
+        obj::write(&scene, &args.output)
+    };
+    written.map_err(|e| Failure {
         code: Exit::Io,
         message: e.to_string(),
     })?;
+    let beside = if gltf {
+        String::new()
+    } else {
+        format!(" and {}", mtl.display())
+    };
     output::note(&format!(
-        "wrote {} ({} patches) and {}",
+        "wrote {} ({} patches){beside}",
         args.output.display(),
         scene.patch_count(),
-        mtl.display()
     ));
     Ok(Exit::Ok)
+}
+
+/// Whether `path` asks for glTF (`.gltf` text or `.glb` binary) rather than OBJ.
+fn is_gltf(path: &std::path::Path) -> bool {
+    path.extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("gltf") || e.eq_ignore_ascii_case("glb"))
 }

@@ -3,18 +3,19 @@
 use std::io::Read;
 use std::path::Path;
 
-use scene_complexity::scene::{obj, Scene};
+use scene_complexity::scene::{obj, Scene, SceneOptions};
 use scene_complexity::scenes;
 
 use super::output::warn;
 use super::{Exit, Failure};
 
-/// Loads the scene a command names, printing its loading warnings; bad input is exit code 2.
-pub fn load_scene(spec: &str) -> Result<Scene, Failure> {
+/// Loads the scene a command names, read as `options` ask, printing its loading warnings; bad input is
+/// exit code 2.
+pub fn load_scene(spec: &str, options: &SceneOptions) -> Result<Scene, Failure> {
     let scene = if spec == "-" {
-        from_stdin()?
+        from_stdin(options)?
     } else {
-        scenes::load(spec).map_err(|e| Failure::bad_input(e.to_string()))?
+        scenes::load_with(spec, options).map_err(|e| Failure::bad_input(e.to_string()))?
     };
     for w in &scene.warnings {
         warn(w);
@@ -23,7 +24,7 @@ pub fn load_scene(spec: &str) -> Result<Scene, Failure> {
 }
 
 /// An OBJ scene from standard input; an `mtllib` is looked for in the current folder.
-fn from_stdin() -> Result<Scene, Failure> {
+fn from_stdin(options: &SceneOptions) -> Result<Scene, Failure> {
     let mut text = String::new();
     std::io::stdin()
         .read_to_string(&mut text)
@@ -31,9 +32,10 @@ fn from_stdin() -> Result<Scene, Failure> {
             code: Exit::Io,
             message: format!("cannot read the scene from standard input: {e}"),
         })?;
-    obj::load_text("<stdin>", &text, &|mtl: &Path| {
+    let materials = |mtl: &Path| {
         let text = std::fs::read_to_string(mtl).map_err(|e| e.to_string())?;
         Ok((mtl.display().to_string(), text))
-    })
-    .map_err(|e| Failure::bad_input(e.to_string()))
+    };
+    obj::load_text_with("<stdin>", &text, &materials, options)
+        .map_err(|e| Failure::bad_input(e.to_string()))
 }

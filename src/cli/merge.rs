@@ -128,7 +128,7 @@ pub fn run(args: &MergeArgs) -> Result<Exit, Failure> {
         _ => Backend::Rust,
     };
     let query = Query::parse(&identity.query).map_err(Failure::bad_input)?;
-    let runner = Runner::with(&spec, backend, query, args.threads)?;
+    let runner = Runner::with(&spec, &identity.reading, backend, query, args.threads)?;
     check_same_scene(&first, &identity, &runner)?;
     let cfg = identity
         .config()

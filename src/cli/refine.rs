@@ -10,6 +10,7 @@ use scene_complexity::scene::obj;
 use scene_complexity::trace::{make_tracer, Query};
 use std::sync::Arc;
 
+use super::args::SceneArgs;
 use super::args::{parse_count, parse_positive, parse_seed, parse_threads, TracerArg};
 use super::input::load_scene;
 use super::output::{self, check_all, note};
@@ -19,8 +20,10 @@ use super::{Exit, Failure};
 /// Arguments of `scx refine`.
 #[derive(clap::Args, Debug)]
 pub struct RefineArgs {
-    /// A scene file, a built-in scene such as `@cornell`, or `-` for an OBJ on standard input.
+    /// A scene file (OBJ, glTF, PLY, STL), a built-in scene such as `@cornell`, or `-` for an OBJ on standard input.
     scene: String,
+    #[command(flatten)]
+    input: SceneArgs,
     /// Which patches to split: uniform (all, largest first), power (A_i B_i), smoothness (variation of
     /// received radiosity over the patch), information (loss of information transfer).
     #[arg(long, value_enum)]
@@ -60,7 +63,7 @@ enum StrategyArg {
 pub fn run(args: &RefineArgs) -> Result<Exit, Failure> {
     let mtl = args.output.with_extension("mtl");
     check_all([args.output.as_path(), mtl.as_path()])?;
-    let scene = load_scene(&args.scene)?;
+    let scene = load_scene(&args.scene, &args.input.options())?;
     let backend = TracerArg::backend(args.tracer);
     // Check the backend once up front, so that an unavailable one is a clear input error.
     make_tracer(backend, &scene, Query::Single).map_err(Failure::bad_input)?;

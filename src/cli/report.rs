@@ -527,12 +527,18 @@ pub fn table(run: &RunInfo, a: &Analysis) -> String {
         a.seconds,
         a.lines as f64 / a.seconds.max(1e-12) / 1e6
     );
+    let back_seen: u64 = a.orientation.iter().map(|o| o.back_seen).sum();
     let _ = writeln!(
         s,
-        "segments {} pairs, {} escapes, {} unpaired; {} hits{}",
+        "segments {} pairs, {} escapes, {} unpaired{}; {} hits{}",
         a.pairs,
         a.escapes,
         a.unpaired,
+        if back_seen > 0 {
+            format!(" ({back_seen} from a front side to a back side)")
+        } else {
+            String::new()
+        },
         a.hits,
         a.distinct_pairs
             .map(|d| format!("; {d} distinct patch pairs"))
@@ -614,6 +620,13 @@ pub fn table(run: &RunInfo, a: &Analysis) -> String {
     s += &t.render();
     for n in &notes {
         let _ = writeln!(s, "{n}");
+    }
+    if a.pairs == 0 && a.lines > 0 && a.environment_area.is_none() {
+        let _ = writeln!(
+            s,
+            "visibility measures undefined: no line segment joined two patches, so there are no form \
+             factors to measure (the warning says what the lines met)"
+        );
     }
     radiosity_lines(&mut s, &a.radiosity);
     let errors = match a.errors {

@@ -3,7 +3,7 @@
 use std::sync::Arc;
 
 use scene_complexity::run::{analyze, Analysis, AnalysisConfig, Measures, RunControl};
-use scene_complexity::scene::Scene;
+use scene_complexity::scene::{Scene, SceneOptions};
 use scene_complexity::trace::{make_tracer, Backend, Query, Tracer};
 
 use super::args::{RunOptions, TracerArg};
@@ -25,6 +25,7 @@ impl Runner {
     pub fn new(spec: &str, opts: &RunOptions) -> Result<Runner, Failure> {
         Runner::with(
             spec,
+            &opts.input.options(),
             TracerArg::backend(opts.tracer),
             opts.query,
             opts.threads,
@@ -34,11 +35,12 @@ impl Runner {
     /// Loads the scene and builds the tracer `backend` with `query` and a pool of `threads` threads.
     pub fn with(
         spec: &str,
+        reading: &SceneOptions,
         backend: Backend,
         query: Query,
         threads: Option<usize>,
     ) -> Result<Runner, Failure> {
-        let scene = load_scene(spec)?;
+        let scene = load_scene(spec, reading)?;
         let tracer = make_tracer(backend, &scene, query).map_err(Failure::bad_input)?;
         let (threads, pool) = thread_pool(threads)?;
         let control = Arc::new(RunControl::default());

@@ -5,6 +5,7 @@
 //! arithmetic the measures were first computed with (a unit vector is divided by its length, not
 //! multiplied by the reciprocal as `DVec3::normalize` does), so that results stay bit-identical.
 
+pub mod polygon;
 pub mod shapes;
 
 use rand::RngCore;

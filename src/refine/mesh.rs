@@ -20,13 +20,16 @@ use std::collections::HashMap;
 use crate::geom::Point;
 use crate::scene::{Material, Scene, SceneBuilder, SceneError};
 
-/// One element (a future patch): its corners counter-clockwise seen from the front, and its material.
+/// One element (a future patch): its corners counter-clockwise seen from the front, its material and
+/// the object it belongs to.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Element {
     /// Corner vertices (indices into the mesh's vertices).
     pub corners: Vec<u32>,
     /// Material index.
     pub material: u32,
+    /// Object index (into the scene's objects), kept so that the refined scene keeps its objects.
+    pub object: u32,
 }
 
 /// A mesh of planar convex elements in the scene's own units.
@@ -38,6 +41,7 @@ pub struct Mesh {
     /// The midpoint vertex of each split edge, keyed by its end vertices (smaller index first).
     splits: HashMap<(u32, u32), u32>,
     materials: Vec<Material>,
+    objects: Vec<String>,
 }
 
 impl Mesh {
@@ -49,12 +53,14 @@ impl Mesh {
             elements: Vec::with_capacity(scene.patch_count()),
             splits: HashMap::new(),
             materials: scene.materials.clone(),
+            objects: scene.objects.clone(),
         };
         let ids: Vec<u32> = scene.vertices.iter().map(|&p| mesh.vertex(p)).collect();
         for p in &scene.patches {
             mesh.elements.push(Element {
                 corners: p.polygon.iter().map(|&v| ids[v as usize]).collect(),
                 material: p.material,
+                object: p.object,
             });
         }
         mesh
@@ -89,6 +95,9 @@ impl Mesh {
         let ids: Vec<u32> = self.vertices.iter().map(|&p| b.vertex(p)).collect();
         for (k, e) in self.elements.iter().enumerate() {
             let corners: Vec<u32> = e.corners.iter().map(|&v| ids[v as usize]).collect();
+            if let Some(object) = self.objects.get(e.object as usize) {
+                b.object(object);
+            }
             b.polygon(&corners, e.material, format!("element {k}"));
         }
         let scene = b.build()?;
@@ -108,7 +117,11 @@ impl Mesh {
 
     /// Splits element `e` (see the module docs): the first child takes its index, the others are appended.
     pub fn split(&mut self, e: usize) {
-        let Element { corners, material } = self.elements[e].clone();
+        let Element {
+            corners,
+            material,
+            object,
+        } = self.elements[e].clone();
         let children = match corners.len() {
             3 => self.split_triangle(&corners),
             4 => self.split_quad(&corners),
@@ -117,6 +130,7 @@ impl Mesh {
         let mut children = children.into_iter().map(|c| Element {
             corners: c,
             material,
+            object,
         });
         self.elements[e] = children.next().expect("a split has children");
         self.elements.extend(children);

@@ -83,8 +83,8 @@ pub fn sample_pairs(
                     .map_or(f64::NAN, |v| v.log2() - log2_pi);
                 out.0.push((pair_key(from, to), term));
             }
-            Segment::Escape { patch } => out.1.push(patch),
-            Segment::Unpaired => {}
+            Segment::Escape { patch, .. } => out.1.push(patch),
+            Segment::BackSeen { .. } | Segment::Unpaired => {}
         },
     )?;
     let mut escapes = vec![0u64; scene.patch_count()];

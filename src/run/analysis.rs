@@ -31,7 +31,7 @@ use crate::measure::sampling::{lines_factor_for_coverage, Sampling};
 use crate::measure::visibility::{self, ContinuousValues, DiscreteValues};
 use crate::measure::Estimate;
 use crate::sample::lines::LineSource;
-use crate::sample::tally::{Tally, Wanted};
+use crate::sample::tally::{ObjectSides, Tally, Wanted};
 use crate::scene::Scene;
 use crate::trace::{TraceError, Tracer};
 
@@ -188,6 +188,8 @@ pub struct Analysis {
     pub radiosity: RadiosityOutcome,
     /// What the user must know about these numbers (an open scene, unsampled patches, ...).
     pub warnings: Vec<RunWarning>,
+    /// Per object of the scene: how lines met its sides (the evidence behind the orientation warnings).
+    pub orientation: Vec<ObjectSides>,
     /// The full-run counts, for form factors (when counted).
     pub tally: Tally,
 }
@@ -607,12 +609,17 @@ pub fn finish(
         )?,
     };
     let FinishedRun { total, .. } = run;
-    let warnings = warnings::of_run(
+    let mut warnings = warnings::of_run(
         &scene.name,
         &total.counters,
         visibility.unsampled,
         visibility.environment_area,
     );
+    warnings.extend(super::orientation::warnings(scene, &total, enclose));
+    let mut visibility = visibility;
+    if total.counters.pairs == 0 && !enclose {
+        visibility.estimates = undefined_without_pairs(&visibility.estimates);
+    }
     Ok(Analysis {
         lines: total.counters.lines,
         seed: cfg.seed,
@@ -641,8 +648,19 @@ pub fn finish(
         target,
         radiosity,
         warnings,
+        orientation: total.orientation.clone(),
         tally: total,
     })
+}
+
+/// The estimates of a run in which no segment joined two patches: only the positional entropy (exact,
+/// from the areas) is defined; every visibility measure has no pair to be computed from, and zeros would
+/// read as measurements.
+fn undefined_without_pairs(estimates: &VisibilityEstimates) -> VisibilityEstimates {
+    VisibilityEstimates {
+        positional_entropy: estimates.positional_entropy,
+        ..VisibilityEstimates::default()
+    }
 }
 
 /// The standard error of `measure` and the verdict on its reading, from the run so far. Batch means:

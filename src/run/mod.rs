@@ -13,6 +13,7 @@ pub mod analysis;
 pub mod batches;
 pub mod control;
 pub mod errors;
+mod orientation;
 pub mod persist;
 pub mod plan;
 pub mod radiosity;

@@ -25,8 +25,8 @@ use super::state::RunState;
 use crate::measure::estimators::EntropyEstimator;
 use crate::sample::counts::{pair_key, split_key, PairCounts};
 use crate::sample::lines::LineSource;
-use crate::sample::tally::{Counters, Tally, Wanted};
-use crate::scene::Scene;
+use crate::sample::tally::{Counters, ObjectSides, Tally, Wanted};
+use crate::scene::{Scene, SceneOptions};
 
 /// The format version this scx writes and reads.
 pub const FORMAT_VERSION: u32 = 1;
@@ -42,6 +42,10 @@ pub struct RunIdentity {
     pub scx_version: String,
     /// The scene as named on the command line (a file path or a built-in).
     pub scene: String,
+    /// How the scene file was read (planarity, flipped and two-sided objects), so that a resume or a
+    /// merge reads it the same way.
+    #[serde(default)]
+    pub reading: SceneOptions,
     /// [`crate::scene::Scene::fingerprint`] of the loaded scene.
     pub fingerprint: String,
     /// Its patches.
@@ -79,6 +83,7 @@ impl RunIdentity {
     /// `tracer` and query `query`, as shard `shard` when it is one.
     pub fn of(
         spec: &str,
+        reading: &SceneOptions,
         scene: &Scene,
         cfg: &AnalysisConfig,
         tracer: &str,
@@ -88,6 +93,7 @@ impl RunIdentity {
         RunIdentity {
             scx_version: env!("CARGO_PKG_VERSION").into(),
             scene: spec.into(),
+            reading: reading.clone(),
             fingerprint: scene.fingerprint(),
             patches: scene.patch_count() as u64,
             seed: cfg.seed,
@@ -277,6 +283,10 @@ struct TallyWire {
     escapes: Sparse,
     /// Pair counts by pair key.
     counts: Option<Sparse>,
+    /// Per object: back sides met from open space, back sides leaving to it, front sides escaping,
+    /// back sides seen from front sides.
+    #[serde(default)]
+    orientation: Vec<[u64; 4]>,
 }
 
 /// Sorted `(key, value)` entries as key differences and values.
@@ -328,6 +338,11 @@ fn tally_wire(t: &Tally) -> TallyWire {
             c.for_each(|i, j, n| entries.push((pair_key(i, j), n)));
             Sparse::of(entries)
         }),
+        orientation: t
+            .orientation
+            .iter()
+            .map(|o| [o.back_from_open, o.back_to_open, o.front_open, o.back_seen])
+            .collect(),
     }
 }
 
@@ -352,8 +367,21 @@ fn tally_of(w: &TallyWire, patches: usize, wanted: Wanted) -> Option<Tally> {
         (None, false) => None,
         _ => return None,
     };
+    let orientation = w
+        .orientation
+        .iter()
+        .map(
+            |&[back_from_open, back_to_open, front_open, back_seen]| ObjectSides {
+                back_from_open,
+                back_to_open,
+                front_open,
+                back_seen,
+            },
+        )
+        .collect();
     Some(Tally {
         counters: w.counters,
+        orientation,
         escapes_by_patch,
         counts,
     })
@@ -547,7 +575,15 @@ mod tests {
                 &mut |_| {},
             )
             .unwrap();
-            let identity = RunIdentity::of(spec, &scene, &cfg, "rust", "single", None);
+            let identity = RunIdentity::of(
+                spec,
+                &SceneOptions::default(),
+                &scene,
+                &cfg,
+                "rust",
+                "single",
+                None,
+            );
             let bytes = encode(&identity, &state, 1.5);
             let back = decode("s.scx", &bytes).unwrap();
             assert_eq!(back.identity, identity);

@@ -15,6 +15,14 @@ pub enum RunWarningKind {
     UnsampledPatches,
     /// Some pairs joined coincident points (touching surfaces) and were left out of I_s^c.
     DegeneratePairs,
+    /// No segment joined two patches: the visibility measures are undefined (the message says what the
+    /// lines met instead: closed solids seen from outside, back sides).
+    NoPairs,
+    /// Objects whose back sides are seen from outside them and whose front sides only from inside: their
+    /// normals face inwards.
+    InsideOut,
+    /// One-sided surfaces seen from behind: segments from front sides arrive at their back sides.
+    OneSided,
 }
 
 /// One warning about a run.

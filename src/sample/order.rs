@@ -68,7 +68,10 @@ pub(crate) fn reorder(crossings: &mut Vec<Crossing>, hits: &[Hit]) -> u64 {
             if is_touch(&crossings[start..end]) {
                 touched[start..end].fill(true);
             } else {
-                overlaps += order_window_between(crossings, start, end);
+                // A window right after this one adapts to whichever space this one ends in, so its
+                // first crossing (in f32 order, not yet in its true order) says nothing about it.
+                let next_is_window = end + 1 < hits.len() && close(hits[end].t, hits[end + 1].t);
+                overlaps += order_window_between(crossings, start, end, next_is_window);
             }
         }
         start = end;
@@ -109,7 +112,9 @@ fn is_touch(window: &[Crossing]) -> bool {
 /// in front of the previous crossing's patch if it left that front side. At the start of the line it is
 /// unknown (outside an object is in front of it, outside an enclosure behind its walls): it is then
 /// chosen so that the line ends the window in the space the next crossing closes (in front if that one
-/// arrives at a front side), and in front when there is no next crossing either.
+/// arrives at a front side), and in front when there is no next crossing either, or when the next
+/// crossing starts a window of its own (two-sided walls one after the other: that window is ordered
+/// after this one, from the space this one ends in, so its first crossing in f32 order says nothing).
 ///
 /// The plane distances give the true order of surfaces that nearly touch. They do not when the line
 /// grazes an edge where two surfaces meet at an angle: it crosses both planes within rounding of the
@@ -118,9 +123,17 @@ fn is_touch(window: &[Crossing]) -> bool {
 /// `@labyrinth`, a line grazing the floor's edge under a wall read as an escape from a closed scene); the
 /// window is then ordered as crossings at one place, which lets the line graze the edge and go on in the
 /// space it came from.
-fn order_window_between(crossings: &mut [Crossing], start: usize, end: usize) -> u64 {
+fn order_window_between(
+    crossings: &mut [Crossing],
+    start: usize,
+    end: usize,
+    next_is_window: bool,
+) -> u64 {
     let before = (start > 0).then(|| crossings[start - 1].cos >= 0.0);
-    let wanted = crossings.get(end).map(|next| next.cos < 0.0);
+    let wanted = crossings
+        .get(end)
+        .filter(|_| !next_is_window)
+        .map(|next| next.cos < 0.0);
     let starts: &[bool] = match before {
         Some(true) => &[true],
         Some(false) => &[false],

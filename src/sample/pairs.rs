@@ -5,7 +5,9 @@
 //! the side the patch normal points to). The end segments, from the bounding sphere to the first hit and
 //! from the last hit to the sphere, are *escapes* when they touch a front side: that surface sees out of
 //! the scene (an open scene). Every other segment (inside a solid, behind an enclosure, between a front and
-//! a back side) is *unpaired*.
+//! a back side) is *unpaired*; of those, a segment between a front side and a back side is reported as
+//! [`Segment::BackSeen`]: a surface seen from behind, which a closed, consistently oriented scene never
+//! shows (a one-sided surface meant to be seen from both sides, or normals facing the wrong way).
 //!
 //! Facing is decided from our own f64 patch normals, identically for every tracer; a line exactly in a
 //! patch's plane faces neither side and makes its segments unpaired.
@@ -36,9 +38,29 @@ pub enum Segment {
     Escape {
         /// The patch whose front side sees the bounding sphere.
         patch: u32,
+        /// Whether the segment is the line's first (from the sphere to the first hit), not its last.
+        at_start: bool,
+    },
+    /// An unpaired segment between a front side and the back side of `patch` (either way along the
+    /// line): that patch is seen from behind.
+    BackSeen {
+        /// The patch whose back side the segment touches.
+        patch: u32,
     },
     /// A segment joining no front sides (inside a solid, behind a wall, broken geometry).
     Unpaired,
+}
+
+/// How a line's ends met the scene: the patches of its first and last crossings and whether the line
+/// met their back sides there (it arrived at a back side from open space, or left one into it).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct LineEnds {
+    /// Crossings of coplanar overlapping surfaces facing the same way (see [`segments_counting_overlaps`]).
+    pub overlaps: u64,
+    /// The first crossing's patch when the line arrives there at its back side.
+    pub back_first: Option<u32>,
+    /// The last crossing's patch when the line leaves its back side there.
+    pub back_last: Option<u32>,
 }
 
 /// The line in f64, with a unit direction: what pairing works on.
@@ -73,21 +95,32 @@ pub fn segments_counting_overlaps(
     scene: &Scene,
     line: &Line,
     hits: &[Hit],
-    mut visit: impl FnMut(Segment),
+    visit: impl FnMut(Segment),
 ) -> u64 {
+    segments_and_ends(scene, line, hits, visit).overlaps
+}
+
+/// [`segments_counting_overlaps`], also returning how the line's ends met back sides ([`LineEnds`]).
+pub fn segments_and_ends(
+    scene: &Scene,
+    line: &Line,
+    hits: &[Hit],
+    mut visit: impl FnMut(Segment),
+) -> LineEnds {
     if hits.is_empty() {
-        return 0;
+        return LineEnds::default();
     }
     let l = LineF64::from(line);
     let crossing = |h: &Hit| crossing(scene, &l, h);
     if !order::has_close_hits(hits) {
-        pair_crossings(hits.iter().map(crossing), &mut visit);
-        return 0;
+        return pair_crossings(hits.iter().map(crossing), &mut visit);
     }
     let mut crossings: Vec<Crossing> = hits.iter().map(crossing).collect();
     let overlaps = order::reorder(&mut crossings, hits);
-    pair_crossings(crossings.into_iter(), &mut visit);
-    overlaps
+    LineEnds {
+        overlaps,
+        ..pair_crossings(crossings.into_iter(), &mut visit)
+    }
 }
 
 /// A hit as a crossing: its patch, the facing and the f64 distance to the patch's plane.
@@ -111,13 +144,20 @@ fn crossing(scene: &Scene, l: &LineF64, h: &Hit) -> Crossing {
     }
 }
 
-/// Pairs consecutive crossings (see the module documentation).
-fn pair_crossings(mut crossings: impl Iterator<Item = Crossing>, visit: &mut impl FnMut(Segment)) {
+/// Pairs consecutive crossings (see the module documentation); returns how the line's ends met back
+/// sides.
+fn pair_crossings(
+    mut crossings: impl Iterator<Item = Crossing>,
+    visit: &mut impl FnMut(Segment),
+) -> LineEnds {
     let Some(first) = crossings.next() else {
-        return;
+        return LineEnds::default();
     };
     if first.cos < 0.0 {
-        visit(Segment::Escape { patch: first.patch });
+        visit(Segment::Escape {
+            patch: first.patch,
+            at_start: true,
+        });
     }
     let mut prev = first;
     for next in crossings {
@@ -130,12 +170,24 @@ fn pair_crossings(mut crossings: impl Iterator<Item = Crossing>, visit: &mut imp
                 cos_from: prev.cos,
                 cos_to: -next.cos,
             });
+        } else if prev.cos > 0.0 && next.cos > 0.0 {
+            visit(Segment::BackSeen { patch: next.patch });
+        } else if prev.cos < 0.0 && next.cos < 0.0 {
+            visit(Segment::BackSeen { patch: prev.patch });
         } else {
             visit(Segment::Unpaired);
         }
         prev = next;
     }
     if prev.cos > 0.0 {
-        visit(Segment::Escape { patch: prev.patch });
+        visit(Segment::Escape {
+            patch: prev.patch,
+            at_start: false,
+        });
+    }
+    LineEnds {
+        overlaps: 0,
+        back_first: (first.cos > 0.0).then_some(first.patch),
+        back_last: (prev.cos < 0.0).then_some(prev.patch),
     }
 }

@@ -9,7 +9,7 @@ use super::counts::{pair_key, PairCounts};
 use super::environment;
 use super::exact::ExactSum;
 use super::kernel::Log2Sum;
-use super::pairs::{segments_counting_overlaps, Segment};
+use super::pairs::{segments_and_ends, Segment};
 use crate::scene::Scene;
 use crate::trace::{Line, LineHits};
 
@@ -71,11 +71,68 @@ impl Counters {
     }
 }
 
+/// How lines met one object's two sides where a consistently oriented scene shows only front sides
+/// ([`super::pairs`]): the evidence for normals facing the wrong way and for one-sided surfaces seen
+/// from behind. Only the ends of a line and its unpaired segments are looked at.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct ObjectSides {
+    /// Lines whose first crossing is a back side of the object: they arrive at it from open space.
+    pub back_from_open: u64,
+    /// Lines whose last crossing is a back side of the object: they leave it into open space.
+    pub back_to_open: u64,
+    /// Segments between a front side of the object and open space (escapes, at either end).
+    pub front_open: u64,
+    /// Segments between a front side (of any object) and a back side of this object: lost pairs if the
+    /// object is meant to be seen from there.
+    pub back_seen: u64,
+}
+
+/// One piece of orientation evidence of a batch: which object, and which of its [`ObjectSides`]
+/// counters. A batch keeps a list of them (its memory follows its lines, not the scene's objects).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct SideEvent {
+    /// The object.
+    pub object: u32,
+    /// Which counter: 0 `back_from_open`, 1 `back_to_open`, 2 `front_open`, 3 `back_seen`.
+    pub kind: u8,
+}
+
+impl ObjectSides {
+    /// Counts one event.
+    fn count(&mut self, kind: u8) {
+        match kind {
+            0 => self.back_from_open += 1,
+            1 => self.back_to_open += 1,
+            2 => self.front_open += 1,
+            _ => self.back_seen += 1,
+        }
+    }
+
+    fn add(&mut self, other: &ObjectSides) {
+        self.back_from_open += other.back_from_open;
+        self.back_to_open += other.back_to_open;
+        self.front_open += other.front_open;
+        self.back_seen += other.back_seen;
+    }
+}
+
+/// Adds per-object sides element by element (an empty side takes the other's length).
+fn add_sides(into: &mut Vec<ObjectSides>, other: &[ObjectSides]) {
+    if into.len() < other.len() {
+        into.resize(other.len(), ObjectSides::default());
+    }
+    for (a, b) in into.iter_mut().zip(other) {
+        a.add(b);
+    }
+}
+
 /// What a set of lines found.
 #[derive(Clone, Debug)]
 pub struct Tally {
     /// The counters and sums.
     pub counters: Counters,
+    /// Per object of the scene ([`crate::scene::Scene::objects`]): how its sides were met.
+    pub orientation: Vec<ObjectSides>,
     /// Escapes per patch (empty unless the discrete measures are wanted).
     pub escapes_by_patch: Vec<u64>,
     /// Pair counts (only when the discrete measures are wanted).
@@ -87,6 +144,7 @@ impl Tally {
     pub fn empty(scene: &Scene, wanted: Wanted) -> Self {
         Tally {
             counters: Counters::default(),
+            orientation: vec![ObjectSides::default(); scene.objects.len()],
             escapes_by_patch: if wanted.discrete {
                 vec![0; scene.patch_count()]
             } else {
@@ -102,6 +160,7 @@ impl Tally {
     pub fn without_counts(&self) -> Tally {
         Tally {
             counters: self.counters,
+            orientation: self.orientation.clone(),
             escapes_by_patch: self.escapes_by_patch.clone(),
             counts: None,
         }
@@ -110,6 +169,7 @@ impl Tally {
     /// Adds another tally of the same scene into this one.
     pub fn merge(&mut self, other: &Tally) {
         self.counters.add(&other.counters);
+        add_sides(&mut self.orientation, &other.orientation);
         for (a, b) in self
             .escapes_by_patch
             .iter_mut()
@@ -128,6 +188,7 @@ impl Tally {
     pub fn without_part(&self, part: &Tally) -> Tally {
         Tally {
             counters: self.counters,
+            orientation: self.orientation.clone(),
             escapes_by_patch: self
                 .escapes_by_patch
                 .iter()
@@ -160,6 +221,7 @@ impl Tally {
     ) -> (Tally, Vec<Vec<u64>>) {
         let mut tally = Tally {
             counters: Counters::default(),
+            orientation: vec![ObjectSides::default(); scene.objects.len()],
             escapes_by_patch: if wanted.discrete {
                 vec![0; scene.patch_count()]
             } else {
@@ -170,6 +232,9 @@ impl Tally {
         let mut batch_keys = Vec::with_capacity(batches.len());
         for b in batches {
             tally.counters.add(&b.counters);
+            for e in &b.side_events {
+                tally.orientation[e.object as usize].count(e.kind);
+            }
             for &p in &b.escape_patches {
                 tally.escapes_by_patch[p as usize] += 1;
             }
@@ -235,6 +300,8 @@ pub struct BatchTally {
     pub pair_keys: Vec<u64>,
     /// The patch of every escape, when the discrete measures are wanted.
     pub escape_patches: Vec<u32>,
+    /// How the batch's lines met the objects' sides, event by event.
+    pub side_events: Vec<SideEvent>,
 }
 
 /// Pairs the canonical hits of a batch of lines and tallies the segments (paper sec. 3.2.2): the hot
@@ -253,6 +320,10 @@ pub fn tally_lines(scene: &Scene, lines: &[Line], hits: &LineHits, wanted: Wante
         },
         ..BatchTally::default()
     };
+    let event = |p: u32, kind: u8| SideEvent {
+        object: scene.patches[p as usize].object,
+        kind,
+    };
     let c = &mut t.counters;
     for (k, line) in lines.iter().enumerate() {
         let line_hits = hits.of_line(k);
@@ -261,38 +332,45 @@ pub fn tally_lines(scene: &Scene, lines: &[Line], hits: &LineHits, wanted: Wante
             env_sum.add(1.0, 2.0);
             continue;
         }
-        let mut at_start = true;
-        let overlaps = segments_counting_overlaps(scene, line, line_hits, |s| {
-            // Only the first segment can be the escape from the first hit.
-            let first = std::mem::replace(&mut at_start, false);
-            match s {
-                Segment::Pair {
-                    from,
-                    to,
-                    distance,
-                    cos_from,
-                    cos_to,
-                } => {
-                    c.pairs += 1;
-                    if wanted.discrete {
-                        keys.push(pair_key(from, to));
-                    }
-                    if wanted.continuous && !log2_sum.add(cos_from * cos_to, distance) {
-                        c.degenerate_pairs += 1;
-                    }
+        let events = &mut t.side_events;
+        let ends = segments_and_ends(scene, line, line_hits, |s| match s {
+            Segment::Pair {
+                from,
+                to,
+                distance,
+                cos_from,
+                cos_to,
+            } => {
+                c.pairs += 1;
+                if wanted.discrete {
+                    keys.push(pair_key(from, to));
                 }
-                Segment::Escape { patch } => {
-                    c.escapes += 1;
-                    if wanted.discrete {
-                        t.escape_patches.push(patch);
-                    }
-                    let (cos_product, distance) = environment::escape(scene, line, patch, first);
-                    env_sum.add(cos_product, distance);
+                if wanted.continuous && !log2_sum.add(cos_from * cos_to, distance) {
+                    c.degenerate_pairs += 1;
                 }
-                Segment::Unpaired => c.unpaired += 1,
             }
+            Segment::Escape { patch, at_start } => {
+                c.escapes += 1;
+                if wanted.discrete {
+                    t.escape_patches.push(patch);
+                }
+                events.push(event(patch, 2));
+                let (cos_product, distance) = environment::escape(scene, line, patch, at_start);
+                env_sum.add(cos_product, distance);
+            }
+            Segment::BackSeen { patch } => {
+                c.unpaired += 1;
+                events.push(event(patch, 3));
+            }
+            Segment::Unpaired => c.unpaired += 1,
         });
-        c.coincident_crossings += overlaps;
+        if let Some(p) = ends.back_first {
+            events.push(event(p, 0));
+        }
+        if let Some(p) = ends.back_last {
+            events.push(event(p, 1));
+        }
+        c.coincident_crossings += ends.overlaps;
     }
     let log2_area_over_pi = (scene.total_area() / std::f64::consts::PI).log2();
     let (cmi_sum, cmi_pairs) = log2_sum.finish(log2_area_over_pi);

@@ -1,14 +1,76 @@
 //! Building a [`Scene`] from polygons: validation, triangulation, patch planes, normalisation.
+//!
+//! Polygons come as files give them: a polygon planar within the tolerance is one patch (cut into
+//! triangles by a fan when convex, by ear clipping when not); a non-planar one is split into planar
+//! triangles, each its own patch, with one warning per scene (or refused in strict mode). Objects chosen
+//! by the options have their normals flipped or are made two-sided: two patches back to back, one per
+//! side, each with the face's area and material.
 
 use std::collections::HashMap;
 
 use super::{Material, Normalization, Patch, Scene, SceneError};
-use crate::geom::{centroid, newell, triangle_area, Normal, Point};
+use crate::geom::polygon::{planar_pieces, planarity_deviation, triangulate};
+use crate::geom::{centroid, newell, triangle_area, Point};
 
 /// A triangle whose area, relative to the squared bounding radius, is below this is degenerate.
 const DEGENERATE_AREA: f64 = 1e-14;
-/// A polygon whose vertices leave its plane by more than this fraction of its own size is not planar.
-const PLANARITY_TOLERANCE: f64 = 1e-4;
+/// By default a polygon whose corners leave its plane by more than this fraction of its own size is not
+/// planar: far above the rounding of coordinates written with 6 or more digits, far below a bend anyone
+/// would model on purpose.
+pub const DEFAULT_PLANARITY: f64 = 1e-4;
+/// How many split polygons the warning names.
+const SPLIT_EXAMPLES: usize = 3;
+
+/// What to do with polygons whose corners leave their plane.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Planarity {
+    /// Corners at most this fraction of the polygon's size off its best-fit plane count as planar.
+    pub tolerance: f64,
+    /// Refuse a non-planar polygon (an error naming it) instead of splitting it into planar triangles.
+    pub strict: bool,
+}
+
+impl Default for Planarity {
+    fn default() -> Self {
+        Planarity {
+            tolerance: DEFAULT_PLANARITY,
+            strict: false,
+        }
+    }
+}
+
+/// Some of a scene's objects, by name.
+#[derive(Clone, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub enum ObjectSet {
+    /// None of them.
+    #[default]
+    None,
+    /// Every object.
+    All,
+    /// The objects with these names (each must exist).
+    Named(Vec<String>),
+}
+
+/// How a scene is built from its file: the planarity rule and the objects to flip or make two-sided.
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct SceneOptions {
+    /// What to do with non-planar polygons.
+    pub planarity: Planarity,
+    /// Objects whose polygons face the other way (their corners reversed).
+    pub flip_normals: ObjectSet,
+    /// Objects whose polygons are surfaces on both sides (a second, reversed patch back to back).
+    pub two_sided: ObjectSet,
+}
+
+/// Which sides of a polygon are surfaces.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Sides {
+    /// The front side only (the side its normal points to): the other side is the inside of a solid or
+    /// the outside of an enclosure.
+    Front,
+    /// Both sides: two patches back to back (a thin panel, a leaf, glTF's `doubleSided`).
+    Both,
+}
 
 /// Collects polygons (each one patch) and turns them into a [`Scene`].
 ///
@@ -21,15 +83,28 @@ pub struct SceneBuilder {
     weld: HashMap<[u64; 3], u32>,
     polygons: Vec<Polygon>,
     materials: Vec<Material>,
+    objects: Vec<String>,
+    current_object: Option<u32>,
     warnings: Vec<String>,
 }
 
-#[derive(Debug)]
+#[derive(Clone, Debug)]
 struct Polygon {
     vertices: Vec<u32>,
     material: u32,
+    object: u32,
+    sides: Sides,
     /// Where it came from, for messages (`face 12`, `line 40`).
     origin: String,
+}
+
+/// The polygons split because they were not planar, for the one warning about them.
+#[derive(Debug, Default)]
+struct Splits {
+    count: usize,
+    pieces: usize,
+    worst: f64,
+    examples: Vec<String>,
 }
 
 impl SceneBuilder {
@@ -41,7 +116,34 @@ impl SceneBuilder {
             weld: HashMap::new(),
             polygons: Vec::new(),
             materials: Vec::new(),
+            objects: Vec::new(),
+            current_object: None,
             warnings: Vec::new(),
+        }
+    }
+
+    /// Makes `name` the object of the polygons added from now on (a new object, or an earlier one of the
+    /// same name) and returns its index. Polygons added before any object is named belong to an object
+    /// named after the scene.
+    pub fn object(&mut self, name: &str) -> u32 {
+        let k = match self.objects.iter().position(|o| o == name) {
+            Some(k) => k as u32,
+            None => {
+                self.objects.push(name.to_string());
+                (self.objects.len() - 1) as u32
+            }
+        };
+        self.current_object = Some(k);
+        k
+    }
+
+    fn current_object(&mut self) -> u32 {
+        match self.current_object {
+            Some(k) => k,
+            None => {
+                let name = self.name.clone();
+                self.object(&name)
+            }
         }
     }
 
@@ -65,11 +167,26 @@ impl SceneBuilder {
         (self.materials.len() - 1) as u32
     }
 
-    /// Adds a planar convex polygon (counter-clockwise seen from its front side) as one patch.
+    /// Adds a polygon (counter-clockwise seen from its front side), one-sided, to the current object: one
+    /// patch when planar, planar triangles when not ([`Planarity`]).
     pub fn polygon(&mut self, vertices: &[u32], material: u32, origin: impl Into<String>) {
+        self.polygon_sided(vertices, material, origin, Sides::Front);
+    }
+
+    /// Adds a polygon with the given sides to the current object (see [`SceneBuilder::polygon`]).
+    pub fn polygon_sided(
+        &mut self,
+        vertices: &[u32],
+        material: u32,
+        origin: impl Into<String>,
+        sides: Sides,
+    ) {
+        let object = self.current_object();
         self.polygons.push(Polygon {
             vertices: vertices.to_vec(),
             material,
+            object,
+            sides,
             origin: origin.into(),
         });
     }
@@ -79,12 +196,26 @@ impl SceneBuilder {
         self.warnings.push(message.into());
     }
 
-    /// Validates the geometry, triangulates the polygons and scales the scene to its unit bounding sphere.
-    pub fn build(mut self) -> Result<Scene, SceneError> {
+    /// Validates the geometry, triangulates the polygons and scales the scene to its unit bounding sphere,
+    /// with the default options.
+    pub fn build(self) -> Result<Scene, SceneError> {
+        self.build_with(&SceneOptions::default())
+    }
+
+    /// [`SceneBuilder::build`] with options: the planarity rule, and objects to flip or make two-sided
+    /// (an object name that does not exist is an error listing the scene's objects).
+    pub fn build_with(mut self, options: &SceneOptions) -> Result<Scene, SceneError> {
         if self.materials.is_empty() {
             self.materials.push(Material::default());
         }
+        if self.objects.is_empty() {
+            let name = self.name.clone();
+            self.object(&name);
+        }
         self.check_finite()?;
+        let flip = self.chosen_objects(&options.flip_normals, "--flip-normals")?;
+        let two_sided = self.chosen_objects(&options.two_sided, "--two-sided")?;
+        self.polygons = sided_polygons(std::mem::take(&mut self.polygons), &flip, &two_sided);
         let normalization = self.normalization()?;
         let traced: Vec<Point> = self
             .vertices
@@ -107,12 +238,14 @@ impl SceneBuilder {
             triangle_patch: Vec::new(),
             patches: Vec::new(),
             materials: std::mem::take(&mut self.materials),
+            objects: std::mem::take(&mut self.objects),
             normalization,
             area_scene_units: 0.0,
             warnings: std::mem::take(&mut self.warnings),
         };
         let mut dropped_triangles = 0usize;
         let mut dropped_polygons = Vec::new();
+        let mut splits = Splits::default();
         for poly in &self.polygons {
             if poly.vertices.len() < 3 {
                 return Err(self.geometry_error(format!(
@@ -128,47 +261,49 @@ impl SceneBuilder {
                 )));
             }
             let pts: Vec<Point> = poly.vertices.iter().map(|&v| traced[v as usize]).collect();
-            let (normal, area) = newell(&pts);
-            check_planar(&pts, normal, area)
-                .map_err(|m| self.geometry_error(format!("{}: {m}", poly.origin)))?;
-            let first = scene.triangles.len() as u32;
-            let patch_index = scene.patches.len() as u32;
-            let mut patch_area = 0.0;
-            for k in 1..poly.vertices.len() - 1 {
-                let tri = [poly.vertices[0], poly.vertices[k], poly.vertices[k + 1]];
-                let a = triangle_area(
-                    traced[tri[0] as usize],
-                    traced[tri[1] as usize],
-                    traced[tri[2] as usize],
-                );
-                if a <= DEGENERATE_AREA {
-                    dropped_triangles += 1;
-                    continue;
+            let deviation = planarity_deviation(&pts);
+            let created = if deviation > options.planarity.tolerance {
+                if options.planarity.strict {
+                    return Err(self.geometry_error(format!(
+                        "{}: non-planar polygon with {} vertices: a vertex is {deviation:.3e} of the \
+                         face's size off its plane (tolerance {:e}); triangulate it, or leave \
+                         --strict-planarity out to have it split into planar triangles",
+                        poly.origin,
+                        pts.len(),
+                        options.planarity.tolerance
+                    )));
                 }
-                patch_area += a;
-                scene.area_scene_units += triangle_area(
-                    scene.vertices[tri[0] as usize],
-                    scene.vertices[tri[1] as usize],
-                    scene.vertices[tri[2] as usize],
-                );
-                scene.triangles.push(tri);
-                scene.triangle_patch.push(patch_index);
-            }
-            let count = scene.triangles.len() as u32 - first;
-            if count == 0 {
+                let pieces = planar_pieces(&pts);
+                splits.add(&poly.origin, deviation, pieces.len());
+                let mut any = false;
+                for piece in pieces {
+                    let corners = piece.map(|k| poly.vertices[k]);
+                    any |= add_patch(
+                        &mut scene,
+                        &traced,
+                        poly,
+                        &corners,
+                        &[[0, 1, 2]],
+                        &mut dropped_triangles,
+                    );
+                }
+                any
+            } else {
+                add_patch(
+                    &mut scene,
+                    &traced,
+                    poly,
+                    &poly.vertices,
+                    &triangulate(&pts),
+                    &mut dropped_triangles,
+                )
+            };
+            if !created {
                 dropped_polygons.push(poly.origin.clone());
-                continue;
             }
-            let centroid = centroid(&pts);
-            scene.patches.push(Patch {
-                area: patch_area,
-                normal,
-                offset: normal.dot(centroid),
-                material: poly.material,
-                first_triangle: first,
-                triangle_count: count,
-                polygon: poly.vertices.clone(),
-            });
+        }
+        if let Some(w) = splits.warning(&self.name, options.planarity.tolerance) {
+            scene.warnings.push(w);
         }
         if dropped_triangles > 0 {
             scene.warnings.push(format!(
@@ -187,7 +322,44 @@ impl SceneBuilder {
         if scene.patches.is_empty() {
             return Err(self.geometry_error("the scene has no faces of non-zero area".into()));
         }
+        self.check_used_materials(&scene)?;
         Ok(scene)
+    }
+
+    /// Every channel of a used material physical (reflectance in [0, 1], emission finite and >= 0).
+    fn check_used_materials(&self, scene: &Scene) -> Result<(), SceneError> {
+        let mut used = vec![false; scene.materials.len()];
+        for p in &scene.patches {
+            used[p.material as usize] = true;
+        }
+        for (m, _) in scene.materials.iter().zip(&used).filter(|(_, &u)| u) {
+            if let Some(problem) = m.unphysical_channel() {
+                return Err(self.geometry_error(format!("material `{}`: {problem}", m.name)));
+            }
+        }
+        Ok(())
+    }
+
+    /// Which objects a set names (one flag per object); an unknown name is an error listing the objects.
+    fn chosen_objects(&self, set: &ObjectSet, option: &str) -> Result<Vec<bool>, SceneError> {
+        let n = self.objects.len();
+        match set {
+            ObjectSet::None => Ok(vec![false; n]),
+            ObjectSet::All => Ok(vec![true; n]),
+            ObjectSet::Named(names) => {
+                let mut chosen = vec![false; n];
+                for name in names {
+                    let Some(k) = self.objects.iter().position(|o| o == name) else {
+                        return Err(self.geometry_error(format!(
+                            "{option}: no object named `{name}`; the scene's objects are {}",
+                            list_names(&self.objects)
+                        )));
+                    };
+                    chosen[k] = true;
+                }
+                Ok(chosen)
+            }
+        }
     }
 
     fn geometry_error(&self, message: String) -> SceneError {
@@ -316,23 +488,125 @@ fn to_tracing_space(p: Point, n: &Normalization) -> Point {
     (p - n.center) / n.scale
 }
 
-fn check_planar(pts: &[Point], normal: Normal, area: f64) -> Result<(), String> {
-    if pts.len() <= 3 || area <= 0.0 {
-        return Ok(());
+/// The polygons with flipped objects' corners reversed, and each two-sided polygon followed by its
+/// reverse (the back side as a patch of its own).
+fn sided_polygons(polygons: Vec<Polygon>, flip: &[bool], two_sided: &[bool]) -> Vec<Polygon> {
+    let mut out = Vec::with_capacity(polygons.len());
+    for mut poly in polygons {
+        if flip[poly.object as usize] {
+            reverse_corners(&mut poly.vertices);
+        }
+        let both = poly.sides == Sides::Both || two_sided[poly.object as usize];
+        let back = both.then(|| {
+            let mut back = poly.clone();
+            reverse_corners(&mut back.vertices);
+            back.origin = format!("{} (back side)", poly.origin);
+            back
+        });
+        out.push(poly);
+        out.extend(back);
     }
-    let c = centroid(pts);
-    let size = pts.iter().map(|&p| (p - c).length()).fold(0.0, f64::max);
-    let off = pts
-        .iter()
-        .map(|&p| normal.dot(p - c).abs())
-        .fold(0.0, f64::max);
-    if off > PLANARITY_TOLERANCE * size {
-        return Err(format!(
-            "non-planar polygon with {} vertices: a vertex is {:.3e} of the face's size off its plane \
-             (tolerance {PLANARITY_TOLERANCE:e}); triangulate it",
-            pts.len(),
-            off / size
-        ));
+    out
+}
+
+/// Reverses a polygon's orientation keeping its first corner first (so its fan starts there too).
+fn reverse_corners(v: &mut [u32]) {
+    if v.len() > 1 {
+        v[1..].reverse();
     }
-    Ok(())
+}
+
+/// Adds the triangles `tris` (indices into `corners`) of polygon `poly` as one patch whose outline is
+/// `corners`; drops zero-area triangles (counted) and returns whether any triangle was left.
+fn add_patch(
+    scene: &mut Scene,
+    traced: &[Point],
+    poly: &Polygon,
+    corners: &[u32],
+    tris: &[[usize; 3]],
+    dropped_triangles: &mut usize,
+) -> bool {
+    let pts: Vec<Point> = corners.iter().map(|&v| traced[v as usize]).collect();
+    let (normal, _) = newell(&pts);
+    let first = scene.triangles.len() as u32;
+    let patch_index = scene.patches.len() as u32;
+    let mut patch_area = 0.0;
+    for t in tris {
+        let tri = t.map(|k| corners[k]);
+        let a = triangle_area(
+            traced[tri[0] as usize],
+            traced[tri[1] as usize],
+            traced[tri[2] as usize],
+        );
+        if a <= DEGENERATE_AREA {
+            *dropped_triangles += 1;
+            continue;
+        }
+        patch_area += a;
+        scene.area_scene_units += triangle_area(
+            scene.vertices[tri[0] as usize],
+            scene.vertices[tri[1] as usize],
+            scene.vertices[tri[2] as usize],
+        );
+        scene.triangles.push(tri);
+        scene.triangle_patch.push(patch_index);
+    }
+    let count = scene.triangles.len() as u32 - first;
+    if count == 0 {
+        return false;
+    }
+    scene.patches.push(Patch {
+        area: patch_area,
+        normal,
+        offset: normal.dot(centroid(&pts)),
+        material: poly.material,
+        object: poly.object,
+        first_triangle: first,
+        triangle_count: count,
+        polygon: corners.to_vec(),
+    });
+    true
+}
+
+impl Splits {
+    fn add(&mut self, origin: &str, deviation: f64, pieces: usize) {
+        self.count += 1;
+        self.pieces += pieces;
+        self.worst = self.worst.max(deviation);
+        if self.examples.len() < SPLIT_EXAMPLES {
+            self.examples.push(origin.to_string());
+        }
+    }
+
+    /// The one warning about the split polygons (`None` when none was split).
+    fn warning(&self, scene: &str, tolerance: f64) -> Option<String> {
+        if self.count == 0 {
+            return None;
+        }
+        let more = self.count - self.examples.len();
+        let rest = if more > 0 {
+            format!(", and {more} more")
+        } else {
+            String::new()
+        };
+        Some(format!(
+            "{scene}: split {} non-planar polygon(s) into {} planar triangles, each a patch (worst: a \
+             vertex {:.3e} of the face's size off its plane; tolerance {tolerance:e}): {}{rest}",
+            self.count,
+            self.pieces,
+            self.worst,
+            self.examples.join("; ")
+        ))
+    }
+}
+
+/// Names for a message: `a`, `b`, `c` (the first 10, then how many more).
+pub(crate) fn list_names(names: &[String]) -> String {
+    let shown: Vec<String> = names.iter().take(10).map(|n| format!("`{n}`")).collect();
+    let more = names.len().saturating_sub(10);
+    if more > 0 {
+        format!("{} and {more} more", shown.join(", "))
+    } else {
+        shown.join(", ")
+    }
 }

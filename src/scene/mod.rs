@@ -6,38 +6,104 @@
 //! original f64 coordinates.
 
 mod build;
+pub mod format;
+pub mod gltf;
 pub mod obj;
 mod obj_check;
+mod ply;
+mod stl;
 
-pub use build::SceneBuilder;
+pub use build::{ObjectSet, Planarity, SceneBuilder, SceneOptions, Sides, DEFAULT_PLANARITY};
 
 use std::fmt;
 
 use crate::geom::{Normal, Point};
 
-/// Diffuse material of a patch (paper eq. (2)): emission `E_i` and reflectance `R_i`, one channel each.
+/// Diffuse material of a patch (paper eq. (2)): emission `E_i` and reflectance `R_i`, one channel each,
+/// and the RGB triples they come from.
 ///
-/// From an MTL file, the single value is the mean of the three RGB channels of `Ke` and `Kd` (exactly the
-/// value of a grey triple): the response to an equal-energy white light with every channel weighted
-/// alike. The radiosity measures (paper sec. 4) use these values; they require `0 <= R_i <= 1` and
-/// `E_i >= 0` (see [`crate::measure::radiosity::PatchMaterials`]).
+/// The single value is the mean of the three RGB channels (exactly the value of a grey triple): the
+/// response to an equal-energy white light with every channel weighted alike. The radiosity measures
+/// (paper sec. 4) use these values; they require `0 <= R_i <= 1` and `E_i >= 0` (see
+/// [`crate::measure::radiosity::PatchMaterials`]). The triples are kept so that a scene written back
+/// (`scx export`, `scx refine`) keeps its colours. Build materials with [`Material::grey`] or
+/// [`Material::rgb`], which keep the scalars the means of the triples.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Material {
-    /// Name as in the MTL file, or a built-in name.
+    /// Name as in the scene file, or a built-in name.
     pub name: String,
-    /// Emitted radiosity `E_i` (>= 0).
+    /// Emitted radiosity `E_i` (>= 0): the mean of [`Material::emission_rgb`].
     pub emission: f64,
-    /// Diffuse reflectance `R_i` (in [0, 1] for a physical material).
+    /// Diffuse reflectance `R_i` (in [0, 1] for a physical material): the mean of
+    /// [`Material::reflectance_rgb`].
     pub reflectance: f64,
+    /// Emission per channel (red, green, blue): MTL `Ke`, glTF `emissiveFactor` times its strength.
+    pub emission_rgb: [f64; 3],
+    /// Reflectance per channel (red, green, blue): MTL `Kd`, glTF `baseColorFactor`, PLY face colour.
+    pub reflectance_rgb: [f64; 3],
+}
+
+impl Material {
+    /// A grey material: every channel the same.
+    pub fn grey(name: impl Into<String>, reflectance: f64, emission: f64) -> Self {
+        Material {
+            name: name.into(),
+            emission,
+            reflectance,
+            emission_rgb: [emission; 3],
+            reflectance_rgb: [reflectance; 3],
+        }
+    }
+
+    /// A coloured material; its single values are the means of the triples ([`grey_value`]).
+    pub fn rgb(name: impl Into<String>, reflectance: [f64; 3], emission: [f64; 3]) -> Self {
+        Material {
+            name: name.into(),
+            emission: grey_value(emission),
+            reflectance: grey_value(reflectance),
+            emission_rgb: emission,
+            reflectance_rgb: reflectance,
+        }
+    }
+
+    /// The first channel of `Kd` (reflectance) outside [0, 1], or of `Ke` (emission) below 0 or not
+    /// finite, described for a message (`None` when every channel is physical).
+    pub fn unphysical_channel(&self) -> Option<String> {
+        const CHANNELS: [&str; 3] = ["red", "green", "blue"];
+        for (k, &r) in self.reflectance_rgb.iter().enumerate() {
+            if !(r.is_finite() && (0.0..=1.0).contains(&r)) {
+                return Some(format!(
+                    "reflectance (Kd) {} channel is {r}; each channel must be in [0, 1]",
+                    CHANNELS[k]
+                ));
+            }
+        }
+        for (k, &e) in self.emission_rgb.iter().enumerate() {
+            if !(e.is_finite() && e >= 0.0) {
+                return Some(format!(
+                    "emission (Ke) {} channel is {e}; each channel must be finite and >= 0",
+                    CHANNELS[k]
+                ));
+            }
+        }
+        None
+    }
+}
+
+/// One channel from RGB: the plain mean (the value seen under an equal-energy white light, the same
+/// weight for each channel). A grey triple gives its value exactly, so that a file written by scx reads
+/// back bit-identical (the mean of three equal values can be off by an ulp).
+pub fn grey_value(c: [f64; 3]) -> f64 {
+    if c[0] == c[1] && c[1] == c[2] {
+        c[0]
+    } else {
+        (c[0] + c[1] + c[2]) / 3.0
+    }
 }
 
 impl Default for Material {
     fn default() -> Self {
-        Material {
-            name: "default".into(),
-            emission: 0.0,
-            reflectance: 0.5,
-        }
+        Material::grey("default", 0.5, 0.0)
     }
 }
 
@@ -52,12 +118,21 @@ pub struct Patch {
     pub offset: f64,
     /// Index into [`Scene::materials`].
     pub material: u32,
+    /// Index into [`Scene::objects`]: the part of the scene it belongs to.
+    pub object: u32,
     /// The range of this patch's triangles in [`Scene::triangles`].
     pub first_triangle: u32,
     /// How many triangles the patch has.
     pub triangle_count: u32,
     /// The polygon's vertices (indices into [`Scene::vertices`]), in order, front side counter-clockwise.
     pub polygon: Vec<u32>,
+}
+
+/// The object name of a single-object file (PLY, STL): its name without the extension.
+pub(crate) fn object_name(path: &std::path::Path) -> String {
+    path.file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "object".into())
 }
 
 /// How tracing space relates to the scene's own units: `original = center + scale * traced`.
@@ -86,6 +161,9 @@ pub struct Scene {
     pub patches: Vec<Patch>,
     /// The materials patches refer to.
     pub materials: Vec<Material>,
+    /// The names of the scene's objects (OBJ `o`/`g`, glTF node or mesh, the file name for PLY and STL,
+    /// the scene's name for a built-in), which patches refer to by index.
+    pub objects: Vec<String>,
     /// Mapping back to the scene's own units.
     pub normalization: Normalization,
     /// Total area in the scene's own units, from the original f64 coordinates.

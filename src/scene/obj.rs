@@ -6,10 +6,15 @@
 
 use std::path::Path;
 
-use super::{Material, Scene, SceneBuilder, SceneError};
+use super::{Material, Scene, SceneBuilder, SceneError, SceneOptions};
 
 /// Loads an OBJ file (and its MTL library, if any, beside it) as a scene.
 pub fn load(path: &Path) -> Result<Scene, SceneError> {
+    load_with(path, &SceneOptions::default())
+}
+
+/// [`load`] with options (planarity, flipped and two-sided objects).
+pub fn load_with(path: &Path, options: &SceneOptions) -> Result<Scene, SceneError> {
     let shown = path.display().to_string();
     let file_error = |message: String| SceneError::File {
         path: shown.clone(),
@@ -29,12 +34,49 @@ pub fn load(path: &Path) -> Result<Scene, SceneError> {
             e.utf8_error().valid_up_to()
         ))
     })?;
+    load_obj_text(&shown, &text, path, options)
+}
+
+/// Loads OBJ text read from `path` (its MTL libraries are looked up beside it).
+pub(crate) fn load_obj_text(
+    shown: &str,
+    text: &str,
+    path: &Path,
+    options: &SceneOptions,
+) -> Result<Scene, SceneError> {
     let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
-    load_text(&shown, &text, &|mtl: &Path| {
-        let full = base.join(mtl);
-        let text = std::fs::read_to_string(&full).map_err(|e| e.to_string())?;
-        Ok((full.display().to_string(), text))
-    })
+    load_text_with(
+        shown,
+        text,
+        &|mtl: &Path| read_libraries(&base, mtl),
+        options,
+    )
+}
+
+/// The MTL text an `mtllib` statement names, read beside the OBJ. The statement may list several files
+/// (a space inside a name escaped as `\ `); `tobj` hands over the whole list, so when it is no file,
+/// each listed file that exists is read and their texts are joined.
+fn read_libraries(base: &Path, mtl: &Path) -> Result<(String, String), String> {
+    let full = base.join(mtl);
+    let whole = match std::fs::read_to_string(&full) {
+        Ok(text) => return Ok((full.display().to_string(), text)),
+        Err(e) => e.to_string(),
+    };
+    let listed = mtl.to_string_lossy().replace("\\ ", "\u{0}");
+    let found: Vec<(String, String)> = listed
+        .split_whitespace()
+        .map(|name| base.join(name.replace('\u{0}', " ")))
+        .filter_map(|p| {
+            let text = std::fs::read_to_string(&p).ok()?;
+            Some((p.display().to_string(), text))
+        })
+        .collect();
+    if found.is_empty() {
+        return Err(whole);
+    }
+    let names: Vec<&str> = found.iter().map(|(n, _)| n.as_str()).collect();
+    let texts: Vec<&str> = found.iter().map(|(_, t)| t.as_str()).collect();
+    Ok((names.join(" + "), texts.join("\n")))
 }
 
 /// Where an OBJ's MTL library comes from: given the name in `mtllib`, the library's name for messages
@@ -44,13 +86,27 @@ pub type MaterialSource<'a> = dyn Fn(&Path) -> Result<(String, String), String> 
 /// Loads OBJ text as a scene called `shown` (messages name it), with `materials` giving the text of an
 /// MTL library from the name in the OBJ (a missing library is a warning, a malformed one an error).
 pub fn load_text(shown: &str, text: &str, materials: &MaterialSource) -> Result<Scene, SceneError> {
+    load_text_with(shown, text, materials, &SceneOptions::default())
+}
+
+/// [`load_text`] with options (planarity, flipped and two-sided objects).
+pub fn load_text_with(
+    shown: &str,
+    text: &str,
+    materials: &MaterialSource,
+    options: &SceneOptions,
+) -> Result<Scene, SceneError> {
     let shown = shown.to_string();
     let file_error = |message: String| SceneError::File {
         path: shown.clone(),
         message,
     };
-    let face_lines = super::obj_check::scan(&shown, text)?;
-    let options = tobj::LoadOptions {
+    let prepared = super::obj_check::prepare(&shown, text)?;
+    if prepared.faces.is_empty() {
+        return Err(no_faces(&shown, &prepared));
+    }
+    let face_lines = &prepared.faces;
+    let options_tobj = tobj::LoadOptions {
         single_index: false,
         triangulate: false,
         ignore_points: true,
@@ -59,6 +115,8 @@ pub fn load_text(shown: &str, text: &str, materials: &MaterialSource) -> Result<
     // tobj panics on some malformed MTL statements: the pre-scan refuses those first, and its error
     // (with the line) comes out of tobj's callback this way.
     let mtl_error: std::cell::RefCell<Option<SceneError>> = std::cell::RefCell::new(None);
+    // Where each material is defined (library and line), for messages about it.
+    let defined: std::cell::RefCell<Vec<(String, String, usize)>> = Default::default();
     let load_mtl = |name: &Path| match materials(name) {
         Err(_) => Err(tobj::LoadError::OpenFileFailed),
         Ok((mtl_shown, mtl_text)) => match super::obj_check::scan_mtl(&mtl_shown, &mtl_text) {
@@ -66,14 +124,23 @@ pub fn load_text(shown: &str, text: &str, materials: &MaterialSource) -> Result<
                 mtl_error.borrow_mut().get_or_insert(e);
                 Err(tobj::LoadError::MaterialParseError)
             }
-            Ok(()) => tobj::load_mtl_buf(&mut mtl_text.as_bytes()),
+            Ok(()) => {
+                let lines = super::obj_check::material_lines(&mtl_text);
+                defined.borrow_mut().extend(
+                    lines
+                        .into_iter()
+                        .map(|(m, line)| (m, mtl_shown.clone(), line)),
+                );
+                tobj::load_mtl_buf(&mut mtl_text.as_bytes())
+            }
         },
     };
-    let loaded = tobj::load_obj_buf(&mut text.as_bytes(), &options, load_mtl);
+    let loaded = tobj::load_obj_buf(&mut prepared.text.as_bytes(), &options_tobj, load_mtl);
     if let Some(e) = mtl_error.take() {
         return Err(e);
     }
     let (models, materials) = loaded.map_err(|e| file_error(describe_tobj_error(&e)))?;
+    let defined = defined.take();
     let total_faces: usize = models.iter().map(|m| face_count(&m.mesh)).sum();
     // Faces as tobj gives them are the `f` statements in file order; name their lines when that holds.
     let face_line = |k: usize| (total_faces == face_lines.len()).then(|| face_lines[k]);
@@ -86,6 +153,8 @@ pub fn load_text(shown: &str, text: &str, materials: &MaterialSource) -> Result<
             for m in &mats {
                 b.material(convert_material(m));
             }
+            check_used_materials(&shown, &mats, &models, &defined)?;
+            warn_undefined_materials(&mut b, &shown, &prepared.usemtl, &mats);
             if mats.is_empty() {
                 None
             } else {
@@ -101,6 +170,7 @@ pub fn load_text(shown: &str, text: &str, materials: &MaterialSource) -> Result<
             None
         }
     };
+    warn_ignored_statements(&mut b, &shown, &prepared);
     let default_material = b.material(Material::default());
 
     for model in &models {
@@ -111,6 +181,7 @@ pub fn load_text(shown: &str, text: &str, materials: &MaterialSource) -> Result<
                 model.name
             )));
         }
+        b.object(&model.name);
         let ids: Vec<u32> = mesh
             .positions
             .chunks_exact(3)
@@ -160,7 +231,114 @@ pub fn load_text(shown: &str, text: &str, materials: &MaterialSource) -> Result<
             at += arity;
         }
     }
-    b.build()
+    b.build_with(options)
+}
+
+/// The error for OBJ text without faces, naming the lines and points it has instead, if any.
+fn no_faces(shown: &str, prepared: &super::obj_check::Prepared) -> SceneError {
+    let (count, line) = prepared.lines_and_points;
+    if count > 0 {
+        return SceneError::File {
+            path: format!("{shown}:{line}"),
+            message: format!(
+                "the scene is empty: no faces (`f`); its {count} line and point statement(s) (`l`, `p`, \
+                 the first here) have no area"
+            ),
+        };
+    }
+    match prepared.text.lines().count() {
+        0 => SceneError::Geometry {
+            scene: shown.to_string(),
+            message: "the scene is empty: no faces".into(),
+        },
+        lines => SceneError::File {
+            path: format!("{shown}:{lines}"),
+            message: format!(
+                "the scene is empty: no faces (`f`) in its {lines} line(s), up to this last one"
+            ),
+        },
+    }
+}
+
+/// Every channel of a used material's `Kd` in [0, 1] and of its `Ke` finite and >= 0: an error naming
+/// the library, the material's line and the channel.
+fn check_used_materials(
+    shown: &str,
+    materials: &[tobj::Material],
+    models: &[tobj::Model],
+    defined: &[(String, String, usize)],
+) -> Result<(), SceneError> {
+    let mut used = vec![false; materials.len()];
+    for m in models {
+        if let Some(id) = m.mesh.material_id.filter(|&id| id < used.len()) {
+            used[id] = true;
+        }
+    }
+    for (m, _) in materials.iter().zip(&used).filter(|(_, &u)| u) {
+        let Some(problem) = convert_material(m).unphysical_channel() else {
+            continue;
+        };
+        let path = match defined.iter().find(|(name, _, _)| *name == m.name) {
+            Some((_, library, line)) => format!("{library}:{line}"),
+            None => shown.to_string(),
+        };
+        return Err(SceneError::File {
+            path,
+            message: format!("material `{}`: {problem}", m.name),
+        });
+    }
+    Ok(())
+}
+
+/// One warning naming the `usemtl` statements whose material no library defines (their faces get the
+/// default material).
+fn warn_undefined_materials(
+    b: &mut SceneBuilder,
+    shown: &str,
+    usemtl: &[(usize, String)],
+    materials: &[tobj::Material],
+) {
+    let mut undefined: Vec<(usize, &str)> = Vec::new();
+    for (line, name) in usemtl {
+        let known = materials.iter().any(|m| m.name == *name);
+        if !known && !undefined.iter().any(|(_, n)| n == name) {
+            undefined.push((*line, name));
+        }
+    }
+    if undefined.is_empty() {
+        return;
+    }
+    let named: Vec<String> = undefined
+        .iter()
+        .map(|(line, name)| format!("`{name}` (line {line})"))
+        .collect();
+    b.warn(format!(
+        "{shown}: `usemtl` names material(s) no library defines: {}; their faces get the default \
+         material (reflectance 0.5, no emission)",
+        named.join(", ")
+    ));
+}
+
+/// Warnings about what the loader left out: `w` weights and line or point statements.
+fn warn_ignored_statements(
+    b: &mut SceneBuilder,
+    shown: &str,
+    prepared: &super::obj_check::Prepared,
+) {
+    let (weights, line) = prepared.weights;
+    if weights > 0 {
+        b.warn(format!(
+            "{shown}: ignored the weight `w` of {weights} vertex statement(s) `v x y z w` (first at line \
+             {line}): it applies to rational curves and surfaces only"
+        ));
+    }
+    let (count, line) = prepared.lines_and_points;
+    if count > 0 {
+        b.warn(format!(
+            "{shown}: ignored {count} line and point statement(s) (`l`, `p`; first at line {line}): they \
+             have no area"
+        ));
+    }
 }
 
 /// Faces of a tobj mesh (triangles when it gives no arities).
@@ -173,32 +351,13 @@ fn face_count(mesh: &tobj::Mesh) -> usize {
 }
 
 fn convert_material(m: &tobj::Material) -> Material {
-    let mean = grey_value;
     // tobj 4 parses `Ke` into `emissive`; the key-value fallback covers readers that leave it unknown.
     let emission = m
         .emissive
         .or_else(|| m.unknown_param.get("Ke").and_then(|s| parse_rgb(s)))
-        .map(mean)
-        .unwrap_or(0.0);
-    Material {
-        name: m.name.clone(),
-        emission,
-        reflectance: m
-            .diffuse
-            .map(mean)
-            .unwrap_or(Material::default().reflectance),
-    }
-}
-
-/// One channel from RGB: the plain mean (the value seen under an equal-energy white light, the same
-/// weight for each channel). A grey triple gives its value exactly, so that an MTL written by [`write`]
-/// reads back bit-identical (the mean of three equal values can be off by an ulp).
-fn grey_value(c: [f64; 3]) -> f64 {
-    if c[0] == c[1] && c[1] == c[2] {
-        c[0]
-    } else {
-        (c[0] + c[1] + c[2]) / 3.0
-    }
+        .unwrap_or([0.0; 3]);
+    let reflectance = m.diffuse.unwrap_or(Material::default().reflectance_rgb);
+    Material::rgb(m.name.clone(), reflectance, emission)
 }
 
 fn parse_rgb(s: &str) -> Option<[f64; 3]> {
@@ -240,7 +399,8 @@ fn describe_tobj_error(e: &tobj::LoadError) -> String {
 }
 
 /// Writes a scene as OBJ (scene units, one polygon face per patch) plus an MTL library beside it
-/// (`Kd` = reflectance, `Ke` = emission, grey), so that [`load`] reads back the same patches and materials.
+/// (`Kd` = reflectance, `Ke` = emission, RGB), so that [`load`] reads back the same patches and
+/// materials. A scene of several objects gets an `o` statement per object, so that they keep their names.
 pub fn write(scene: &Scene, path: &Path) -> Result<(), SceneError> {
     use std::fmt::Write as _;
     let io_error = |p: &Path, e: std::io::Error| SceneError::File {
@@ -255,10 +415,11 @@ pub fn write(scene: &Scene, path: &Path) -> Result<(), SceneError> {
 
     let mut mtl = String::from("# written by scx\n");
     for (k, m) in scene.materials.iter().enumerate() {
-        let (r, e) = (m.reflectance, m.emission);
+        let [r, g, b] = m.reflectance_rgb;
+        let [er, eg, eb] = m.emission_rgb;
         let _ = writeln!(
             mtl,
-            "newmtl {}\nKd {r} {r} {r}\nKe {e} {e} {e}\n",
+            "newmtl {}\nKd {r} {g} {b}\nKe {er} {eg} {eb}\n",
             material_label(k, m)
         );
     }
@@ -271,8 +432,17 @@ pub fn write(scene: &Scene, path: &Path) -> Result<(), SceneError> {
     for v in &scene.vertices {
         let _ = writeln!(obj, "v {:?} {:?} {:?}", v[0], v[1], v[2]);
     }
+    let named_objects = scene.objects.len() > 1;
     let mut current = None;
+    let mut current_object = None;
     for p in &scene.patches {
+        if named_objects && current_object != Some(p.object) {
+            let name = scene.objects[p.object as usize].trim();
+            let _ = writeln!(obj, "o {}", if name.is_empty() { "unnamed" } else { name });
+            current_object = Some(p.object);
+            // tobj starts a new model at `o`: say the material again.
+            current = None;
+        }
         if current != Some(p.material) {
             let k = p.material as usize;
             let _ = writeln!(obj, "usemtl {}", material_label(k, &scene.materials[k]));

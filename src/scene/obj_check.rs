@@ -7,7 +7,93 @@
 //! `f` statements only (what scx uses) and remembers the line of every face, so that later messages about
 //! a face (non-planar, zero area) can name its line too.
 
+use std::borrow::Cow;
+
 use super::SceneError;
+
+/// OBJ text as scx reads it, and what the scan found on the way.
+pub(crate) struct Prepared<'a> {
+    /// The line numbers (1-based) of the `f` statements, in file order.
+    pub faces: Vec<usize>,
+    /// The text for `tobj`: the input, or a copy with the statements scx ignores blanked out (same lines).
+    pub text: Cow<'a, str>,
+    /// `v` statements whose fourth number (`w`) was dropped: how many, and the first one's line.
+    pub weights: (usize, usize),
+    /// `l` and `p` statements (lines and points: no area), blanked out: how many, the first one's line.
+    pub lines_and_points: (usize, usize),
+    /// Every `usemtl`: its line and the material it names.
+    pub usemtl: Vec<(usize, String)>,
+}
+
+/// Scans OBJ text ([`scan`]) and prepares it for `tobj`: the optional `w` of `v x y z w` is dropped (the
+/// OBJ specification gives it a meaning for rational curves and surfaces only, and `tobj` would divide
+/// x, y and z by it), and `l` and `p` statements are blanked (`tobj` reads an `l` of three or more
+/// vertices as a polygon).
+pub(crate) fn prepare<'a>(shown: &str, text: &'a str) -> Result<Prepared<'a>, SceneError> {
+    let faces = scan(shown, text)?;
+    let mut weights = (0, 0);
+    let mut lines_and_points = (0, 0);
+    let mut usemtl = Vec::new();
+    let mut rewritten: Vec<(usize, String)> = Vec::new();
+    for (k, raw) in text.lines().enumerate() {
+        let mut tokens = raw.split_whitespace();
+        match tokens.next() {
+            Some("v") => {
+                let numbers: Vec<&str> = tokens.collect();
+                if numbers.len() == 4 {
+                    note(&mut weights, k + 1);
+                    rewritten.push((k, format!("v {} {} {}", numbers[0], numbers[1], numbers[2])));
+                }
+            }
+            Some("l" | "p") => {
+                note(&mut lines_and_points, k + 1);
+                rewritten.push((k, String::new()));
+            }
+            Some("usemtl") => {
+                let name = raw.trim_start()["usemtl".len()..].trim();
+                usemtl.push((k + 1, name.to_string()));
+            }
+            _ => {}
+        }
+    }
+    let text = if rewritten.is_empty() {
+        Cow::Borrowed(text)
+    } else {
+        let mut lines: Vec<&str> = text.lines().collect();
+        for (k, new) in &rewritten {
+            lines[*k] = new.as_str();
+        }
+        Cow::Owned(lines.join("\n"))
+    };
+    Ok(Prepared {
+        faces,
+        text,
+        weights,
+        lines_and_points,
+        usemtl,
+    })
+}
+
+/// Counts one more statement of a kind, remembering the first one's line.
+fn note(seen: &mut (usize, usize), line: usize) {
+    if seen.0 == 0 {
+        seen.1 = line;
+    }
+    seen.0 += 1;
+}
+
+/// The line (1-based) of each `newmtl` in MTL text, by material name.
+pub(crate) fn material_lines(text: &str) -> Vec<(String, usize)> {
+    text.lines()
+        .enumerate()
+        .filter_map(|(k, raw)| {
+            let t = raw.trim_start();
+            let rest = t.strip_prefix("newmtl")?;
+            rest.starts_with(char::is_whitespace)
+                .then(|| (rest.trim().to_string(), k + 1))
+        })
+        .collect()
+}
 
 /// The line numbers (1-based) of the `f` statements, in file order; or the first problem found.
 pub(crate) fn scan(shown: &str, text: &str) -> Result<Vec<usize>, SceneError> {

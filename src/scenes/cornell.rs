@@ -46,6 +46,20 @@ pub const RED: f64 = 0.242_947_368_421_052_66;
 pub const GREEN: f64 = 0.198_25;
 /// Mean of the published emission spectrum of the light (piecewise linear, 400-700 nm).
 pub const LIGHT_EMISSION: f64 = (4.0 + 11.8 + 17.0) / 3.0;
+
+/// The white paint as RGB: the means of the published spectrum over the longest, middle and shortest
+/// third of its 76 samples (the samples at 500 and 600 nm shared 1/3 : 2/3 between neighbouring
+/// thirds), so that the three means average to [`WHITE`] exactly; the blue value is moved by one ulp
+/// to make that hold in f64 too. Only `scx export` and `refine` use the triples: every measure uses the
+/// single values.
+pub const WHITE_RGB: [f64; 3] = [0.7337631578947369, 0.7357631578947369, 0.698486842105263];
+/// The red paint as RGB (see [`WHITE_RGB`]; blue moved by one ulp), averaging to [`RED`].
+pub const RED_RGB: [f64; 3] = [0.5836842105263158, 0.08889473684210526, 0.05626315789473685];
+/// The green paint as RGB (see [`WHITE_RGB`]), averaging to [`GREEN`].
+pub const GREEN_RGB: [f64; 3] = [0.13221052631578947, 0.3466842105263158, 0.11585526315789474];
+/// The light's emission as RGB: the mean of its published spectrum over 600-700, 500-600 and 400-500 nm
+/// (the three terms of [`LIGHT_EMISSION`]).
+pub const LIGHT_EMISSION_RGB: [f64; 3] = [17.0, 11.8, 4.0];
 /// Reflectance we give the light (the published data give none).
 pub const LIGHT_REFLECTANCE: f64 = 0.78;
 
@@ -203,22 +217,20 @@ struct Materials {
 
 impl Materials {
     fn add(b: &mut SceneBuilder) -> Self {
-        let mut diffuse = |name: &str, reflectance: f64| {
+        let mut diffuse = |name: &str, reflectance: f64, rgb: [f64; 3]| {
             b.material(Material {
-                name: name.into(),
-                emission: 0.0,
-                reflectance,
+                reflectance_rgb: rgb,
+                ..Material::grey(name, reflectance, 0.0)
             })
         };
         let (white, red, green) = (
-            diffuse("white", WHITE),
-            diffuse("red", RED),
-            diffuse("green", GREEN),
+            diffuse("white", WHITE, WHITE_RGB),
+            diffuse("red", RED, RED_RGB),
+            diffuse("green", GREEN, GREEN_RGB),
         );
         let light = b.material(Material {
-            name: "light".into(),
-            emission: LIGHT_EMISSION,
-            reflectance: LIGHT_REFLECTANCE,
+            emission_rgb: LIGHT_EMISSION_RGB,
+            ..Material::grey("light", LIGHT_REFLECTANCE, LIGHT_EMISSION)
         });
         Materials {
             white,

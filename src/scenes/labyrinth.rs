@@ -96,13 +96,7 @@ pub fn build(spec: &str, n: usize) -> Result<Scene, SceneError> {
     let g = open.len();
     let gf = g as f64;
     let mut b = SceneBuilder::new(spec);
-    let mut material = |name: &str, r: f64| {
-        b.material(Material {
-            name: name.into(),
-            emission: 1.0 - r,
-            reflectance: r,
-        })
-    };
+    let mut material = |name: &str, r: f64| b.material(Material::grey(name, r, 1.0 - r));
     let (floor, block, ceiling, hall) = (
         material("floor", 0.8),
         material("block", 0.6),

@@ -29,7 +29,7 @@ pub mod solids;
 use cube_lattice::Fig56Mesh;
 use solids::Solid;
 
-use crate::scene::{obj, Scene, SceneError};
+use crate::scene::{format, Scene, SceneBuilder, SceneError, SceneOptions};
 
 /// A built-in scene: its name, how to name it, what it is, and how to build it.
 #[derive(Clone, Copy, Debug)]
@@ -143,13 +143,38 @@ pub const CATALOGUE: &[Builtin] = &[
     },
 ];
 
-/// Loads a scene: a built-in name starting with `@` ([`build`]) or a scene file ([`obj::load`]).
+/// Loads a scene: a built-in name starting with `@` ([`build`]) or a scene file in any format scx reads
+/// ([`format::load_file`]: OBJ, glTF, PLY, STL, told apart by their content).
 pub fn load(spec: &str) -> Result<Scene, SceneError> {
+    load_with(spec, &SceneOptions::default())
+}
+
+/// [`load`] with options: the planarity rule, and objects to flip or make two-sided (a built-in is one
+/// object, named after it).
+pub fn load_with(spec: &str, options: &SceneOptions) -> Result<Scene, SceneError> {
     if spec.starts_with('@') {
-        build(spec)
-    } else {
-        obj::load(std::path::Path::new(spec))
+        if *options == SceneOptions::default() {
+            return build(spec);
+        }
+        return rebuild(&build(spec)?, options);
     }
+    format::load_file(std::path::Path::new(spec), options)
+}
+
+/// A built scene built again with options: its patches as polygons (they are planar, so the planarity
+/// rule changes nothing), its objects and materials.
+fn rebuild(scene: &Scene, options: &SceneOptions) -> Result<Scene, SceneError> {
+    let mut b = SceneBuilder::new(scene.name.clone());
+    for m in &scene.materials {
+        b.material(m.clone());
+    }
+    let ids: Vec<u32> = scene.vertices.iter().map(|&v| b.vertex(v)).collect();
+    for (k, p) in scene.patches.iter().enumerate() {
+        b.object(&scene.objects[p.object as usize]);
+        let corners: Vec<u32> = p.polygon.iter().map(|&v| ids[v as usize]).collect();
+        b.polygon(&corners, p.material, format!("patch {k}"));
+    }
+    b.build_with(options)
 }
 
 /// Builds a built-in scene from its name (`@cube:10`).

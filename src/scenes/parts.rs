@@ -7,11 +7,7 @@ use crate::scene::{Material, SceneBuilder};
 
 /// Adds the grey `wall` material of the built-ins without light (R = 0.5, no emission).
 pub(crate) fn grey_wall(b: &mut SceneBuilder) -> u32 {
-    b.material(Material {
-        name: "wall".into(),
-        emission: 0.0,
-        reflectance: 0.5,
-    })
+    b.material(Material::grey("wall", 0.5, 0.0))
 }
 
 /// Adds a rectangle cut into `grid.0 x grid.1` equal patches.

@@ -78,11 +78,6 @@ fn malformed_obj_files_name_the_file_and_line() {
             format!("{TRIANGLE}f 1 2 7\n"),
             &[":4:", "refers to vertex 7, but the file has 3"],
         ),
-        (
-            "non_planar.obj",
-            "v 0 0 0\nv 1 0 0\nv 1 1 0.5\nv 0 1 0\n# a bent quad\nf 1 2 3 4\n".into(),
-            &["line 6: face 1", "non-planar polygon"],
-        ),
     ];
     for (name, text, expected) in cases {
         let path = write(dir.path(), name, text.as_bytes());
@@ -93,6 +88,24 @@ fn malformed_obj_files_name_the_file_and_line() {
             &want,
         );
     }
+    // A bent quad is split into planar triangles, or refused in strict mode.
+    let bent = write(
+        dir.path(),
+        "non_planar.obj",
+        b"v 0 0 0\nv 1 0 0\nv 1 1 0.5\nv 0 1 0\n# a bent quad\nf 1 2 3 4\n",
+    );
+    assert_rejected(
+        &[
+            "analyze",
+            &bent,
+            "--lines",
+            "1000",
+            "--tracer",
+            "rust",
+            "--strict-planarity",
+        ],
+        &[&bent, "line 6: face 1", "non-planar polygon"],
+    );
     let binary = write(
         dir.path(),
         "binary.obj",
@@ -141,28 +154,34 @@ fn bad_materials_are_errors_and_a_missing_library_a_warning() {
         (
             "bright",
             "newmtl m\nKd 1.2 1.2 1.2\nKe 1 1 1\n",
-            "reflectance (Kd, mean of RGB) is 1.2",
+            "reflectance (Kd) red channel is 1.2",
+        ),
+        (
+            "red_only",
+            "newmtl m\nKd 1.5 0 0\nKe 1 1 1\n",
+            "reflectance (Kd) red channel is 1.5",
         ),
         (
             "negative",
-            "newmtl m\nKd -0.1 -0.1 -0.1\nKe 1 1 1\n",
-            "reflectance (Kd, mean of RGB) is -0.1",
+            "newmtl m\nKd 0.5 0.5 -0.1\nKe 1 1 1\n",
+            "reflectance (Kd) blue channel is -0.1",
         ),
         (
             "dark_light",
-            "newmtl m\nKd 0.5 0.5 0.5\nKe -2 -2 -2\n",
-            "emission (Ke, mean of RGB) is -2",
+            "newmtl m\nKd 0.5 0.5 0.5\nKe 2 -2 2\n",
+            "emission (Ke) green channel is -2",
         ),
     ] {
-        write(dir.path(), &format!("{name}.mtl"), mtl.as_bytes());
+        let library = write(dir.path(), &format!("{name}.mtl"), mtl.as_bytes());
         let path = write(
             dir.path(),
             &format!("{name}.obj"),
             obj(&format!("{name}.mtl")).as_bytes(),
         );
+        // The library and the line of the material's `newmtl`, checked per channel.
         assert_rejected(
             &["analyze", &path, "--lines", "1000", "--tracer", "rust"],
-            &[&path, "material `m`", expected],
+            &[&format!("{library}:1:"), "material `m`", expected],
         );
     }
     let path = write(dir.path(), "lost.obj", obj("nowhere.mtl").as_bytes());

@@ -13,6 +13,7 @@ mod findings;
 mod lines_and_tracers;
 mod radiosity;
 mod rust_bvh;
+mod scene_files;
 mod stability;
 mod visibility;
 
@@ -27,6 +28,8 @@ mod cli_honest;
 mod cli_radiosity;
 #[cfg(feature = "cli")]
 mod cli_reproduce;
+#[cfg(feature = "cli")]
+mod cli_scene_files;
 #[cfg(feature = "cli")]
 mod runs;
 

@@ -27,11 +27,7 @@ fn set_materials(scene: &mut Scene, mats: &[(f64, f64)]) {
     scene.materials = mats
         .iter()
         .enumerate()
-        .map(|(k, &(emission, reflectance))| Material {
-            name: format!("m{k}"),
-            emission,
-            reflectance,
-        })
+        .map(|(k, &(emission, reflectance))| Material::grey(format!("m{k}"), reflectance, emission))
         .collect();
     for (k, p) in scene.patches.iter_mut().enumerate() {
         p.material = (k % mats.len()) as u32;

@@ -269,3 +269,74 @@ fn bad_states_are_refused_by_name() {
     assert_eq!(partial["covered_lines"][0][0], 0);
     assert!(partial["covered_lines"][0][1].as_u64().unwrap() < 100_000);
 }
+
+/// A scene file read with options (two-sided, flipped normals) is read the same way by a resume and a
+/// merge, which take the options from the state: both give the single run's report, orientation
+/// counts and warnings included.
+#[test]
+fn resumed_and_merged_runs_read_the_scene_file_as_first_read() {
+    let dir = tempfile::tempdir().unwrap();
+    let obj = dir.path().join("box.obj");
+    let out = scx(&["export", "@cube", "-o", obj.to_str().unwrap(), "-q"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    for reading in [
+        ["--two-sided", "--planarity=1e-3"],
+        ["--flip-normals", "--planarity=1e-3"],
+    ] {
+        let mut base = vec![
+            "analyze",
+            obj.to_str().unwrap(),
+            "--tracer",
+            "rust",
+            "--format",
+            "json",
+        ];
+        base.extend(reading);
+        let mut full = base.clone();
+        full.extend(["--lines", "6e5"]);
+        let single = run_json(&full);
+        assert!(single["pairs"].as_u64().is_some());
+
+        let state = dir.path().join("half.scx");
+        let mut half = base.clone();
+        half.extend(["--lines", "3e5", "--save", state.to_str().unwrap(), "-q"]);
+        assert!(scx(&half).status.success());
+        let resumed = run_json(&[
+            "analyze",
+            "--resume",
+            state.to_str().unwrap(),
+            "--lines",
+            "6e5",
+            "--format",
+            "json",
+        ]);
+        assert_same(&single, &resumed, &format!("resumed {reading:?}"));
+
+        let mut parts = Vec::new();
+        for k in 1..=2 {
+            let part = dir.path().join(format!("r{k}.scx"));
+            let shard = format!("{k}/2");
+            let mut args = full.clone();
+            args.extend(["--shard", &shard, "--save", part.to_str().unwrap(), "-q"]);
+            assert!(scx(&args).status.success());
+            parts.push(part);
+        }
+        let mut merge = vec!["merge", "--format", "json"];
+        merge.extend(parts.iter().map(|p| p.to_str().unwrap()));
+        assert_same(&single, &run_json(&merge), &format!("merged {reading:?}"));
+    }
+    let flipped = run_json(&[
+        "analyze",
+        obj.to_str().unwrap(),
+        "--flip-normals",
+        "--lines",
+        "1e4",
+        "--format",
+        "json",
+    ]);
+    assert_eq!(flipped["pairs"], 0, "a room turned inside out has no pairs");
+}

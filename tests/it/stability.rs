@@ -96,11 +96,7 @@ fn block_counts(
 }
 
 fn wall() -> Material {
-    Material {
-        name: "wall".into(),
-        emission: 0.0,
-        reflectance: 0.5,
-    }
+    Material::grey("wall", 0.5, 0.0)
 }
 
 /// Adds an axis-aligned box `[lo, hi]` as six quads, normals outwards (`inward == false`) or inwards.

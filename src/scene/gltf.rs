@@ -1,0 +1,522 @@
+//! glTF 2.0 scenes (`.gltf` with its buffers, `.glb`), read with the `gltf` crate, and written.
+//!
+//! Reading: the default scene (or the first, or every root node when there is none) is walked from its
+//! root nodes with each node's transform applied (a mirroring transform reverses the triangles' winding,
+//! as the specification says). Each node with a mesh is an object, named after the node (or its mesh);
+//! each triangle of its primitives is a patch. Materials: `baseColorFactor` (RGB) is the reflectance,
+//! `emissiveFactor` times `KHR_materials_emissive_strength` the emission, `doubleSided` makes its
+//! triangles two-sided (two patches back to back). Textures are not read (a warning says so). A primitive
+//! without a material gets scx's default material (reflectance 0.5), as an OBJ face without one does.
+//!
+//! Writing ([`write()`]): one node and mesh per object, one primitive per material, f32 positions in the
+//! scene's units, every patch's triangles; `.glb` or `.gltf` (the buffer in a data URI) by the extension.
+
+use std::path::Path;
+
+use ::gltf::mesh::Mode;
+use base64::Engine as _;
+use serde_json::json;
+
+use super::{Material, Scene, SceneBuilder, SceneError, SceneOptions, Sides};
+
+type Matrix = [[f64; 4]; 4];
+
+const IDENTITY: Matrix = [
+    [1.0, 0.0, 0.0, 0.0],
+    [0.0, 1.0, 0.0, 0.0],
+    [0.0, 0.0, 1.0, 0.0],
+    [0.0, 0.0, 0.0, 1.0],
+];
+
+/// Loads glTF bytes (JSON or binary) read from `path` (external buffers are looked up beside it).
+pub(crate) fn load_bytes(
+    shown: &str,
+    bytes: &[u8],
+    path: &Path,
+    options: &SceneOptions,
+) -> Result<Scene, SceneError> {
+    // The gltf crate validates indices between its objects, but a reader of untrusted files should not
+    // take down the program if one of its accessors does not: any panic becomes a clear error.
+    let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
+    let result = std::panic::catch_unwind(|| load_document(shown, bytes, &base, options));
+    result.unwrap_or_else(|_| {
+        Err(SceneError::File {
+            path: shown.to_string(),
+            message: "malformed glTF: its accessors do not fit its buffers".into(),
+        })
+    })
+}
+
+fn load_document(
+    shown: &str,
+    bytes: &[u8],
+    base: &Path,
+    options: &SceneOptions,
+) -> Result<Scene, SceneError> {
+    let file_error = |message: String| SceneError::File {
+        path: shown.to_string(),
+        message,
+    };
+    let gltf = ::gltf::Gltf::from_slice(bytes)
+        .map_err(|e| file_error(format!("not a readable glTF 2.0 file: {e}")))?;
+    let buffers = gltf
+        .buffers()
+        .map(|buffer| buffer_data(&gltf, &buffer, base))
+        .collect::<Result<Vec<Vec<u8>>, String>>()
+        .map_err(file_error)?;
+
+    let mut b = SceneBuilder::new(shown);
+    let mut materials: Vec<Option<u32>> = vec![None; gltf.materials().len()];
+    let mut default_material = None;
+    let mut textured = Vec::new();
+    let roots: Vec<::gltf::Node> = match gltf.default_scene().or_else(|| gltf.scenes().next()) {
+        Some(scene) => scene.nodes().collect(),
+        None => gltf.nodes().collect(),
+    };
+    // Depth first in document order (a stack, so pushed in reverse): objects come in the file's order.
+    let mut stack: Vec<(::gltf::Node, Matrix)> =
+        roots.into_iter().rev().map(|n| (n, IDENTITY)).collect();
+    let mut primitives_seen = 0usize;
+    let mut skipped_modes = 0usize;
+    while let Some((node, parent)) = stack.pop() {
+        let world = multiply(&parent, &to_f64(node.transform().matrix()));
+        let children: Vec<::gltf::Node> = node.children().collect();
+        stack.extend(children.into_iter().rev().map(|child| (child, world)));
+        let Some(mesh) = node.mesh() else {
+            continue;
+        };
+        let name = node
+            .name()
+            .or(mesh.name())
+            .map(str::to_string)
+            .unwrap_or_else(|| format!("node {}", node.index()));
+        b.object(&name);
+        let mirrored = determinant3(&world) < 0.0;
+        for primitive in mesh.primitives() {
+            primitives_seen += 1;
+            let m = primitive.material();
+            let material = match m.index() {
+                Some(k) => *materials[k].get_or_insert_with(|| {
+                    if m.pbr_metallic_roughness().base_color_texture().is_some() {
+                        textured.push(m.name().unwrap_or("unnamed").to_string());
+                    }
+                    b.material(convert_material(&m, k))
+                }),
+                None => *default_material.get_or_insert_with(|| b.material(Material::default())),
+            };
+            let sides = if m.double_sided() {
+                Sides::Both
+            } else {
+                Sides::Front
+            };
+            let reader = primitive.reader(|buffer| buffers.get(buffer.index()).map(Vec::as_slice));
+            let Some(positions) = reader.read_positions() else {
+                return Err(file_error(format!(
+                    "mesh `{name}` primitive {}: no POSITION attribute",
+                    primitive.index()
+                )));
+            };
+            let ids: Vec<u32> = positions
+                .map(|p| b.vertex(transform_point(&world, p)))
+                .collect();
+            let indices: Vec<u32> = match reader.read_indices() {
+                Some(i) => i.into_u32().collect(),
+                None => (0..ids.len() as u32).collect(),
+            };
+            let Some(triangles) = triangles(primitive.mode(), &indices) else {
+                skipped_modes += 1;
+                continue;
+            };
+            for (k, t) in triangles.into_iter().enumerate() {
+                let mut corners = [0u32; 3];
+                for (c, &i) in corners.iter_mut().zip(&t) {
+                    *c = *ids.get(i as usize).ok_or_else(|| {
+                        file_error(format!(
+                            "mesh `{name}` primitive {}: index {i} past its {} vertices",
+                            primitive.index(),
+                            ids.len()
+                        ))
+                    })?;
+                }
+                if mirrored {
+                    corners.swap(1, 2);
+                }
+                let origin = format!("mesh `{name}` primitive {} triangle {k}", primitive.index());
+                b.polygon_sided(&corners, material, origin, sides);
+            }
+        }
+    }
+    if primitives_seen == 0 {
+        return Err(file_error(
+            "the scene is empty: no node of its scene has a mesh".into(),
+        ));
+    }
+    if skipped_modes > 0 {
+        b.warn(format!(
+            "{shown}: ignored {skipped_modes} primitive(s) of points or lines: they have no area"
+        ));
+    }
+    if !textured.is_empty() {
+        b.warn(format!(
+            "{shown}: textures are not read; the reflectance of material(s) {} is their \
+             baseColorFactor alone",
+            super::build::list_names(&textured)
+        ));
+    }
+    b.build_with(options)
+}
+
+/// A buffer's bytes: the binary chunk of a .glb, a base64 data URI, or a file beside the glTF.
+fn buffer_data(
+    gltf: &::gltf::Gltf,
+    buffer: &::gltf::Buffer,
+    base: &Path,
+) -> Result<Vec<u8>, String> {
+    let data = match buffer.source() {
+        ::gltf::buffer::Source::Bin => gltf.blob.clone().ok_or_else(|| {
+            format!(
+                "buffer {} is the binary chunk, which is missing",
+                buffer.index()
+            )
+        })?,
+        ::gltf::buffer::Source::Uri(uri) if uri.starts_with("data:") => {
+            let (_, payload) = uri.split_once(";base64,").ok_or_else(|| {
+                format!("buffer {}: a data URI that is not base64", buffer.index())
+            })?;
+            base64::engine::general_purpose::STANDARD
+                .decode(payload)
+                .map_err(|e| {
+                    format!("buffer {}: bad base64 in its data URI: {e}", buffer.index())
+                })?
+        }
+        ::gltf::buffer::Source::Uri(uri) => {
+            let file = base.join(percent_decode(uri));
+            std::fs::read(&file).map_err(|e| {
+                format!(
+                    "buffer {}: cannot read `{}`: {e}",
+                    buffer.index(),
+                    file.display()
+                )
+            })?
+        }
+    };
+    if data.len() < buffer.length() {
+        return Err(format!(
+            "buffer {} has {} bytes, the file says {}",
+            buffer.index(),
+            data.len(),
+            buffer.length()
+        ));
+    }
+    Ok(data)
+}
+
+/// A relative URI's path with its `%XX` escapes decoded (glTF URIs are percent-encoded).
+fn percent_decode(uri: &str) -> String {
+    let bytes = uri.as_bytes();
+    let mut out = Vec::with_capacity(bytes.len());
+    let mut k = 0;
+    while k < bytes.len() {
+        let hex = |b: u8| (b as char).to_digit(16);
+        if bytes[k] == b'%' && k + 2 < bytes.len() {
+            if let (Some(h), Some(l)) = (hex(bytes[k + 1]), hex(bytes[k + 2])) {
+                out.push((h * 16 + l) as u8);
+                k += 3;
+                continue;
+            }
+        }
+        out.push(bytes[k]);
+        k += 1;
+    }
+    String::from_utf8_lossy(&out).into_owned()
+}
+
+/// The triangles of a primitive's index list (`None` for points and lines).
+fn triangles(mode: Mode, indices: &[u32]) -> Option<Vec<[u32; 3]>> {
+    Some(match mode {
+        Mode::Triangles => indices
+            .chunks_exact(3)
+            .map(|t| [t[0], t[1], t[2]])
+            .collect(),
+        Mode::TriangleStrip => (2..indices.len())
+            .map(|k| {
+                let (a, b, c) = (indices[k - 2], indices[k - 1], indices[k]);
+                if k % 2 == 0 {
+                    [a, b, c]
+                } else {
+                    [b, a, c]
+                }
+            })
+            .collect(),
+        Mode::TriangleFan => (2..indices.len())
+            .map(|k| [indices[0], indices[k - 1], indices[k]])
+            .collect(),
+        Mode::Points | Mode::Lines | Mode::LineLoop | Mode::LineStrip => return None,
+    })
+}
+
+/// A glTF material as scx's: reflectance from `baseColorFactor`, emission from `emissiveFactor` times
+/// its strength.
+fn convert_material(m: &::gltf::Material, index: usize) -> Material {
+    let base = m.pbr_metallic_roughness().base_color_factor();
+    let strength = f64::from(m.emissive_strength().unwrap_or(1.0));
+    let emissive = m.emissive_factor().map(|e| f64::from(e) * strength);
+    let name = m
+        .name()
+        .map(str::to_string)
+        .unwrap_or_else(|| format!("material {index}"));
+    Material::rgb(name, [base[0], base[1], base[2]].map(f64::from), emissive)
+}
+
+fn to_f64(m: [[f32; 4]; 4]) -> Matrix {
+    m.map(|c| c.map(f64::from))
+}
+
+/// `a b` for column-major matrices (`m[column][row]`).
+fn multiply(a: &Matrix, b: &Matrix) -> Matrix {
+    let mut out = [[0.0; 4]; 4];
+    for (c, column) in out.iter_mut().enumerate() {
+        for (r, value) in column.iter_mut().enumerate() {
+            *value = (0..4).map(|k| a[k][r] * b[c][k]).sum();
+        }
+    }
+    out
+}
+
+fn transform_point(m: &Matrix, p: [f32; 3]) -> [f64; 3] {
+    let p = p.map(f64::from);
+    let mut out = [0.0; 3];
+    for (r, value) in out.iter_mut().enumerate() {
+        *value = m[0][r] * p[0] + m[1][r] * p[1] + m[2][r] * p[2] + m[3][r];
+    }
+    out
+}
+
+/// The determinant of the linear part: negative for a mirroring transform.
+fn determinant3(m: &Matrix) -> f64 {
+    let a = |c: usize, r: usize| m[c][r];
+    a(0, 0) * (a(1, 1) * a(2, 2) - a(2, 1) * a(1, 2))
+        - a(1, 0) * (a(0, 1) * a(2, 2) - a(2, 1) * a(0, 2))
+        + a(2, 0) * (a(0, 1) * a(1, 2) - a(1, 1) * a(0, 2))
+}
+
+/// Writes a scene as glTF 2.0: binary (`.glb`) when the path ends so, else JSON with the buffer in a
+/// data URI (one self-contained file).
+pub fn write(scene: &Scene, path: &Path) -> Result<(), SceneError> {
+    let (document, buffer) = document(scene);
+    let binary = path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("glb"));
+    let bytes = if binary {
+        glb(&document, &buffer)
+    } else {
+        let mut doc = document;
+        doc["buffers"][0]["uri"] = json!(format!(
+            "data:application/octet-stream;base64,{}",
+            base64::engine::general_purpose::STANDARD.encode(&buffer)
+        ));
+        let mut text = serde_json::to_string_pretty(&doc).expect("a JSON value always serialises");
+        text.push('\n');
+        text.into_bytes()
+    };
+    std::fs::write(path, bytes).map_err(|e| SceneError::File {
+        path: path.display().to_string(),
+        message: format!("cannot write: {e}"),
+    })
+}
+
+/// The glTF JSON and its one buffer: per object a node and a mesh, per material in it a primitive with
+/// its own positions (f32, scene units) and u32 indices.
+fn document(scene: &Scene) -> (serde_json::Value, Vec<u8>) {
+    let mut buffer: Vec<u8> = Vec::new();
+    let mut views = Vec::new();
+    let mut accessors = Vec::new();
+    let mut meshes = Vec::new();
+    let mut nodes = Vec::new();
+    for (object, name) in scene.objects.iter().enumerate() {
+        let mut primitives = Vec::new();
+        for material in 0..scene.materials.len() {
+            let tris: Vec<[u32; 3]> = scene
+                .patches
+                .iter()
+                .filter(|p| p.object as usize == object && p.material as usize == material)
+                .flat_map(|p| {
+                    let first = p.first_triangle as usize;
+                    scene.triangles[first..first + p.triangle_count as usize]
+                        .iter()
+                        .copied()
+                })
+                .collect();
+            if tris.is_empty() {
+                continue;
+            }
+            let (local, positions) = local_vertices(scene, &tris);
+            let position_view = push_view(&mut buffer, &mut views, &positions, Some(34962));
+            let (lo, hi) = bounds(&positions);
+            accessors.push(json!({"bufferView": position_view, "componentType": 5126,
+                "count": positions.len() / 3, "type": "VEC3", "min": lo, "max": hi}));
+            let index_view = push_view(&mut buffer, &mut views, &local, Some(34963));
+            accessors.push(json!({"bufferView": index_view, "componentType": 5125,
+                "count": local.len(), "type": "SCALAR"}));
+            primitives.push(json!({"attributes": {"POSITION": accessors.len() - 2},
+                "indices": accessors.len() - 1, "material": material, "mode": 4}));
+        }
+        if primitives.is_empty() {
+            continue;
+        }
+        nodes.push(json!({"name": name, "mesh": meshes.len()}));
+        meshes.push(json!({"name": name, "primitives": primitives}));
+    }
+    let materials: Vec<serde_json::Value> = scene.materials.iter().map(material_json).collect();
+    let uses_strength = materials.iter().any(|m| m.get("extensions").is_some());
+    let mut doc = json!({
+        "asset": {"version": "2.0", "generator": format!("scx {}", env!("CARGO_PKG_VERSION"))},
+        "scene": 0,
+        "scenes": [{"name": scene.name, "nodes": (0..nodes.len()).collect::<Vec<_>>()}],
+        "nodes": nodes,
+        "meshes": meshes,
+        "materials": materials,
+        "accessors": accessors,
+        "bufferViews": views,
+        "buffers": [{"byteLength": buffer.len()}],
+    });
+    if uses_strength {
+        doc["extensionsUsed"] = json!(["KHR_materials_emissive_strength"]);
+    }
+    (doc, buffer)
+}
+
+/// A primitive's vertices renumbered from 0, and their f32 positions.
+fn local_vertices(scene: &Scene, tris: &[[u32; 3]]) -> (Vec<u32>, Vec<f32>) {
+    let mut map = std::collections::HashMap::new();
+    let mut positions = Vec::new();
+    let mut local = Vec::with_capacity(tris.len() * 3);
+    for &v in tris.iter().flatten() {
+        let k = *map.entry(v).or_insert_with(|| {
+            let p = scene.vertices[v as usize];
+            positions.extend([p.x as f32, p.y as f32, p.z as f32]);
+            (positions.len() / 3 - 1) as u32
+        });
+        local.push(k);
+    }
+    (local, positions)
+}
+
+/// Appends little-endian numbers to the buffer (4-byte aligned) as a buffer view; returns its index.
+fn push_view<T: ToLeBytes>(
+    buffer: &mut Vec<u8>,
+    views: &mut Vec<serde_json::Value>,
+    data: &[T],
+    target: Option<u32>,
+) -> usize {
+    let offset = buffer.len();
+    for x in data {
+        buffer.extend_from_slice(&x.le_bytes());
+    }
+    let mut view = json!({"buffer": 0, "byteOffset": offset, "byteLength": buffer.len() - offset});
+    if let Some(t) = target {
+        view["target"] = json!(t);
+    }
+    views.push(view);
+    views.len() - 1
+}
+
+/// Little-endian bytes of the numbers a glTF buffer holds.
+trait ToLeBytes {
+    fn le_bytes(&self) -> [u8; 4];
+}
+
+impl ToLeBytes for f32 {
+    fn le_bytes(&self) -> [u8; 4] {
+        self.to_le_bytes()
+    }
+}
+
+impl ToLeBytes for u32 {
+    fn le_bytes(&self) -> [u8; 4] {
+        self.to_le_bytes()
+    }
+}
+
+fn bounds(positions: &[f32]) -> (Vec<f32>, Vec<f32>) {
+    let mut lo = vec![f32::INFINITY; 3];
+    let mut hi = vec![f32::NEG_INFINITY; 3];
+    for p in positions.chunks_exact(3) {
+        for a in 0..3 {
+            lo[a] = lo[a].min(p[a]);
+            hi[a] = hi[a].max(p[a]);
+        }
+    }
+    (lo, hi)
+}
+
+/// A material as glTF: `baseColorFactor` from the reflectance, `emissiveFactor` (at most 1 per
+/// channel) times `KHR_materials_emissive_strength` from the emission.
+fn material_json(m: &Material) -> serde_json::Value {
+    let [r, g, b] = m.reflectance_rgb;
+    let mut out = json!({
+        "name": m.name,
+        "pbrMetallicRoughness": {"baseColorFactor": [r, g, b, 1.0], "metallicFactor": 0.0,
+                                 "roughnessFactor": 1.0},
+    });
+    let strength = m.emission_rgb.iter().copied().fold(0.0, f64::max);
+    if strength > 0.0 {
+        let factor = if strength > 1.0 { strength } else { 1.0 };
+        out["emissiveFactor"] = json!(m.emission_rgb.map(|e| e / factor));
+        if factor > 1.0 {
+            out["extensions"] =
+                json!({"KHR_materials_emissive_strength": {"emissiveStrength": factor}});
+        }
+    }
+    out
+}
+
+/// A .glb: the 12-byte header, the JSON chunk (padded with spaces) and the binary chunk (padded with
+/// zeros).
+fn glb(document: &serde_json::Value, buffer: &[u8]) -> Vec<u8> {
+    let mut json_bytes = serde_json::to_vec(document).expect("a JSON value always serialises");
+    while json_bytes.len() % 4 != 0 {
+        json_bytes.push(b' ');
+    }
+    let mut bin = buffer.to_vec();
+    while bin.len() % 4 != 0 {
+        bin.push(0);
+    }
+    let total = 12 + 8 + json_bytes.len() + 8 + bin.len();
+    let mut out = Vec::with_capacity(total);
+    out.extend_from_slice(b"glTF");
+    out.extend_from_slice(&2u32.to_le_bytes());
+    out.extend_from_slice(&(total as u32).to_le_bytes());
+    out.extend_from_slice(&(json_bytes.len() as u32).to_le_bytes());
+    out.extend_from_slice(b"JSON");
+    out.extend_from_slice(&json_bytes);
+    out.extend_from_slice(&(bin.len() as u32).to_le_bytes());
+    out.extend_from_slice(b"BIN\0");
+    out.extend_from_slice(&bin);
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn transforms_compose_and_mirrors_are_found() {
+        let translate = |x: f64| {
+            let mut m = IDENTITY;
+            m[3][0] = x;
+            m
+        };
+        let mut scale = IDENTITY;
+        scale[0][0] = 2.0;
+        // Translate after scaling: p -> 2 p + (1, 0, 0).
+        let m = multiply(&translate(1.0), &scale);
+        assert_eq!(transform_point(&m, [3.0, 4.0, 5.0]), [7.0, 4.0, 5.0]);
+        assert!(determinant3(&m) > 0.0);
+        let mut mirror = IDENTITY;
+        mirror[2][2] = -1.0;
+        assert!(determinant3(&multiply(&m, &mirror)) < 0.0);
+        assert_eq!(percent_decode("my%20scene.bin"), "my scene.bin");
+        assert_eq!(percent_decode("100%"), "100%");
+    }
+}

@@ -1,0 +1,222 @@
+//! Scenes from the wild through the `scx` binary (issue 15): the public test models of tinyobjloader
+//! (when `../shared/real-scenes/` is beside the crate), undefined measures, unknown formats, glTF export.
+
+use std::path::{Path, PathBuf};
+
+use crate::support::{json_of, scx};
+
+/// The public OBJ corpus, if it is there (it is not part of the project).
+fn corpus() -> Option<PathBuf> {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()?
+        .join("shared/real-scenes/tinyobjloader");
+    dir.is_dir().then_some(dir)
+}
+
+/// The files of the corpus that are not valid scenes, and why: each must be refused with exit code 2 and
+/// a message naming the file and a line.
+const INVALID: &[(&str, &str)] = &[
+    ("invalid-face-definition.obj", "a face with 1 vertex"),
+    ("invalid-relative-texture-index.obj", "no vertices"),
+    ("invalid-relative-vertex-index.obj", "no vertices"),
+    ("issue-140-zero-face-idx.obj", "vertex index 0"),
+    ("test-nan.obj", "NaN vertices"),
+    ("line-prim.obj", "lines only, no faces"),
+    ("points-prim.obj", "points only, no faces"),
+    ("issue-356-leading-spaces-newmtl.obj", "no faces"),
+];
+
+/// Every valid file analyses (exit 0); every invalid one exits 2 naming the file and the line.
+#[test]
+fn the_tinyobjloader_models_analyse_or_are_refused_with_file_and_line() {
+    let Some(dir) = corpus() else {
+        eprintln!("skipped: ../shared/real-scenes/tinyobjloader is not there");
+        return;
+    };
+    let mut files: Vec<PathBuf> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "obj"))
+        .collect();
+    files.sort();
+    assert!(files.len() >= 40, "{} files", files.len());
+    for path in &files {
+        let name = path.file_name().unwrap().to_str().unwrap();
+        let shown = path.display().to_string();
+        let out = scx(&[
+            "analyze", &shown, "--lines", "2e4", "--tracer", "rust", "--format", "json",
+        ]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(!err.contains("panicked"), "{name}: {err}");
+        if INVALID.iter().any(|(n, _)| *n == name) {
+            assert_eq!(out.status.code(), Some(2), "{name}: {err}");
+            let line = err.lines().find(|l| l.contains("error")).unwrap_or("");
+            let names_line = line.contains(&format!("{shown}:")) || line.contains(": line ");
+            assert!(line.contains(&shown) && names_line, "{name}: {err}");
+        } else {
+            assert_eq!(out.status.code(), Some(0), "{name}: {err}");
+        }
+    }
+}
+
+/// The two Cornell boxes among them (non-planar left walls, split now) give finite visibility measures,
+/// and with `--enclose` every row of the enclosed channel sums to 1: no escape is left.
+#[test]
+fn the_public_cornell_boxes_give_finite_measures() {
+    let Some(dir) = corpus() else {
+        eprintln!("skipped: ../shared/real-scenes/tinyobjloader is not there");
+        return;
+    };
+    for name in ["cornell_box.obj", "cornell_box_multimaterial.obj"] {
+        let path = dir.join(name).display().to_string();
+        let doc = json_of(&scx(&[
+            "analyze", &path, "--lines", "1e5", "--tracer", "rust", "--format", "json",
+        ]));
+        for key in [
+            "entropy",
+            "mutual_information",
+            "continuous_mutual_information",
+        ] {
+            let v = doc["visibility"][key]["value"].as_f64();
+            assert!(v.is_some_and(f64::is_finite), "{name}: {key} {v:?}");
+        }
+        assert!(
+            doc["escape_fraction"].as_f64().unwrap() > 0.0,
+            "{name}: the box is open"
+        );
+
+        let scene = scene_complexity::load(&path).unwrap();
+        let tracer = scene_complexity::make_tracer(
+            scene_complexity::Backend::Rust,
+            &scene,
+            scene_complexity::Query::Single,
+        )
+        .unwrap();
+        let cfg = scene_complexity::AnalysisConfig {
+            enclose: true,
+            ..scene_complexity::AnalysisConfig::new(100_000, 1)
+        };
+        let a =
+            scene_complexity::analyze(&scene, tracer.as_ref(), &cfg, &Default::default()).unwrap();
+        let (enclosed, _) = a.tally.enclosed(&scene);
+        let mut rows = vec![0u64; scene.patch_count() + 1];
+        enclosed.counts.as_ref().unwrap().for_each(|i, j, k| {
+            rows[i as usize] += k;
+            if i != j {
+                rows[j as usize] += k;
+            }
+        });
+        assert!(enclosed.escapes_by_patch.iter().all(|&e| e == 0));
+        // Every patch some line left has a row summing to 1: N_ij / N_i over j, with nothing escaping.
+        let sampled = rows.iter().filter(|&&r| r > 0).count();
+        assert!(sampled >= scene.patch_count(), "{name}: {sampled} rows");
+        let visibility = &a.visibility;
+        assert!(visibility.mutual_information.unwrap().value.is_finite());
+    }
+}
+
+/// A room exported with outward normals: exit 0, the visibility measures `null` in JSON and a sentence in
+/// the table, a warning naming the object and the flag; `--flip-normals` gives measures.
+#[test]
+fn a_scene_without_pairs_reports_undefined_measures() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("box.obj");
+    std::fs::write(
+        &path,
+        "o box\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n\
+         f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n",
+    )
+    .unwrap();
+    let path = path.display().to_string();
+    let json = scx(&[
+        "analyze", &path, "--lines", "2e4", "--tracer", "rust", "--format", "json",
+    ]);
+    let doc = json_of(&json);
+    for key in [
+        "entropy",
+        "mutual_information",
+        "continuous_mutual_information",
+        "mse_per_line",
+    ] {
+        assert!(
+            doc["visibility"][key].is_null(),
+            "{key}: {}",
+            doc["visibility"][key]
+        );
+    }
+    assert!(doc["visibility"]["positional_entropy"]["value"].is_f64());
+    let warnings = doc["warnings"].to_string();
+    assert!(
+        warnings.contains("no line segment joined two patches"),
+        "{warnings}"
+    );
+    assert!(
+        warnings.contains("`box`") && warnings.contains("--flip-normals"),
+        "{warnings}"
+    );
+
+    let table = scx(&["analyze", &path, "--lines", "2e4", "--tracer", "rust"]);
+    assert_eq!(table.status.code(), Some(0));
+    let text = String::from_utf8_lossy(&table.stdout);
+    assert!(text.contains("visibility measures undefined"), "{text}");
+    assert!(!text.contains("visibility entropy H_s"), "{text}");
+
+    let flipped = json_of(&scx(&[
+        "analyze",
+        &path,
+        "--lines",
+        "2e4",
+        "--tracer",
+        "rust",
+        "--format",
+        "json",
+        "--flip-normals",
+    ]));
+    assert!(flipped["visibility"]["entropy"]["value"].is_f64());
+    assert_eq!(flipped["warnings"].as_array().unwrap().len(), 0);
+}
+
+/// A file in no format scx reads is refused naming it; a `.obj` that holds binary STL is read as STL;
+/// `scx export -o x.gltf` writes glTF that analyses like the original.
+#[test]
+fn formats_come_from_the_content() {
+    let dir = tempfile::tempdir().unwrap();
+    let junk = dir.path().join("notes.obj");
+    std::fs::write(&junk, "hello, this is not a scene\n").unwrap();
+    let junk = junk.display().to_string();
+    let out = scx(&["analyze", &junk]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains(&junk) && err.contains("unknown scene format"),
+        "{err}"
+    );
+
+    let gltf = dir.path().join("cornell.gltf").display().to_string();
+    let out = scx(&["export", "@cornell", "-o", &gltf]);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = std::fs::read_to_string(&gltf).unwrap();
+    assert!(text.contains("\"asset\"") && text.contains("KHR_materials_emissive_strength"));
+    let doc = json_of(&scx(&[
+        "analyze", &gltf, "--lines", "1e5", "--tracer", "rust", "--format", "json",
+    ]));
+    let original = json_of(&scx(&[
+        "analyze", "@cornell", "--lines", "1e5", "--tracer", "rust", "--format", "json", "--seed",
+        "2",
+    ]));
+    let isc = |d: &serde_json::Value| {
+        let e = &d["visibility"]["continuous_mutual_information"];
+        (e["value"].as_f64().unwrap(), e["stderr"].as_f64().unwrap())
+    };
+    let (a, b) = (isc(&doc), isc(&original));
+    assert!(
+        (a.0 - b.0).abs() < 4.0 * (a.1 * a.1 + b.1 * b.1).sqrt(),
+        "{a:?} {b:?}"
+    );
+    assert!((doc["area"].as_f64().unwrap() - original["area"].as_f64().unwrap()).abs() < 1.0);
+}
