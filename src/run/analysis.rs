@@ -15,6 +15,7 @@ use rayon::prelude::*;
 use super::batches::LineStream;
 use super::control::{Budget, RunControl, StopReason, TargetMeasure};
 use super::errors::{ErrorMethod, Spread};
+use super::patches::{self as per_patch, PatchEstimate, PatchLight};
 use super::plan::{BatchPlan, MAX_ROUND_LINES};
 use super::radiosity::{self, RadiosityOutcome, SolveFailure};
 use super::readings::VisibilityEstimates;
@@ -96,6 +97,9 @@ pub struct AnalysisConfig {
     pub enclose: bool,
     /// How the radiosity system is solved.
     pub solve: SolveOptions,
+    /// Also share the measures out among the patches ([`Analysis::patches`]); gathers eq. (27)'s terms
+    /// per patch, which costs nothing when left off. Not with `enclose` on an open scene.
+    pub per_patch: bool,
 }
 
 impl AnalysisConfig {
@@ -112,6 +116,7 @@ impl AnalysisConfig {
             source: LineSource::Independent,
             enclose: false,
             solve: SolveOptions::default(),
+            per_patch: false,
         }
     }
 }
@@ -186,6 +191,9 @@ pub struct Analysis {
     pub warnings: Vec<RunWarning>,
     /// The full-run counts, for form factors (when counted).
     pub tally: Tally,
+    /// Each patch's results, with standard errors, when [`AnalysisConfig::per_patch`] asked for them
+    /// (`None` as well for an enclosed open scene).
+    pub patches: Option<Vec<PatchEstimate>>,
 }
 
 impl Analysis {
@@ -310,8 +318,9 @@ pub fn analyze(
     };
     let lit = materials.as_ref().is_some_and(|m| m.any_emission());
     let wanted = Wanted {
-        discrete: cfg.measures.discrete || lit,
+        discrete: cfg.measures.discrete || lit || cfg.per_patch,
         continuous: cfg.measures.continuous,
+        per_patch: cfg.per_patch && cfg.measures.continuous,
     };
     let (state, stop_reason) = cast(scene, tracer, cfg, wanted, control)?;
     let run = state.finish(scene);
@@ -343,6 +352,15 @@ pub fn analyze(
                 .expect("radiosity counts the pairs"),
         )?,
     };
+    let patches = (cfg.per_patch && !enclose)
+        .then(|| {
+            let light = materials.as_ref().filter(|_| lit).map(|m| PatchLight {
+                materials: m,
+                solve: &cfg.solve,
+            });
+            per_patch::estimates(scene, &run, cfg.estimator, light)
+        })
+        .flatten();
     let FinishedRun { total, .. } = run;
     let warnings = warnings::of_run(
         &scene.name,
@@ -377,6 +395,7 @@ pub fn analyze(
         radiosity,
         warnings,
         tally: total,
+        patches,
     })
 }
 

@@ -9,6 +9,7 @@ use super::counts::{pair_key, PairCounts};
 use super::environment;
 use super::kernel::Log2Sum;
 use super::pairs::{segments_counting_overlaps, Segment};
+use super::patch_sums::PatchKernelSums;
 use crate::scene::Scene;
 use crate::trace::{Line, LineHits};
 
@@ -19,6 +20,9 @@ pub struct Wanted {
     pub discrete: bool,
     /// The per-pair sum of eq. (27) for the continuous mutual information.
     pub continuous: bool,
+    /// Eq. (27)'s terms summed per patch ([`PatchKernelSums`]) for the per-patch results; needs
+    /// `discrete` (the pair keys say which patches a term belongs to).
+    pub per_patch: bool,
 }
 
 /// The counters and sums of a set of lines: every number a run adds up but the pair counts and the
@@ -79,6 +83,8 @@ pub struct Tally {
     pub escapes_by_patch: Vec<u64>,
     /// Pair counts (only when the discrete measures are wanted).
     pub counts: Option<PairCounts>,
+    /// Eq. (27)'s terms summed per patch (only when [`Wanted::per_patch`]).
+    pub kernel_by_patch: Option<PatchKernelSums>,
 }
 
 impl Tally {
@@ -94,6 +100,9 @@ impl Tally {
             counts: wanted
                 .discrete
                 .then(|| PairCounts::new(scene.patch_count())),
+            kernel_by_patch: wanted
+                .per_patch
+                .then(|| PatchKernelSums::new(scene.patch_count())),
         }
     }
 
@@ -103,6 +112,7 @@ impl Tally {
             counters: self.counters,
             escapes_by_patch: self.escapes_by_patch.clone(),
             counts: None,
+            kernel_by_patch: self.kernel_by_patch.clone(),
         }
     }
 
@@ -117,6 +127,9 @@ impl Tally {
             *a += b;
         }
         if let (Some(a), Some(b)) = (&mut self.counts, &other.counts) {
+            a.merge(b);
+        }
+        if let (Some(a), Some(b)) = (&mut self.kernel_by_patch, &other.kernel_by_patch) {
             a.merge(b);
         }
     }
@@ -137,6 +150,7 @@ impl Tally {
                 (Some(t), Some(p)) => Some(t.without(p)),
                 _ => None,
             },
+            kernel_by_patch: None,
         }
     }
 
@@ -165,10 +179,16 @@ impl Tally {
                 Vec::new()
             },
             counts: None,
+            kernel_by_patch: wanted
+                .per_patch
+                .then(|| PatchKernelSums::new(scene.patch_count())),
         };
         let mut batch_keys = Vec::with_capacity(batches.len());
         for b in batches {
             tally.counters.add(&b.counters);
+            if let Some(k) = &mut tally.kernel_by_patch {
+                k.add_pairs(&b.pair_keys, &b.pair_terms);
+            }
             for &p in &b.escape_patches {
                 tally.escapes_by_patch[p as usize] += 1;
             }
@@ -232,6 +252,9 @@ pub struct BatchTally {
     pub pair_keys: Vec<u64>,
     /// The patch of every escape, when the discrete measures are wanted.
     pub escape_patches: Vec<u32>,
+    /// Beside each pair key, its log kernel ([`PatchKernelSums::pair_term`]), when
+    /// [`Wanted::per_patch`].
+    pub pair_terms: Vec<f64>,
 }
 
 /// Pairs the canonical hits of a batch of lines and tallies the segments (paper sec. 3.2.2): the hot
@@ -273,6 +296,10 @@ pub fn tally_lines(scene: &Scene, lines: &[Line], hits: &LineHits, wanted: Wante
                     c.pairs += 1;
                     if wanted.discrete {
                         keys.push(pair_key(from, to));
+                    }
+                    if wanted.per_patch {
+                        t.pair_terms
+                            .push(PatchKernelSums::pair_term(cos_from * cos_to, distance));
                     }
                     if wanted.continuous && !log2_sum.add(cos_from * cos_to, distance) {
                         c.degenerate_pairs += 1;
