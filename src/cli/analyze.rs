@@ -1,5 +1,7 @@
 //! `scx analyze`: one analysis, reported as a table, JSON or CSV.
 
+use std::path::PathBuf;
+
 use clap::ValueEnum;
 use scene_complexity::run::{AnalysisConfig, Budget, Measures, StopReason, Target, TargetMeasure};
 use scene_complexity::sample::lines::LineSource;
@@ -7,7 +9,7 @@ use scene_complexity::sample::lines::LineSource;
 use super::args::{parse_count, parse_positive, parse_target_measure, ReportOutput, RunOptions};
 use super::output::{self, warn};
 use super::runner::Runner;
-use super::{report, Exit, Failure};
+use super::{patches, report, Exit, Failure};
 
 /// Arguments of `scx analyze`.
 #[derive(clap::Args, Debug)]
@@ -52,6 +54,23 @@ pub struct AnalyzeArgs {
     format: Format,
     #[command(flatten)]
     out: ReportOutput,
+    #[command(flatten)]
+    files: PatchFiles,
+}
+
+/// The per-patch files of `scx analyze`.
+#[derive(clap::Args, Debug)]
+struct PatchFiles {
+    /// Also write one row per patch to FILE (.csv): id (the order `scx export` writes faces), material,
+    /// area, centroid and normal in the scene's units, segments N_i, row entropy, its terms of I_s and
+    /// I_s^c, the information it loses, radiosity when lit, each with its standard error. Repeat to
+    /// write several files.
+    #[arg(long, value_name = "FILE")]
+    patches: Vec<PathBuf>,
+    /// Also write the sparse form-factor matrix to FILE: `.csv` (i, j, n_ij, n_i, f_ij, f_ij_stderr) or
+    /// `.mtx` (Matrix Market, for scipy.io.mmread). Repeat to write both.
+    #[arg(long, value_name = "FILE")]
+    form_factors: Vec<PathBuf>,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -72,6 +91,30 @@ pub enum Format {
     Csv,
 }
 
+/// Checks the per-patch files before any work: their kinds, that they can be written, and that the run
+/// will have what they need.
+fn check_patch_files(args: &AnalyzeArgs) -> Result<(), Failure> {
+    let f = &args.files;
+    if f.patches.is_empty() && f.form_factors.is_empty() {
+        return Ok(());
+    }
+    patches::check_patch_files(&f.patches)?;
+    patches::check_matrix_files(&f.form_factors)?;
+    if args.enclose {
+        return Err(Failure::bad_input(
+            "--patches and --form-factors describe the scene's own patches; they do not take --enclose",
+        ));
+    }
+    if !f.form_factors.is_empty() && args.measures.as_ref().is_some_and(|m| {
+        !m.contains(&MeasureArg::Discrete) && !m.contains(&MeasureArg::Radiosity)
+    }) {
+        return Err(Failure::bad_input(
+            "--form-factors needs the pair counts: add `discrete` to --measures",
+        ));
+    }
+    output::check_all(f.patches.iter().chain(&f.form_factors).map(PathBuf::as_path))
+}
+
 fn parse_bundle(s: &str) -> Result<u32, String> {
     let g: u32 = s
         .trim()
@@ -83,6 +126,7 @@ fn parse_bundle(s: &str) -> Result<u32, String> {
 /// Runs `scx analyze`.
 pub fn run(args: &AnalyzeArgs) -> Result<Exit, Failure> {
     output::check_all(args.out.output.as_deref())?;
+    check_patch_files(args)?;
     let runner = Runner::new(&args.scene, &args.run)?;
     let measures = match &args.measures {
         None => Measures::ALL,
@@ -110,6 +154,7 @@ pub fn run(args: &AnalyzeArgs) -> Result<Exit, Failure> {
         budget,
         source: LineSource::bundles(args.bundle).map_err(Failure::bad_input)?,
         enclose: args.enclose,
+        per_patch: !args.files.patches.is_empty(),
         ..runner.config(&args.run, lines, args.run.seed)
     };
     let total = (!open_ended).then_some(lines);
@@ -121,6 +166,8 @@ pub fn run(args: &AnalyzeArgs) -> Result<Exit, Failure> {
         bundle: args.bundle,
         ..runner.info()
     };
+    patches::write_patches(&args.files.patches, &runner.scene, &analysis)?;
+    patches::write_form_factors(&args.files.form_factors, &runner.scene, &analysis)?;
     let text = match args.format {
         Format::Table => report::table(&run, &analysis),
         Format::Json => report::json(&run, &analysis),

@@ -8,6 +8,7 @@ mod docs;
 mod export;
 mod input;
 mod output;
+mod patches;
 mod plot;
 mod progress;
 mod refine;
@@ -65,6 +66,7 @@ enum Command {
         "  scx analyze @cube:10 --lines 1e7\n",
         "  scx analyze room.obj --format json -o room.json\n",
         "  scx analyze @cube:30 --target-stderr 0.002 --lines 1e9\n",
+        "  scx analyze @fig2:a --lines 1e7 --patches patches.csv --form-factors ff.mtx\n",
         "  cat room.obj | scx analyze - --lines 1e6\n\n",
         "Exit codes: 0 success, 1 the tracer failed, 2 bad input, 3 a file could not be written, \
          130 interrupted (the report covers the lines gathered)."
