@@ -105,14 +105,21 @@ fn check_patch_files(args: &AnalyzeArgs) -> Result<(), Failure> {
             "--patches and --form-factors describe the scene's own patches; they do not take --enclose",
         ));
     }
-    if !f.form_factors.is_empty() && args.measures.as_ref().is_some_and(|m| {
-        !m.contains(&MeasureArg::Discrete) && !m.contains(&MeasureArg::Radiosity)
-    }) {
+    if !f.form_factors.is_empty()
+        && args.measures.as_ref().is_some_and(|m| {
+            !m.contains(&MeasureArg::Discrete) && !m.contains(&MeasureArg::Radiosity)
+        })
+    {
         return Err(Failure::bad_input(
             "--form-factors needs the pair counts: add `discrete` to --measures",
         ));
     }
-    output::check_all(f.patches.iter().chain(&f.form_factors).map(PathBuf::as_path))
+    output::check_all(
+        f.patches
+            .iter()
+            .chain(&f.form_factors)
+            .map(PathBuf::as_path),
+    )
 }
 
 fn parse_bundle(s: &str) -> Result<u32, String> {

@@ -65,6 +65,9 @@ pub fn check_matrix_files(paths: &[PathBuf]) -> Result<(), Failure> {
 
 /// Writes the per-patch results to every file in `paths`.
 pub fn write_patches(paths: &[PathBuf], scene: &Scene, a: &Analysis) -> Result<(), Failure> {
+    if paths.is_empty() {
+        return Ok(());
+    }
     let Some(patches) = &a.patches else {
         return Err(Failure::bad_input(
             "no per-patch results: the run counted no patch pairs",
@@ -78,6 +81,9 @@ pub fn write_patches(paths: &[PathBuf], scene: &Scene, a: &Analysis) -> Result<(
 
 /// Writes the form-factor matrix to every file in `paths`.
 pub fn write_form_factors(paths: &[PathBuf], scene: &Scene, a: &Analysis) -> Result<(), Failure> {
+    if paths.is_empty() {
+        return Ok(());
+    }
     let Some(counts) = &a.tally.counts else {
         return Err(Failure::bad_input(
             "no form factors: the run counted no patch pairs (--measures without discrete)",

@@ -11,6 +11,7 @@ mod embree_backend;
 mod errors;
 mod findings;
 mod lines_and_tracers;
+mod patches;
 mod radiosity;
 mod rust_bvh;
 mod stability;
@@ -23,6 +24,8 @@ mod bad_input;
 mod cli;
 #[cfg(feature = "cli")]
 mod cli_honest;
+#[cfg(feature = "cli")]
+mod cli_patches;
 #[cfg(feature = "cli")]
 mod cli_radiosity;
 #[cfg(feature = "cli")]

@@ -1,0 +1,124 @@
+//! The per-patch results against invariants: the per-patch terms add up to the scene's measures, and
+//! the radiosity columns solve eq. (2). (`cli_patches` checks the files `scx analyze` writes.)
+
+use scene_complexity::run::{analyze, Analysis, AnalysisConfig, RunControl};
+use scene_complexity::scenes;
+use scene_complexity::trace::{make_tracer, Backend, Query};
+
+fn run_with_patches(
+    spec: &str,
+    lines: u64,
+    backend: Backend,
+) -> (scene_complexity::Scene, Analysis) {
+    let scene = scenes::load(spec).unwrap();
+    let tracer = make_tracer(backend, &scene, Query::Single).unwrap();
+    let cfg = AnalysisConfig {
+        per_patch: true,
+        ..AnalysisConfig::new(lines, 7)
+    };
+    let a = analyze(&scene, tracer.as_ref(), &cfg, &RunControl::default()).unwrap();
+    (scene, a)
+}
+
+fn close(x: f64, y: f64) -> bool {
+    (x - y).abs() <= 1e-10 * x.abs().max(y.abs()).max(1.0)
+}
+
+/// H_s = sum a_i H_i, I_s = sum I_i and I_s^c = sum I_i^c, plug-in and corrected, to rounding: in a
+/// closed lit scene (dense counts), an open one (escapes), and a mesh with sparse counts and unsampled
+/// patches.
+#[test]
+fn per_patch_terms_add_up_to_the_scene_measures() {
+    for (spec, lines) in [
+        ("@cornell", 200_000),
+        ("@cornell-open", 200_000),
+        ("@cube:4", 100_000),
+        ("@cube:30", 20_000),
+    ] {
+        let (scene, a) = run_with_patches(spec, lines, Backend::Rust);
+        let p = a.patches.as_ref().expect("asked for");
+        assert_eq!(p.len(), scene.patch_count());
+        let v = &a.visibility;
+        let total_area = scene.total_area();
+        let a_i = |i: usize| scene.patches[i].area / total_area;
+        let sum = |f: &dyn Fn(usize) -> f64| (0..p.len()).map(f).sum::<f64>();
+        let checks = [
+            (
+                "H_s",
+                sum(&|i| a_i(i) * p[i].row_entropy.value),
+                v.entropy.unwrap().value,
+            ),
+            (
+                "H_s corrected",
+                sum(&|i| a_i(i) * p[i].row_entropy_corrected.value),
+                v.entropy_corrected.unwrap().value,
+            ),
+            (
+                "I_s",
+                sum(&|i| p[i].mutual_information_term.value),
+                v.mutual_information.unwrap().value,
+            ),
+            (
+                "I_s corrected",
+                sum(&|i| p[i].mutual_information_term_corrected.value),
+                v.mutual_information_corrected.unwrap().value,
+            ),
+            (
+                "I_s^c",
+                sum(&|i| p[i].continuous_term.unwrap().value),
+                v.continuous_mutual_information.unwrap().value,
+            ),
+            (
+                "I_s^c - I_s",
+                sum(&|i| p[i].lost_information.unwrap().value),
+                v.continuous_mutual_information.unwrap().value
+                    - v.mutual_information.unwrap().value,
+            ),
+        ];
+        for (name, parts, whole) in checks {
+            assert!(
+                close(parts, whole),
+                "{spec}: {name}: sum of patches {parts} vs scene {whole}"
+            );
+        }
+        // Every value with a standard error, no NaN from an unsampled patch.
+        for (i, e) in p.iter().enumerate() {
+            for x in [
+                e.row_entropy,
+                e.mutual_information_term,
+                e.continuous_term.unwrap(),
+            ] {
+                assert!(
+                    x.value.is_finite() && x.stderr.is_some_and(f64::is_finite),
+                    "{spec} {i}: {e:?}"
+                );
+            }
+            assert_eq!(
+                e.radiosity.is_some(),
+                spec == "@cornell" || spec == "@cornell-open"
+            );
+        }
+        if spec == "@cube:30" {
+            assert!(
+                p.iter().any(|e| !e.sampled()),
+                "20 000 lines leave patches of @cube:30 unsampled"
+            );
+        }
+    }
+}
+
+/// The radiosity columns solve eq. (2): B_i = E_i + R_i B_i^in for every patch.
+#[test]
+fn per_patch_radiosities_solve_the_radiosity_equation() {
+    let (scene, a) = run_with_patches("@cornell", 300_000, Backend::Rust);
+    for (i, e) in a.patches.as_ref().unwrap().iter().enumerate() {
+        let m = &scene.materials[scene.patches[i].material as usize];
+        let (b, b_in) = (e.radiosity.unwrap(), e.incoming_radiosity.unwrap());
+        let residual = b.value - m.emission - m.reflectance * b_in.value;
+        assert!(
+            residual.abs() <= 1e-8 * m.emission.max(b.value),
+            "patch {i}: {residual}"
+        );
+        assert!(b.stderr.is_some_and(|se| se > 0.0 || m.reflectance == 0.0));
+    }
+}
