@@ -12,6 +12,7 @@ mod patches;
 mod plot;
 mod progress;
 mod refine;
+mod render;
 mod report;
 mod reproduce;
 mod runner;
@@ -90,6 +91,16 @@ enum Command {
         "  scx refine @cornell --strategy information --patches 460 -o cornell_460.obj"
     ))]
     Refine(refine::RefineArgs),
+    /// Draw the scene with each patch coloured by a per-patch result of a run (row entropy, lost
+    /// information, segments, radiosity, ...), with a labelled colour bar (PNG); optionally the coloured
+    /// mesh (PLY).
+    #[command(after_help = concat!(
+        "Examples:\n",
+        "  scx render @fig2:a --color lost-information --per-area --lines 1e7 -o fig2a.png\n",
+        "  scx render @cornell --color radiosity -o cornell.png --patches-mesh cornell.ply\n",
+        "  scx render @cube:10 --color row-entropy --camera 0.5,0.5,0.02,0.5,0.5,1,0,1,0,70 -o cube.png"
+    ))]
+    Render(render::RenderArgs),
     /// Trace the same lines with Embree and the pure-Rust tracer, compare them hit for hit and measure
     /// for measure; exit 1 when a line differs beyond the tolerance.
     #[command(after_help = "Example:\n  scx crosscheck @cubes512 --lines 1e6")]
@@ -141,6 +152,7 @@ pub fn main() -> ExitCode {
         Command::Export(args) => export::run(&args),
         Command::Convergence(args) => convergence::run(&args),
         Command::Refine(args) => refine::run(&args),
+        Command::Render(args) => render::run(&args),
         Command::Crosscheck(args) => crosscheck::run(&args),
         Command::Reproduce(args) => reproduce::run(&args),
         Command::Completions(args) => docs::completions(&args),
