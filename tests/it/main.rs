@@ -13,6 +13,7 @@ mod findings;
 mod lines_and_tracers;
 mod patches;
 mod radiosity;
+mod render;
 mod rust_bvh;
 mod stability;
 mod visibility;
@@ -28,6 +29,8 @@ mod cli_honest;
 mod cli_patches;
 #[cfg(feature = "cli")]
 mod cli_radiosity;
+#[cfg(feature = "cli")]
+mod cli_render;
 #[cfg(feature = "cli")]
 mod cli_reproduce;
 
