@@ -173,8 +173,10 @@ pub fn run(args: &AnalyzeArgs) -> Result<Exit, Failure> {
         bundle: args.bundle,
         ..runner.info()
     };
-    patches::write_patches(&args.files.patches, &runner.scene, &analysis)?;
-    patches::write_form_factors(&args.files.form_factors, &runner.scene, &analysis)?;
+    runner.pool.install(|| {
+        patches::write_patches(&args.files.patches, &runner.scene, &analysis)?;
+        patches::write_form_factors(&args.files.form_factors, &runner.scene, &analysis)
+    })?;
     let text = match args.format {
         Format::Table => report::table(&run, &analysis),
         Format::Json => report::json(&run, &analysis),

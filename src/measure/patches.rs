@@ -88,14 +88,18 @@ pub fn patch_values(
 ) -> PatchValues {
     let a = area_distribution(areas);
     let a = a.as_slice().expect("a fresh array is contiguous");
-    let rows = Rows::gather(a, counts, escapes, EntropyEstimator::PlugIn).sums;
-    let corrections = row_corrections(counts, escapes, estimator);
+    let gathered = Rows::gather(a, counts, escapes, estimator);
+    let rows = &gathered.sums;
     let row_entropy: Vec<f64> = rows.iter().map(|r| r.plug_in_entropy()).collect();
-    let row_entropy_corrected: Vec<f64> = row_entropy
-        .iter()
-        .enumerate()
-        .map(|(i, h)| h + corrections.get(i).copied().unwrap_or(0.0))
-        .collect();
+    // One pass serves every estimator but Chao–Shen, which needs a second one over the counts.
+    let row_entropy_corrected = gathered.corrected_entropies().unwrap_or_else(|| {
+        let corrections = row_corrections(counts, escapes, estimator);
+        row_entropy
+            .iter()
+            .enumerate()
+            .map(|(i, h)| h + corrections.get(i).copied().unwrap_or(0.0))
+            .collect()
+    });
     let term = |i: usize, h: f64| a[i] * (rows[i].cross_entropy_with_areas() - h);
     PatchValues {
         segments: rows.iter().map(|r| r.segments).collect(),

@@ -4,16 +4,18 @@
 use scene_complexity::run::{analyze, Analysis, AnalysisConfig, RunControl};
 use scene_complexity::scenes;
 use scene_complexity::trace::{make_tracer, Backend, Query};
+use scene_complexity::EntropyEstimator;
 
 fn run_with_patches(
     spec: &str,
     lines: u64,
-    backend: Backend,
+    estimator: EntropyEstimator,
 ) -> (scene_complexity::Scene, Analysis) {
     let scene = scenes::load(spec).unwrap();
-    let tracer = make_tracer(backend, &scene, Query::Single).unwrap();
+    let tracer = make_tracer(Backend::Rust, &scene, Query::Single).unwrap();
     let cfg = AnalysisConfig {
         per_patch: true,
+        estimator,
         ..AnalysisConfig::new(lines, 7)
     };
     let a = analyze(&scene, tracer.as_ref(), &cfg, &RunControl::default()).unwrap();
@@ -26,16 +28,16 @@ fn close(x: f64, y: f64) -> bool {
 
 /// H_s = sum a_i H_i, I_s = sum I_i and I_s^c = sum I_i^c, plug-in and corrected, to rounding: in a
 /// closed lit scene (dense counts), an open one (escapes), and a mesh with sparse counts and unsampled
-/// patches.
+/// patches; with the one-pass estimators and with Chao–Shen (two passes).
 #[test]
 fn per_patch_terms_add_up_to_the_scene_measures() {
-    for (spec, lines) in [
-        ("@cornell", 200_000),
-        ("@cornell-open", 200_000),
-        ("@cube:4", 100_000),
-        ("@cube:30", 20_000),
+    for (spec, lines, estimator) in [
+        ("@cornell", 200_000, EntropyEstimator::ChaoWangJost),
+        ("@cornell-open", 200_000, EntropyEstimator::Grassberger),
+        ("@cube:4", 100_000, EntropyEstimator::ChaoShen),
+        ("@cube:30", 20_000, EntropyEstimator::ChaoWangJost),
     ] {
-        let (scene, a) = run_with_patches(spec, lines, Backend::Rust);
+        let (scene, a) = run_with_patches(spec, lines, estimator);
         let p = a.patches.as_ref().expect("asked for");
         assert_eq!(p.len(), scene.patch_count());
         let v = &a.visibility;
@@ -110,7 +112,7 @@ fn per_patch_terms_add_up_to_the_scene_measures() {
 /// The radiosity columns solve eq. (2): B_i = E_i + R_i B_i^in for every patch.
 #[test]
 fn per_patch_radiosities_solve_the_radiosity_equation() {
-    let (scene, a) = run_with_patches("@cornell", 300_000, Backend::Rust);
+    let (scene, a) = run_with_patches("@cornell", 300_000, EntropyEstimator::ChaoWangJost);
     for (i, e) in a.patches.as_ref().unwrap().iter().enumerate() {
         let m = &scene.materials[scene.patches[i].material as usize];
         let (b, b_in) = (e.radiosity.unwrap(), e.incoming_radiosity.unwrap());
