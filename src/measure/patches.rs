@@ -7,12 +7,17 @@
 //! * eq. (21): `I_s = sum_i I_i`, with `I_i = a_i sum_j F_ij log2(F_ij / a_j)`, the patch's term of the
 //!   discrete mutual information (corrected: `a_i (X_i - H_i)`, with `H_i` corrected and the linear
 //!   cross term `X_i = -sum_j F_ij log2 a_j` as it is);
-//! * eq. (27): `I_s^c = sum_i I_i^c`. I_s^c is the mean over the run's P visible pairs of
-//!   `log2(A_T cos_x cos_y / (pi d^2))`, and eq. (27) integrates over *ordered* pairs of points (x, y).
-//!   A segment found by a line stands for both orders (a global line has no preferred direction), so
-//!   each pair's term goes half to each of its two end patches: `I_i^c` is the sum of the half terms of
-//!   the pairs with an end on patch i, divided by P. The shares then add up to the run's I_s^c exactly
-//!   (to rounding), whatever the sample;
+//! * eq. (27): `I_s^c = sum_i I_i^c`. Eq. (27) integrates `F(x,y) log2(A_T F(x,y))` over x uniform on
+//!   the scene, so it is `sum_i a_i m_i`, with `m_i` the mean of that log over x uniform on patch i and y
+//!   the point x sees in a cosine-distributed direction. The pairs with an end on patch i sample
+//!   exactly that (a global line crosses i at a uniform point, in a cosine-distributed direction, and
+//!   leaves its front side along one segment), so `m_i` is estimated by the mean term of those pairs,
+//!   and `I_i^c = a_i (m_i + delta)`. The estimates `sum_i a_i m_i` and the run's I_s^c (the mean over
+//!   all its pairs) agree in expectation but not sample by sample; `delta` shares their difference out
+//!   in proportion to area (a few 1e-4 bits), so that the shares add up to the run's I_s^c exactly (to
+//!   rounding). Splitting each pair's term half and half between its ends would add up too, but weighs
+//!   a patch by its share of the run's pairs, whose sampling noise then swamps the lost information
+//!   below (5 times the scatter per patch on `@fig2:a` at 10^7 lines);
 //! * the information the discretisation loses at patch i (sec. 3.3): `I_i^c - I_i`, which adds up to
 //!   `I_s^c - I_s`.
 //!
@@ -65,14 +70,13 @@ impl PatchValues {
     }
 }
 
-/// What eq. (27)'s per-patch shares are computed from: the per-patch sums of the log kernel, the number
-/// of pairs `P` of the run's I_s^c, and the total area `A_T` in the units the kernel was measured in.
+/// What eq. (27)'s per-patch shares are computed from: the per-patch sums of the log kernel and the
+/// total area `A_T` in the units the kernel was measured in.
 #[derive(Clone, Copy, Debug)]
 pub struct ContinuousSums<'a> {
-    /// Per-patch sums of `log2(cos_x cos_y / d^2)` over the pair ends.
+    /// Per-patch sums of `log2(cos_x cos_y / d^2)` over the pair ends (every usable pair of the run
+    /// has its two ends there).
     pub sums: &'a PatchKernelSums,
-    /// The pairs behind I_s^c (degenerate ones left out).
-    pub pairs: u64,
     /// `A_T`, in the units of the distances `d`.
     pub total_area: f64,
 }
@@ -110,24 +114,41 @@ pub fn patch_values(
             .collect(),
         row_entropy,
         row_entropy_corrected,
-        continuous_term: continuous.and_then(continuous_shares),
+        continuous_term: continuous.and_then(|c| continuous_shares(c, a)),
     }
 }
 
-/// Eq. (27)'s share of every patch: half of each pair's term to each end, over the run's pairs (module
-/// documentation); `None` without pairs.
-pub fn continuous_shares(c: ContinuousSums<'_>) -> Option<Vec<f64>> {
-    if c.pairs == 0 {
+/// Eq. (27)'s share of every patch, `a_i (m_i + delta)` (module documentation), from the area
+/// fractions `a_i`; 0 for a patch no pair reached; `None` without pairs.
+pub fn continuous_shares(c: ContinuousSums<'_>, area_fractions: &[f64]) -> Option<Vec<f64>> {
+    let ends: u64 = c.sums.ends.iter().sum();
+    if ends == 0 {
         return None;
     }
     let offset = (c.total_area / std::f64::consts::PI).log2();
-    let p = c.pairs as f64;
+    // Every term of the run once per end: their sum over the ends is twice the sum over the pairs.
+    let terms = |i: usize| c.sums.log2_kernel[i] + c.sums.ends[i] as f64 * offset;
+    let whole = (0..area_fractions.len()).map(terms).sum::<f64>() / ends as f64;
+    let reached = |i: &usize| c.sums.ends[*i] > 0;
+    let mean = |i: usize| terms(i) / c.sums.ends[i] as f64;
+    let stratified: f64 = (0..area_fractions.len())
+        .filter(reached)
+        .map(|i| area_fractions[i] * mean(i))
+        .sum();
+    let reached_area: f64 = (0..area_fractions.len())
+        .filter(reached)
+        .map(|i| area_fractions[i])
+        .sum();
+    let delta = (whole - stratified) / reached_area;
     Some(
-        c.sums
-            .log2_kernel
-            .iter()
-            .zip(&c.sums.ends)
-            .map(|(&s, &ends)| 0.5 * (s + ends as f64 * offset) / p)
+        (0..area_fractions.len())
+            .map(|i| {
+                if reached(&i) {
+                    area_fractions[i] * (mean(i) + delta)
+                } else {
+                    0.0
+                }
+            })
             .collect(),
     )
 }
@@ -162,12 +183,10 @@ pub struct PairKernelSums {
 /// factor). The integral is `A_i F_ij` times the mean of `log2 F(x, y)` over the sampled pairs of
 /// points between i and j.
 ///
-/// With `B = 1` the score divided by `A_T` estimates the same loss as [`PatchValues::lost_information`]
-/// (`I_i^c - I_i`), with other weights: here both parts of a pair's bracket are weighted by the same
-/// estimated `A_i F_ij`, so the sampling noise of patch i's segment count cancels between them, which
-/// suits a ranking; there the continuous part is weighted by the pair's share of all the run's pairs,
-/// so that the shares add up to the run's I_s^c exactly. The two agree in expectation in a closed
-/// scene.
+/// With `B = 1` and a closed scene the score divided by `A_T` is [`PatchValues::lost_information`]
+/// (`I_i^c - I_i`) but for its common correction `a_i delta` (module documentation), which keeps the
+/// per-patch table adding up exactly: both weigh a pair by the estimated `A_i F_ij`. (In an open scene
+/// the escapes count in `N_i` here and not in `m_i` there.)
 pub fn information_loss(
     areas: &[f64],
     sample: &PairKernelSums,
@@ -231,25 +250,41 @@ mod tests {
         assert_eq!(v.row_entropy, v.row_entropy_corrected);
     }
 
-    /// Two pairs of known terms: each is shared half and half, and the shares add up to their mean.
+    /// Known terms: each patch gets its area fraction times the mean term of its pairs, plus its share
+    /// of the difference to the mean over all pairs, so the shares add up to that mean; a patch no pair
+    /// reached gets nothing (never 0/0).
     #[test]
-    fn continuous_shares_split_each_pair_between_its_ends() {
-        let mut sums = PatchKernelSums::new(3);
-        sums.add_pairs(&[pair_key(0, 1), pair_key(1, 2)], &[1.0, 3.0]);
+    fn continuous_shares_are_area_times_mean_term_and_add_up() {
+        let mut sums = PatchKernelSums::new(4);
+        sums.add_pairs(
+            &[pair_key(0, 1), pair_key(1, 2), pair_key(0, 2)],
+            &[1.0, 3.0, 2.0],
+        );
         let total_area = std::f64::consts::PI; // offset log2(A_T / pi) = 0
-        let s = continuous_shares(ContinuousSums {
-            sums: &sums,
-            pairs: 2,
-            total_area,
-        })
+        let a = [0.25, 0.25, 0.25, 0.25];
+        let s = continuous_shares(
+            ContinuousSums {
+                sums: &sums,
+                total_area,
+            },
+            &a,
+        )
         .unwrap();
-        assert_eq!(s, vec![0.25, 1.0, 0.75]);
-        assert_eq!(s.iter().sum::<f64>(), 2.0);
-        let none = continuous_shares(ContinuousSums {
-            sums: &PatchKernelSums::new(3),
-            pairs: 0,
-            total_area,
-        });
-        assert!(none.is_none(), "no pairs, no shares (never 0/0)");
+        // Means 1.5, 2, 2.5 over a_i = 1/4 give 1.5; the pairs' mean is 2: delta = 0.5 / 0.75.
+        let delta = 0.5 / 0.75;
+        let expected = [1.5, 2.0, 2.5].map(|m| 0.25 * (m + delta));
+        for (x, e) in s.iter().zip(expected) {
+            assert!((x - e).abs() < 1e-15, "{s:?}");
+        }
+        assert_eq!(s[3], 0.0);
+        assert!((s.iter().sum::<f64>() - 2.0).abs() < 1e-15);
+        let none = continuous_shares(
+            ContinuousSums {
+                sums: &PatchKernelSums::new(4),
+                total_area,
+            },
+            &a,
+        );
+        assert!(none.is_none(), "no pairs, no shares");
     }
 }

@@ -97,7 +97,6 @@ fn of_tally(
     let areas: Vec<f64> = scene.patches.iter().map(|p| p.area).collect();
     let continuous = t.kernel_by_patch.as_ref().map(|sums| ContinuousSums {
         sums,
-        pairs: t.counters.cmi_pairs,
         total_area: scene.total_area(),
     });
     let values = patch_values(&areas, counts, &t.escapes_by_patch, estimator, continuous);

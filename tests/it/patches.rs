@@ -1,6 +1,8 @@
 //! The per-patch results against invariants: the per-patch terms add up to the scene's measures, and
 //! the radiosity columns solve eq. (2). (`cli_patches` checks the files `scx analyze` writes.)
 
+use scene_complexity::measure::patches::information_loss;
+use scene_complexity::refine::oracle;
 use scene_complexity::run::{analyze, Analysis, AnalysisConfig, RunControl};
 use scene_complexity::scenes;
 use scene_complexity::trace::{make_tracer, Backend, Query};
@@ -122,5 +124,33 @@ fn per_patch_radiosities_solve_the_radiosity_equation() {
             "patch {i}: {residual}"
         );
         assert!(b.stderr.is_some_and(|se| se > 0.0 || m.reflectance == 0.0));
+    }
+}
+
+/// One computation: on the same lines (same seed and count), the `information` meshing strategy's
+/// scores with B = 1, divided by A_T, are the per-patch table's lost information but for the table's
+/// common correction `a_i delta` (the same `delta` for every patch), in a closed scene.
+#[test]
+fn refines_information_scores_are_the_tables_lost_information() {
+    let (lines, seed) = (300_000, 7);
+    for spec in ["@cube:4", "@cornell:2"] {
+        let (scene, a) = run_with_patches(spec, lines, EntropyEstimator::PlugIn);
+        assert_eq!(a.seed, seed);
+        let tracer = make_tracer(Backend::Rust, &scene, Query::Single).unwrap();
+        let sample = oracle::sample_pairs(&scene, tracer.as_ref(), lines, seed).unwrap();
+        let areas: Vec<f64> = scene.patches.iter().map(|p| p.area).collect();
+        let scores = information_loss(&areas, &sample, None);
+        let total = scene.total_area();
+        let p = a.patches.unwrap();
+        let delta: Vec<f64> = (0..p.len())
+            .map(|i| {
+                let a_i = areas[i] / total;
+                (p[i].lost_information.unwrap().value - scores[i] / total) / a_i
+            })
+            .collect();
+        for d in &delta {
+            assert!((d - delta[0]).abs() < 1e-9, "{spec}: {delta:?}");
+        }
+        assert!(delta[0].abs() < 0.01, "{spec}: delta {}", delta[0]);
     }
 }
