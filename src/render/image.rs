@@ -12,18 +12,19 @@ use crate::trace::{Line, TraceError, Tracer};
 pub enum Sample {
     /// Nothing (the ray leaves the scene).
     Background,
-    /// A patch's front side, with `|cos|` between the ray and the patch normal.
+    /// A patch's front side, with `|cos|` between the patch normal and the view of its centroid (flat
+    /// shading: one shade per patch).
     Front {
         /// The patch.
         patch: u32,
-        /// `|cos|` of the angle of incidence.
+        /// `|cos|` of the angle the patch is seen at.
         cos: f32,
     },
     /// A patch's back side (the camera is behind it).
     Back {
         /// The patch.
         patch: u32,
-        /// `|cos|` of the angle of incidence.
+        /// `|cos|` of the angle the patch is seen at.
         cos: f32,
     },
 }
@@ -62,6 +63,13 @@ pub fn trace_view(
     let half_height = (0.5 * camera.fov_degrees.to_radians()).tan();
     let pixel = 2.0 * half_height / height as f64;
     let t_max = (eye.length() + 2.0 * scene.bounding_radius()) as f32;
+    // Flat shading: one shade per patch (a picture of flat colours also compresses well).
+    let seen_at: Vec<f32> = (0..scene.patch_count())
+        .map(|p| {
+            let to_patch = (centroid(scene, p) - eye).normalize_or_zero();
+            scene.patches[p].normal.dot(to_patch).abs() as f32
+        })
+        .collect();
     let rows: Vec<Vec<Sample>> = (0..height)
         .into_par_iter()
         .map(|y| {
@@ -91,7 +99,7 @@ pub fn trace_view(
                     };
                     let patch = scene.triangle_patch[h.triangle as usize];
                     let cos = scene.patches[patch as usize].normal.dot(*d);
-                    let c = cos.abs() as f32;
+                    let c = seen_at[patch as usize];
                     if cos < 0.0 {
                         Sample::Front { patch, cos: c }
                     } else {
@@ -106,6 +114,16 @@ pub fn trace_view(
         height,
         samples: rows.into_iter().flatten().collect(),
     })
+}
+
+/// The centroid of a patch's corners in tracing space.
+fn centroid(scene: &Scene, patch: usize) -> crate::geom::Point {
+    let corners: Vec<crate::geom::Point> = scene.patches[patch]
+        .polygon
+        .iter()
+        .map(|&v| crate::geom::DVec3::from_array(scene.positions[v as usize].map(f64::from)))
+        .collect();
+    crate::geom::centroid(&corners)
 }
 
 /// The grey of a back side: darker than any "no data" patch and outside the colour maps.
