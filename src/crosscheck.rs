@@ -16,8 +16,8 @@ use std::fmt;
 
 use crate::measure::Estimate;
 use crate::run::{
-    analyze, map_batches, Analysis, AnalysisConfig, AnalysisError, Batch, LineStream, Measures,
-    RunControl, TraceBuffers,
+    all_batches, analyze, map_batches, Analysis, AnalysisConfig, AnalysisError, Batch, LineStream,
+    Measures, RunControl, TraceBuffers,
 };
 use crate::scene::Scene;
 use crate::trace::{Hit, Line, TraceError, Tracer};
@@ -193,12 +193,12 @@ pub fn compare_hits(
     let (parts, _) = map_batches(
         &stream,
         scene.bounding_radius(),
-        0..stream.plan.batches(),
+        &all_batches(&stream),
         &|_| false,
         |buf: &mut Buffers, batch| compare_batch(scene, a, b, cfg, batch, buf),
     )?;
     let mut total = HitComparison::empty((a.name(), b.name()), cfg.tolerance);
-    for p in parts {
+    for (_, p) in parts {
         total.merge(p, cfg.examples);
     }
     Ok(total)

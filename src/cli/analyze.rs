@@ -1,22 +1,30 @@
 //! `scx analyze`: one analysis, reported as a table, JSON or CSV.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
 
 use clap::ValueEnum;
-use scene_complexity::run::{AnalysisConfig, Budget, Measures, StopReason, Target, TargetMeasure};
+use scene_complexity::run::persist;
+use scene_complexity::run::{
+    cast, finish, plan_of, remaining_lines, start, AnalysisConfig, Budget, CastOptions, Measures,
+    PersistError, RunControl, RunIdentity, RunState, Scope, StopReason, Target, TargetMeasure,
+};
 use scene_complexity::sample::lines::LineSource;
+use scene_complexity::trace::{Backend, Query};
 
 use super::args::{parse_count, parse_positive, parse_target_measure, ReportOutput, RunOptions};
 use super::output::{self, warn};
+use super::report::{self, Format};
 use super::runner::Runner;
-use super::{patches, report, Exit, Failure};
+use super::{patches, Exit, Failure};
 
 /// Arguments of `scx analyze`.
 #[derive(clap::Args, Debug)]
 pub struct AnalyzeArgs {
     /// A scene file (OBJ), a built-in scene such as `@cube:10` (see `scx scenes`), or `-` to read an OBJ
-    /// from standard input.
-    scene: String,
+    /// from standard input. With --resume, the saved run's scene (given again, it must be the same).
+    #[arg(required_unless_present = "resume")]
+    scene: Option<String>,
     /// Number of global lines (accepts `1e7`; default 1e6, or no limit with a budget).
     #[arg(long, value_parser = parse_count, allow_negative_numbers = true)]
     lines: Option<u64>,
@@ -54,6 +62,29 @@ pub struct AnalyzeArgs {
     format: Format,
     #[command(flatten)]
     out: ReportOutput,
+    /// Save the run's state to FILE at the end (also when interrupted): `scx merge` reports it,
+    /// `--resume` continues it (README, "Runs beyond one machine and one sitting").
+    #[arg(long, value_name = "FILE")]
+    save: Option<PathBuf>,
+    /// Run only shard K of M of the run's batches (K from 1); needs --save or --checkpoint, and no
+    /// --seconds or --target-stderr. `scx merge` joins the shards' states into the report of the whole
+    /// run.
+    #[arg(long, value_name = "K/M", value_parser = parse_shard,
+          conflicts_with_all = ["seconds", "target_stderr"])]
+    shard: Option<(u32, u32)>,
+    /// Save the run's state to FILE every --checkpoint-every seconds and at the end (atomically: a
+    /// run killed loses only the work since the last checkpoint).
+    #[arg(long, value_name = "FILE")]
+    checkpoint: Option<PathBuf>,
+    /// Seconds between checkpoints.
+    #[arg(long, default_value = "300", value_parser = parse_positive, allow_negative_numbers = true)]
+    checkpoint_every: f64,
+    /// Continue the run saved in FILE (by --save or --checkpoint) with its own settings, up to --lines
+    /// (more lines than first asked are fine), and save it back to FILE as it goes.
+    #[arg(long, value_name = "FILE", conflicts_with_all = [
+        "seed", "tracer", "query", "groups", "estimator", "errors", "measures", "seconds",
+        "target_stderr", "target_measure", "bundle", "enclose", "shard"])]
+    resume: Option<PathBuf>,
     #[command(flatten)]
     files: PatchFiles,
 }
@@ -80,15 +111,21 @@ enum MeasureArg {
     Radiosity,
 }
 
-/// Output formats of a report.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub enum Format {
-    /// A readable table.
-    Table,
-    /// One JSON document.
-    Json,
-    /// CSV rows with a header.
-    Csv,
+/// A shard `K/M`, 1 <= K <= M.
+fn parse_shard(s: &str) -> Result<(u32, u32), String> {
+    let (k, m) = s
+        .split_once('/')
+        .ok_or_else(|| format!("`{s}`: a shard is K/M, shard K (from 1) of M"))?;
+    let parse = |x: &str| {
+        x.trim()
+            .parse::<u32>()
+            .map_err(|_| format!("`{s}`: K and M must be whole numbers"))
+    };
+    let (k, m) = (parse(k)?, parse(m)?);
+    if !(1..=m).contains(&k) {
+        return Err(format!("`{s}`: need 1 <= K <= M"));
+    }
+    Ok((k, m))
 }
 
 /// Checks the per-patch files before any work: their kinds, that they can be written, and that the run
@@ -130,11 +167,8 @@ fn parse_bundle(s: &str) -> Result<u32, String> {
     LineSource::bundles(g).map(|_| g)
 }
 
-/// Runs `scx analyze`.
-pub fn run(args: &AnalyzeArgs) -> Result<Exit, Failure> {
-    output::check_all(args.out.output.as_deref())?;
-    check_patch_files(args)?;
-    let runner = Runner::new(&args.scene, &args.run)?;
+/// The settings of a new run from the arguments.
+fn config_of(args: &AnalyzeArgs, runner: &Runner) -> Result<AnalysisConfig, Failure> {
     let measures = match &args.measures {
         None => Measures::ALL,
         Some(m) => Measures {
@@ -150,38 +184,260 @@ pub fn run(args: &AnalyzeArgs) -> Result<Exit, Failure> {
             stderr,
         }),
     };
-    let open_ended = budget.is_open_ended();
-    let lines = args.lines.unwrap_or(if open_ended {
+    let lines = args.lines.unwrap_or(if budget.is_open_ended() {
         1_000_000_000_000
     } else {
         1_000_000
     });
-    let cfg = AnalysisConfig {
+    Ok(AnalysisConfig {
         measures,
         budget,
         source: LineSource::bundles(args.bundle).map_err(Failure::bad_input)?,
         enclose: args.enclose,
         per_patch: !args.files.patches.is_empty(),
         ..runner.config(&args.run, lines, args.run.seed)
+    })
+}
+
+/// A run about to be cast: its runner, settings, identity and state, and the seconds it took before.
+struct Prepared {
+    runner: Runner,
+    cfg: AnalysisConfig,
+    identity: RunIdentity,
+    state: RunState,
+    seconds: f64,
+}
+
+/// A new run from the arguments.
+fn new_run(args: &AnalyzeArgs, spec: &str) -> Result<Prepared, Failure> {
+    let runner = Runner::new(spec, &args.run)?;
+    let cfg = config_of(args, &runner)?;
+    if spec == "-" && (args.save.is_some() || args.checkpoint.is_some()) {
+        return Err(Failure::bad_input(
+            "a run of a scene read from standard input cannot be saved (a resume or merge could not \
+             read it again): save the scene to a file",
+        ));
+    }
+    let state = start(&runner.scene, &cfg).map_err(Failure::of)?;
+    let identity = RunIdentity::of(
+        spec,
+        &runner.scene,
+        &cfg,
+        runner.tracer.name(),
+        &args.run.query.to_string(),
+        args.shard,
+    );
+    Ok(Prepared {
+        runner,
+        cfg,
+        identity,
+        state,
+        seconds: 0.0,
+    })
+}
+
+/// A saved run to continue, to `--lines` when given.
+fn resumed_run(args: &AnalyzeArgs, file: &Path) -> Result<Prepared, Failure> {
+    let saved = persist::load(file).map_err(persist_failure)?;
+    let mut identity = saved.identity;
+    let spec = args.scene.clone().unwrap_or_else(|| identity.scene.clone());
+    let backend = match identity.tracer.as_str() {
+        "embree" => Backend::Embree,
+        _ => Backend::Rust,
     };
-    let total = (!open_ended).then_some(lines);
-    let analysis = runner.analyze(&cfg, total, "")?;
+    let query = Query::parse(&identity.query).map_err(Failure::bad_input)?;
+    let runner = Runner::with(&spec, backend, query, args.run.threads)?;
+    check_same_scene(&file.display().to_string(), &identity, &runner)?;
+    let mut cfg = identity
+        .config()
+        .map_err(|e| Failure::bad_input(format!("{}: {e}", file.display())))?;
+    let mut state = saved.state;
+    if let Some(lines) = args.lines.filter(|&n| n != identity.lines) {
+        let old_plan = plan_of(&cfg);
+        cfg.lines = lines;
+        let plan = plan_of(&cfg);
+        let groups = (cfg.groups.max(2) as u64).min(plan.batches().max(2));
+        if lines < identity.lines {
+            return Err(Failure::bad_input(format!(
+                "{}: a run of {} lines cannot be continued to fewer lines ({lines})",
+                file.display(),
+                identity.lines
+            )));
+        }
+        if plan.batch_size != old_plan.batch_size || groups != state.group_count() {
+            return Err(Failure::bad_input(format!(
+                "{}: a run of {} lines (batches of {}) can be continued to more lines cut the same way: \
+                 {lines} lines would be batches of {} in {groups} groups (from 262144 lines on, every \
+                 run has batches of 4096)",
+                file.display(),
+                identity.lines,
+                old_plan.batch_size,
+                plan.batch_size
+            )));
+        }
+        state = state.extend(plan);
+        identity.lines = lines;
+    }
+    Ok(Prepared {
+        runner,
+        cfg,
+        identity,
+        state,
+        seconds: saved.seconds,
+    })
+}
+
+/// Refuses a scene that is not the one a state was made of.
+pub fn check_same_scene(
+    file: &str,
+    identity: &RunIdentity,
+    runner: &Runner,
+) -> Result<(), Failure> {
+    let fingerprint = runner.scene.fingerprint();
+    if fingerprint != identity.fingerprint {
+        return Err(Failure::bad_input(format!(
+            "{file}: the state is of another scene than {} (fingerprint {} against {})",
+            runner.scene.name,
+            &identity.fingerprint[..12.min(identity.fingerprint.len())],
+            &fingerprint[..12]
+        )));
+    }
+    Ok(())
+}
+
+/// A state file that cannot be read or written: bad input (2) or I/O (3).
+pub fn persist_failure(e: PersistError) -> Failure {
+    Failure {
+        code: if e.is_bad_input() {
+            Exit::BadInput
+        } else {
+            Exit::Io
+        },
+        message: e.to_string(),
+    }
+}
+
+/// Saves checkpoints every so often while a run goes on, and remembers a failed save (the run then
+/// stops, since its work could no longer be kept).
+struct Checkpoints<'a> {
+    path: Option<&'a Path>,
+    every: Duration,
+    last: Instant,
+    failed: Option<Failure>,
+    /// Seconds of the run before this session, and when this session began.
+    before: f64,
+    began: Instant,
+}
+
+impl Checkpoints<'_> {
+    fn seconds(&self) -> f64 {
+        self.before + self.began.elapsed().as_secs_f64()
+    }
+
+    fn after_round(&mut self, identity: &RunIdentity, state: &RunState, control: &RunControl) {
+        let Some(path) = self.path else { return };
+        if self.failed.is_some() || self.last.elapsed() < self.every {
+            return;
+        }
+        match persist::save(path, identity, state, self.seconds()) {
+            Ok(()) => self.last = Instant::now(),
+            Err(e) => {
+                self.failed = Some(persist_failure(e));
+                control.request_stop();
+            }
+        }
+    }
+}
+
+/// Runs `scx analyze`.
+pub fn run(args: &AnalyzeArgs) -> Result<Exit, Failure> {
+    if args.shard.is_some() && args.save.is_none() && args.checkpoint.is_none() {
+        return Err(Failure::bad_input(
+            "--shard needs --save FILE (or --checkpoint FILE): a shard's work is only of use saved",
+        ));
+    }
+    let checkpoint = args.checkpoint.as_deref().or(args.resume.as_deref());
+    output::check_all(
+        [args.out.output.as_deref(), args.save.as_deref(), checkpoint]
+            .into_iter()
+            .flatten(),
+    )?;
+    check_patch_files(args)?;
+    let Prepared {
+        runner,
+        cfg,
+        identity,
+        mut state,
+        seconds: before,
+    } = match &args.resume {
+        Some(file) => resumed_run(args, file)?,
+        None => new_run(args, args.scene.as_deref().unwrap_or("-"))?,
+    };
+    if args.resume.is_some() && !args.files.patches.is_empty() {
+        warn(
+            "a run state keeps no per-patch sums of eq. (27): the I_s^c and lost-information columns \
+             of --patches stay empty for a resumed run",
+        );
+    }
+    let cfg = AnalysisConfig {
+        per_patch: !args.files.patches.is_empty(),
+        ..cfg
+    };
+    let scope = match identity.shard {
+        Some((index, count)) => Scope::Shard { index, count },
+        None => Scope::All,
+    };
+    let mut checkpoints = Checkpoints {
+        path: checkpoint,
+        every: Duration::from_secs_f64(args.checkpoint_every),
+        last: Instant::now(),
+        failed: None,
+        before,
+        began: Instant::now(),
+    };
+    let total = (!cfg.budget.is_open_ended()).then(|| remaining_lines(&state, scope));
+    let control = &runner.control;
+    let stop_reason = runner
+        .in_pool(total, "", || {
+            cast(
+                &runner.scene,
+                runner.tracer.as_ref(),
+                &cfg,
+                &mut state,
+                CastOptions {
+                    scope,
+                    round_seconds: checkpoint.map(|_| args.checkpoint_every.min(30.0) / 2.0),
+                },
+                control,
+                &mut |s| checkpoints.after_round(&identity, s, control),
+            )
+        })
+        .map_err(|e| Failure {
+            code: Exit::Failed,
+            message: e.to_string(),
+        })?;
+    let seconds = checkpoints.seconds();
+    if let Some(f) = checkpoints.failed {
+        return Err(f);
+    }
+    for path in [args.save.as_deref(), checkpoint].into_iter().flatten() {
+        persist::save(path, &identity, &state, seconds).map_err(persist_failure)?;
+        output::wrote(path);
+    }
+    let analysis = finish(&runner.scene, &cfg, state, stop_reason, seconds).map_err(Failure::of)?;
     for w in &analysis.warnings {
         warn(&w.message);
     }
     let run = report::RunInfo {
-        bundle: args.bundle,
+        bundle: identity.bundle,
+        shard: identity.shard,
         ..runner.info()
     };
     runner.pool.install(|| {
         patches::write_patches(&args.files.patches, &runner.scene, &analysis)?;
         patches::write_form_factors(&args.files.form_factors, &runner.scene, &analysis)
     })?;
-    let text = match args.format {
-        Format::Table => report::table(&run, &analysis),
-        Format::Json => report::json(&run, &analysis),
-        Format::Csv => report::csv(&run, &analysis),
-    };
+    let text = report::render(args.format, &run, &analysis);
     output::emit(args.out.output.as_deref(), &text)?;
     Ok(if analysis.stop_reason == StopReason::Interrupted {
         Exit::Interrupted

@@ -135,15 +135,7 @@ pub fn parse_target_measure(s: &str) -> Result<TargetMeasure, String> {
 }
 
 fn parse_query(s: &str) -> Result<Query, String> {
-    match s {
-        "single" => Ok(Query::Single),
-        "packet4" => Ok(Query::Packet(4)),
-        "packet8" => Ok(Query::Packet(8)),
-        "packet16" => Ok(Query::Packet(16)),
-        _ => Err(format!(
-            "`{s}`: expected single, packet4, packet8 or packet16"
-        )),
-    }
+    Query::parse(s)
 }
 
 #[cfg(test)]

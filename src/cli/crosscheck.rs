@@ -58,14 +58,7 @@ pub fn run(args: &CrosscheckArgs) -> Result<Exit, Failure> {
         .install(|| {
             crosscheck::crosscheck(&scene, embree.as_ref(), rust.as_ref(), &cfg, DEFAULT_GROUPS)
         })
-        .map_err(|e| Failure {
-            code: if e.is_bad_input() {
-                Exit::BadInput
-            } else {
-                Exit::Failed
-            },
-            message: e.to_string(),
-        })?;
+        .map_err(Failure::of)?;
     output::emit(
         args.out.output.as_deref(),
         &crosscheck::report(&check, &scene),

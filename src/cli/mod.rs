@@ -7,6 +7,7 @@ mod crosscheck;
 mod docs;
 mod export;
 mod input;
+mod merge;
 mod output;
 mod patches;
 mod plot;
@@ -105,6 +106,14 @@ enum Command {
     /// for measure; exit 1 when a line differs beyond the tolerance.
     #[command(after_help = "Example:\n  scx crosscheck @cubes512 --lines 1e6")]
     Crosscheck(crosscheck::CrosscheckArgs),
+    /// Join the saved states of a run's shards (`analyze --shard K/M --save FILE`) into the report of the
+    /// whole run, identical to casting it at once.
+    #[command(after_help = concat!(
+        "Example:\n",
+        "  for k in 1 2 3 4; do scx analyze @cube:30 --lines 1e9 --shard $k/4 --save part-$k.scx & done; wait\n",
+        "  scx merge part-*.scx --format json -o cube30.json"
+    ))]
+    Merge(merge::MergeArgs),
     /// Regenerate the paper's Tables 1 to 9 and print each beside the published values (Markdown).
     #[command(after_help = "Example:\n  scx reproduce --table 4 --lines x0.1 -o table4.md")]
     Reproduce(reproduce::ReproduceArgs),
@@ -132,7 +141,41 @@ pub struct Failure {
     message: String,
 }
 
+/// A library error that tells whether the user's input is at fault.
+pub trait InputError: std::fmt::Display {
+    /// Whether the input (a scene, materials, settings) is at fault, not the machinery.
+    fn is_bad_input(&self) -> bool;
+}
+
+macro_rules! input_errors {
+    ($($t:ty),*) => {$(
+        impl InputError for $t {
+            fn is_bad_input(&self) -> bool {
+                <$t>::is_bad_input(self)
+            }
+        }
+    )*};
+}
+
+input_errors!(
+    scene_complexity::run::AnalysisError,
+    scene_complexity::refine::RefineError,
+    scene_complexity::reproduce::ReproduceError
+);
+
 impl Failure {
+    /// A library error: bad input (2) when the input is at fault, else a failure (1).
+    pub fn of(e: impl InputError) -> Self {
+        Failure {
+            code: if e.is_bad_input() {
+                Exit::BadInput
+            } else {
+                Exit::Failed
+            },
+            message: e.to_string(),
+        }
+    }
+
     /// Bad input (exit code 2).
     pub fn bad_input(message: impl ToString) -> Self {
         Failure {
@@ -155,6 +198,7 @@ pub fn main() -> ExitCode {
         Command::Render(args) => render::run(&args),
         Command::Crosscheck(args) => crosscheck::run(&args),
         Command::Reproduce(args) => reproduce::run(&args),
+        Command::Merge(args) => merge::run(&args),
         Command::Completions(args) => docs::completions(&args),
         Command::Man(args) => docs::man(&args),
     };

@@ -72,7 +72,7 @@ pub fn write_patches(paths: &[PathBuf], scene: &Scene, a: &Analysis) -> Result<(
     }
     let Some(patches) = &a.patches else {
         return Err(Failure::bad_input(
-            "no per-patch results: the run counted no patch pairs",
+            "no per-patch results: the run counted no patch pairs, or closed the scene with --enclose",
         ));
     };
     for path in paths {

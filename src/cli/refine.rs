@@ -5,13 +5,15 @@ use std::path::PathBuf;
 use clap::ValueEnum;
 use scene_complexity::measure::radiosity::SolveOptions;
 use scene_complexity::refine::{refine, RefineConfig, RefineRound, Strategy};
+use scene_complexity::run::RunControl;
 use scene_complexity::scene::obj;
 use scene_complexity::trace::{make_tracer, Query};
+use std::sync::Arc;
 
 use super::args::{parse_count, parse_positive, parse_seed, parse_threads, TracerArg};
 use super::input::load_scene;
 use super::output::{self, check_all, note};
-use super::runner::thread_pool;
+use super::runner::{thread_pool, watch_ctrl_c};
 use super::{Exit, Failure};
 
 /// Arguments of `scx refine`.
@@ -77,6 +79,8 @@ pub fn run(args: &RefineArgs) -> Result<Exit, Failure> {
         solve: SolveOptions::default(),
     };
     let (_, pool) = thread_pool(args.threads)?;
+    let control = Arc::new(RunControl::default());
+    watch_ctrl_c(&control);
     let started = std::time::Instant::now();
     let mut log = |r: &RefineRound| {
         let mi = r
@@ -94,17 +98,11 @@ pub fn run(args: &RefineArgs) -> Result<Exit, Failure> {
                 &scene,
                 &|s| make_tracer(backend, s, Query::Single),
                 &cfg,
+                &control,
                 &mut log,
             )
         })
-        .map_err(|e| Failure {
-            code: if e.is_bad_input() {
-                Exit::BadInput
-            } else {
-                Exit::Failed
-            },
-            message: e.to_string(),
-        })?;
+        .map_err(Failure::of)?;
     obj::write(&refined.scene, &args.output).map_err(|e| Failure {
         code: Exit::Io,
         message: e.to_string(),
@@ -118,5 +116,9 @@ pub fn run(args: &RefineArgs) -> Result<Exit, Failure> {
         refined.rounds.len(),
         started.elapsed().as_secs_f64()
     ));
+    if refined.interrupted {
+        note("interrupted: the mesh written is that of the last finished round");
+        return Ok(Exit::Interrupted);
+    }
     Ok(Exit::Ok)
 }

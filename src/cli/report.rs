@@ -4,16 +4,37 @@
 
 use std::fmt::Write;
 
+use clap::ValueEnum;
+
 use scene_complexity::measure::Estimate;
 use scene_complexity::run::{
     Analysis, ErrorMethod, RadiosityEstimates, RadiosityOutcome, Reliability, StopReason,
     TargetOutcome, Verdict,
 };
 use scene_complexity::scene::Scene;
-use scene_complexity::trace::Query;
 use serde_json::{json, Value};
 
 use super::table::{fixed, Align, Table};
+
+/// Output formats of a report.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum Format {
+    /// A readable table.
+    Table,
+    /// One JSON document.
+    Json,
+    /// CSV rows with a header.
+    Csv,
+}
+
+/// The report of an analysis in `format`.
+pub fn render(format: Format, run: &RunInfo, a: &Analysis) -> String {
+    match format {
+        Format::Table => table(run, a),
+        Format::Json => json(run, a),
+        Format::Csv => csv(run, a),
+    }
+}
 
 /// JSON schema version of `analyze --format json` (2: units, reliability, sampling, target, command
 /// line, CPU).
@@ -22,11 +43,13 @@ pub const SCHEMA_VERSION: u32 = 2;
 /// Facts about the run that the analysis itself does not hold.
 pub struct RunInfo<'a> {
     pub scene: &'a Scene,
-    pub tracer: &'static str,
-    pub query: Query,
+    pub tracer: &'a str,
+    pub query: String,
     pub threads: usize,
     /// Lines per side of a bundle, 0 for independent lines.
     pub bundle: u32,
+    /// The shard (index from 1, count) when the run was one.
+    pub shard: Option<(u32, u32)>,
 }
 
 /// A reading's unit.
@@ -305,7 +328,7 @@ pub fn json(run: &RunInfo, a: &Analysis) -> String {
         "triangles": run.scene.triangles.len(),
         "area": run.scene.total_area_scene_units(),
         "tracer": run.tracer,
-        "query": run.query.to_string(),
+        "query": run.query,
         "bundle": run.bundle,
         "lines": a.lines,
         "seed": a.seed,
@@ -314,6 +337,9 @@ pub fn json(run: &RunInfo, a: &Analysis) -> String {
         "seconds": a.seconds,
         "stop_reason": a.stop_reason.name(),
         "interrupted": a.stop_reason == StopReason::Interrupted,
+        "complete": a.is_complete(),
+        "covered_lines": a.covered_lines().iter().map(|r| [r.start, r.end]).collect::<Vec<_>>(),
+        "shard": run.shard.map(|(k, m)| json!({"index": k, "count": m})),
         "target": target_json(&a.target),
         "estimator": a.estimator.name(),
         "errors": a.errors.name(),
@@ -521,6 +547,26 @@ pub fn table(run: &RunInfo, a: &Analysis) -> String {
             smp.sampling.coverage,
             100.0 * smp.sampling.singleton_share,
             String::new()
+        );
+    }
+    if !a.is_complete() {
+        let ranges: Vec<String> = a
+            .covered_lines()
+            .iter()
+            .map(|r| format!("{}..{}", r.start, r.end))
+            .collect();
+        let _ = writeln!(
+            s,
+            "covers   lines {} of the run's {}{} (a partial run: every figure is of these lines only)",
+            if ranges.is_empty() {
+                "none".to_string()
+            } else {
+                ranges.join(", ")
+            },
+            a.plan.lines,
+            run.shard
+                .map(|(k, m)| format!(", shard {k} of {m}"))
+                .unwrap_or_default()
         );
     }
     if let Some(env) = a.environment_area {

@@ -80,14 +80,7 @@ pub fn run(args: &ReproduceArgs) -> Result<Exit, Failure> {
     };
     let mut log = |m: &str| output::note(&format!("reproduce: {m}"));
     pool.install(|| reproduce(&cfg, &mut log, &mut on_table))
-        .map_err(|e| Failure {
-            code: if e.is_bad_input() {
-                Exit::BadInput
-            } else {
-                Exit::Failed
-            },
-            message: e.to_string(),
-        })?;
+        .map_err(Failure::of)?;
     printed?;
     print(&format!(
         "Total: {:.1} s ({:.1} min).\n",

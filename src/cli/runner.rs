@@ -4,7 +4,7 @@ use std::sync::Arc;
 
 use scene_complexity::run::{analyze, Analysis, AnalysisConfig, Measures, RunControl};
 use scene_complexity::scene::Scene;
-use scene_complexity::trace::{make_tracer, Query, Tracer};
+use scene_complexity::trace::{make_tracer, Backend, Query, Tracer};
 
 use super::args::{RunOptions, TracerArg};
 use super::input::load_scene;
@@ -23,10 +23,24 @@ pub struct Runner {
 impl Runner {
     /// Loads the scene and builds its tracer and thread pool.
     pub fn new(spec: &str, opts: &RunOptions) -> Result<Runner, Failure> {
+        Runner::with(
+            spec,
+            TracerArg::backend(opts.tracer),
+            opts.query,
+            opts.threads,
+        )
+    }
+
+    /// Loads the scene and builds the tracer `backend` with `query` and a pool of `threads` threads.
+    pub fn with(
+        spec: &str,
+        backend: Backend,
+        query: Query,
+        threads: Option<usize>,
+    ) -> Result<Runner, Failure> {
         let scene = load_scene(spec)?;
-        let tracer = make_tracer(TracerArg::backend(opts.tracer), &scene, opts.query)
-            .map_err(Failure::bad_input)?;
-        let (threads, pool) = thread_pool(opts.threads)?;
+        let tracer = make_tracer(backend, &scene, query).map_err(Failure::bad_input)?;
+        let (threads, pool) = thread_pool(threads)?;
         let control = Arc::new(RunControl::default());
         watch_ctrl_c(&control);
         Ok(Runner {
@@ -34,9 +48,19 @@ impl Runner {
             tracer,
             pool,
             threads,
-            query: opts.query,
+            query,
             control,
         })
+    }
+
+    /// Runs `work` in the runner's thread pool while a progress bar shows (of `total` lines when known).
+    pub fn in_pool<T: Send>(
+        &self,
+        total: Option<u64>,
+        label: &str,
+        work: impl FnOnce() -> T + Send,
+    ) -> T {
+        progress::while_running(&self.control, total, label, || self.pool.install(work))
     }
 
     /// Runs one analysis with a progress bar (of `total` lines when known; `label` says which run).
@@ -50,14 +74,7 @@ impl Runner {
             self.pool
                 .install(|| analyze(&self.scene, self.tracer.as_ref(), cfg, &self.control))
         })
-        .map_err(|e| Failure {
-            code: if e.is_bad_input() {
-                Exit::BadInput
-            } else {
-                Exit::Failed
-            },
-            message: e.to_string(),
-        })
+        .map_err(Failure::of)
     }
 
     /// Facts about the run for the reports.
@@ -65,9 +82,10 @@ impl Runner {
         report::RunInfo {
             scene: &self.scene,
             tracer: self.tracer.name(),
-            query: self.query,
+            query: self.query.to_string(),
             threads: self.threads,
             bundle: 0,
+            shard: None,
         }
     }
 
@@ -101,7 +119,7 @@ pub fn thread_pool(threads: Option<usize>) -> Result<(usize, rayon::ThreadPool),
 }
 
 /// The first Ctrl-C asks the run to stop and report what it gathered; a second one ends the program.
-fn watch_ctrl_c(control: &Arc<RunControl>) {
+pub fn watch_ctrl_c(control: &Arc<RunControl>) {
     let control = Arc::clone(control);
     let presses = std::sync::atomic::AtomicU32::new(0);
     // Failing to install the handler only loses the clean stop: Ctrl-C then ends the program as usual.

@@ -127,7 +127,7 @@ pub fn continuous_shares(c: ContinuousSums<'_>, area_fractions: &[f64]) -> Optio
     }
     let offset = (c.total_area / std::f64::consts::PI).log2();
     // Every term of the run once per end: their sum over the ends is twice the sum over the pairs.
-    let terms = |i: usize| c.sums.log2_kernel[i] + c.sums.ends[i] as f64 * offset;
+    let terms = |i: usize| c.sums.log2_kernel[i].value() + c.sums.ends[i] as f64 * offset;
     let whole = (0..area_fractions.len()).map(terms).sum::<f64>() / ends as f64;
     let reached = |i: &usize| c.sums.ends[*i] > 0;
     let mean = |i: usize| terms(i) / c.sums.ends[i] as f64;

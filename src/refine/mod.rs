@@ -22,7 +22,7 @@ use std::time::Instant;
 
 use crate::measure::patches;
 use crate::measure::radiosity::{self, FormFactors, MaterialError, PatchMaterials, SolveOptions};
-use crate::run::SolveFailure;
+use crate::run::{RunControl, SolveFailure};
 use crate::scene::{Scene, SceneError};
 use crate::trace::{TraceError, Tracer};
 use mesh::Mesh;
@@ -91,6 +91,9 @@ pub struct Refinement {
     pub scene: Scene,
     /// The rounds, in order.
     pub rounds: Vec<RefineRound>,
+    /// Whether a stop request ended the refinement early (the mesh is then that of the last finished
+    /// round).
+    pub interrupted: bool,
 }
 
 /// Why a refinement failed.
@@ -141,12 +144,14 @@ impl RefineError {
 /// Builds a tracer for a scene (each round's mesh is a new scene).
 pub type TracerFactory<'a> = dyn Fn(&Scene) -> Result<Box<dyn Tracer>, TraceError> + 'a;
 
-/// Refines `scene` with `cfg`; `tracer_for` builds a tracer for each round's mesh, and `progress` hears of
-/// every finished round.
+/// Refines `scene` with `cfg`; `tracer_for` builds a tracer for each round's mesh, `progress` hears of
+/// every finished round, and a stop requested on `control` ends the refinement after the round under
+/// way (the mesh is that of the last finished round).
 pub fn refine(
     scene: &Scene,
     tracer_for: &TracerFactory,
     cfg: &RefineConfig,
+    control: &RunControl,
     progress: &mut dyn FnMut(&RefineRound),
 ) -> Result<Refinement, RefineError> {
     if !(cfg.growth > 1.0 && cfg.growth.is_finite()) {
@@ -166,7 +171,12 @@ pub fn refine(
     let name = format!("{} refined ({})", scene.name, cfg.strategy);
     let mut mesh = Mesh::from_scene(scene);
     let mut rounds = Vec::new();
+    let mut interrupted = false;
     while mesh.len() < cfg.target_patches {
+        if control.stop_requested() {
+            interrupted = true;
+            break;
+        }
         let start = Instant::now();
         let before = mesh.len();
         let current = mesh.to_scene(&name)?;
@@ -196,6 +206,7 @@ pub fn refine(
     Ok(Refinement {
         scene: mesh.to_scene(&name)?,
         rounds,
+        interrupted,
     })
 }
 

@@ -7,7 +7,7 @@ use rayon::prelude::*;
 use crate::geom::{orthonormal_basis, Direction};
 use crate::measure::patches::PairKernelSums;
 use crate::measure::radiosity::{FormFactors, Solution};
-use crate::run::{map_traced_batches, LineStream};
+use crate::run::{all_batches, map_traced_batches, LineStream};
 use crate::sample::counts::{pair_key, PairCounts};
 use crate::sample::kernel::kernel_without_pi;
 use crate::sample::pairs::{segments, LineF64, Segment};
@@ -29,7 +29,7 @@ fn trace_segments<T: Default + Send>(
         &stream,
         tracer,
         scene.bounding_radius(),
-        0..stream.plan.batches(),
+        &all_batches(&stream),
         &|_| false,
         |_: &mut (), batch, hits| {
             let mut out = T::default();
@@ -40,7 +40,7 @@ fn trace_segments<T: Default + Send>(
             out
         },
     )?;
-    Ok(per_batch)
+    Ok(per_batch.into_iter().map(|(_, t)| t).collect())
 }
 
 /// Casts `lines` global lines and gathers, per unordered patch pair, its count and the sum of

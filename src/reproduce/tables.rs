@@ -834,7 +834,13 @@ fn refine_cornell(
         solve: SolveOptions::default(),
     };
     let tracer_for = |sc: &Scene| make_tracer(backend, sc, Query::Single);
-    let refined = refine(base, &tracer_for, &cfg, &mut |_| {})?;
+    let refined = refine(
+        base,
+        &tracer_for,
+        &cfg,
+        &crate::run::RunControl::default(),
+        &mut |_| {},
+    )?;
     let lines: u64 = refined.rounds.iter().map(|r| r.lines).sum();
     let seconds = start.elapsed().as_secs_f64();
     s.lines_cast += lines;

@@ -16,7 +16,7 @@ use super::batches::LineStream;
 use super::control::{Budget, RunControl, StopReason, TargetMeasure};
 use super::errors::{ErrorMethod, Spread};
 use super::patches::{self as per_patch, PatchEstimate, PatchLight};
-use super::plan::{BatchPlan, MAX_ROUND_LINES};
+use super::plan::{BatchPlan, BatchSet, MAX_ROUND_LINES};
 use super::radiosity::{self, RadiosityOutcome, SolveFailure};
 use super::readings::VisibilityEstimates;
 use super::reliability::{self, SamplingReport, Verdict, VisibilityReliability, COVERAGE_OK};
@@ -153,6 +153,10 @@ pub struct Analysis {
     pub seconds: f64,
     /// Why the run ended.
     pub stop_reason: StopReason,
+    /// How the run's lines are cut into batches.
+    pub plan: BatchPlan,
+    /// The batches the report covers (all of the plan's but when interrupted, or for a partial merge).
+    pub covered: BatchSet,
     /// Groups behind the standard errors.
     pub groups: usize,
     /// The estimator of the corrected measures.
@@ -197,6 +201,23 @@ pub struct Analysis {
 }
 
 impl Analysis {
+    /// Whether the report covers every batch of its plan.
+    pub fn is_complete(&self) -> bool {
+        self.covered.len() == self.plan.batches()
+    }
+
+    /// The line ranges the report covers (of the plan's `0..lines`).
+    pub fn covered_lines(&self) -> Vec<std::ops::Range<u64>> {
+        self.covered
+            .ranges()
+            .iter()
+            .map(|r| {
+                self.plan.first_line(r.start)
+                    ..self.plan.first_line(r.end - 1) + self.plan.batch_len(r.end - 1) as u64
+            })
+            .collect()
+    }
+
     /// The fraction of the segments leaving a front side that escape the scene (`None` without
     /// segments).
     pub fn escape_fraction(&self) -> Option<f64> {
@@ -264,7 +285,10 @@ impl GroupValues {
         let mut values = GroupValues {
             discrete: None,
             corrected: None,
-            continuous: ContinuousValues::from_sum(t.counters.cmi_sum, t.counters.cmi_pairs),
+            continuous: ContinuousValues::from_sum(
+                t.counters.cmi_sum.value(),
+                t.counters.cmi_pairs,
+            ),
             environment_area: None,
             sampling: None,
             lines_factor: None,
@@ -303,26 +327,265 @@ fn areas(scene: &Scene) -> Vec<f64> {
 ///
 /// With radiosity asked for, the materials are checked before any line is cast; when nothing emits the
 /// radiosity measures are left out with the reason. Uses the current rayon thread pool; results do not
-/// depend on its size.
+/// depend on its size. [`start`], [`cast`] and [`finish`] are its three steps, for runs that are
+/// sharded, checkpointed or resumed.
 pub fn analyze(
     scene: &Scene,
     tracer: &dyn Tracer,
     cfg: &AnalysisConfig,
     control: &RunControl,
 ) -> Result<Analysis, AnalysisError> {
+    let started = Instant::now();
+    let mut state = start(scene, cfg)?;
+    let stop_reason = cast(
+        scene,
+        tracer,
+        cfg,
+        &mut state,
+        CastOptions::default(),
+        control,
+        &mut |_| {},
+    )?;
+    finish(
+        scene,
+        cfg,
+        state,
+        stop_reason,
+        started.elapsed().as_secs_f64(),
+    )
+}
+
+/// Which measures a run of `cfg` gathers on `scene`: the pair counts also for the radiosity measures
+/// when something emits. Checks the materials first when radiosity is asked for.
+fn gathered(scene: &Scene, cfg: &AnalysisConfig) -> Result<Wanted, AnalysisError> {
+    let lit = if cfg.measures.radiosity {
+        PatchMaterials::of_scene(scene)?.any_emission()
+    } else {
+        false
+    };
+    Ok(Wanted {
+        discrete: cfg.measures.discrete || lit || cfg.per_patch,
+        continuous: cfg.measures.continuous,
+        per_patch: cfg.per_patch && cfg.measures.continuous,
+    })
+}
+
+/// The batch plan of a run of `cfg`: fixed by the line count, or full batches when a budget may end the
+/// run anywhere.
+pub fn plan_of(cfg: &AnalysisConfig) -> BatchPlan {
+    if cfg.budget.is_open_ended() {
+        BatchPlan::open_ended(cfg.lines, cfg.source)
+    } else {
+        BatchPlan::for_source(cfg.lines, cfg.source)
+    }
+}
+
+/// The empty state of a run of `cfg` on `scene`, checked before any line is cast (the materials, when
+/// radiosity is asked for).
+pub fn start(scene: &Scene, cfg: &AnalysisConfig) -> Result<RunState, AnalysisError> {
+    let plan = plan_of(cfg);
+    // A short fixed run has fewer batches than groups: one group per batch then.
+    let groups = (cfg.groups.max(2) as u64).min(plan.batches().max(2)) as usize;
+    Ok(RunState::new(plan, groups, gathered(scene, cfg)?))
+}
+
+/// The batches a run casts: all of them, or one shard's share.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Scope {
+    /// Every batch of the plan.
+    All,
+    /// Shard `index` (from 1) of `count`: a contiguous block of about 1/count of the batches.
+    Shard {
+        /// Which shard, 1 to `count`.
+        index: u32,
+        /// How many shards.
+        count: u32,
+    },
+}
+
+impl Scope {
+    /// The batches of a plan of `batches` batches in this scope.
+    pub fn batches(self, batches: u64) -> std::ops::Range<u64> {
+        match self {
+            Scope::All => 0..batches,
+            Scope::Shard { index, count } => {
+                let (k, m) = (u64::from(index.max(1) - 1), u64::from(count.max(1)));
+                (k * batches / m)..((k + 1) * batches / m)
+            }
+        }
+    }
+}
+
+/// How a run casts its batches: which of them, and in rounds of about how long.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CastOptions {
+    /// The batches to cast.
+    pub scope: Scope,
+    /// Keep rounds to about this many seconds (a checkpointed run saves between rounds); `None`: rounds
+    /// as large as memory allows. Rounds change nothing in the numbers.
+    pub round_seconds: Option<f64>,
+}
+
+impl Default for CastOptions {
+    fn default() -> Self {
+        CastOptions {
+            scope: Scope::All,
+            round_seconds: None,
+        }
+    }
+}
+
+/// Lines still to cast in `scope` for a run in `state`.
+pub fn remaining_lines(state: &RunState, scope: Scope) -> u64 {
+    let plan = state.plan();
+    let range = scope.batches(plan.batches());
+    let missing = state.done().missing(range.end);
+    missing
+        .indices_within(range)
+        .into_iter()
+        .map(|b| plan.batch_len(b) as u64)
+        .sum()
+}
+
+/// Casts the batches of `options.scope` not done yet in `state`, in rounds, until they are all done,
+/// the budget is spent or a stop is requested; every finished batch is kept, and `after_round` sees the
+/// state after each round (to save a checkpoint).
+pub fn cast(
+    scene: &Scene,
+    tracer: &dyn Tracer,
+    cfg: &AnalysisConfig,
+    state: &mut RunState,
+    options: CastOptions,
+    control: &RunControl,
+    after_round: &mut dyn FnMut(&RunState),
+) -> Result<StopReason, TraceError> {
     let start = Instant::now();
+    let plan = state.plan();
+    let wanted = state.wanted();
+    let stream = LineStream {
+        plan,
+        source: cfg.source,
+        seed: cfg.seed,
+    };
+    let deadline = cfg
+        .budget
+        .seconds
+        .map(|s| start + Duration::from_secs_f64(s.max(0.0)));
+    let stop = |b: u64| {
+        let late = deadline.is_some_and(|d| Instant::now() >= d);
+        if control.stop_requested() || late {
+            return true;
+        }
+        control.started(plan.batch_len(b) as u64);
+        false
+    };
+    let scope = options.scope.batches(plan.batches());
+    // Rounds bound the memory held in pair keys and let a budget run check itself.
+    let max_round = (MAX_ROUND_LINES / plan.batch_size).max(1);
+    let first_round = (4 * state.group_count()).max(64);
+    let mut round = if cfg.budget.is_open_ended() || options.round_seconds.is_some() {
+        first_round
+    } else {
+        max_round
+    };
+    let mut cast_batches = 0u64;
+    // The next batch to look at, and the last round's batches when they are not counted yet: without a
+    // precision target the next round's size does not depend on the counts, so a round is counted while
+    // the next one is traced, which keeps both cores busy through the counting's serial parts.
+    let mut cursor = scope.start;
+    let mut pending: Option<TracedBatches> = None;
+    let stop_reason = loop {
+        let (batches, next) = next_batches(state.done(), cursor, scope.end, round);
+        let trace = || TracedBatches::trace(scene, tracer, &stream, &batches, wanted, &stop);
+        let (traced, complete) = match pending.take() {
+            Some(previous) => {
+                let (traced, ()) = rayon::join(trace, || state.add(scene, previous));
+                after_round(state);
+                traced?
+            }
+            None => trace()?,
+        };
+        cursor = next;
+        cast_batches += traced.len() as u64;
+        let ended = if !complete {
+            Some(if control.stop_requested() {
+                StopReason::Interrupted
+            } else {
+                StopReason::Seconds
+            })
+        } else if cursor >= scope.end {
+            Some(StopReason::Lines)
+        } else if deadline.is_some_and(|d| Instant::now() >= d) {
+            Some(StopReason::Seconds)
+        } else {
+            None
+        };
+        if ended.is_some() || cfg.budget.target.is_some() {
+            state.add(scene, traced);
+            after_round(state);
+        } else {
+            pending = Some(traced);
+        }
+        if let Some(reason) = ended {
+            break reason;
+        }
+        if let Some(target) = cfg.budget.target {
+            let done = state.batches_done();
+            let (se, verdict) = current_reading(scene, state, cfg, target.measure);
+            let reliable = verdict == Some(Verdict::Ok);
+            match se {
+                Some(se) if se <= target.stderr && reliable => break StopReason::Target,
+                // stderr ~ 1/sqrt(lines): aim 10% past the predicted need, at most doubling per round.
+                Some(se) if se > target.stderr => {
+                    let need = done as f64 * (se / target.stderr).powi(2) * 1.1;
+                    round = ((need as u64).saturating_sub(done)).clamp(1, done.max(1));
+                }
+                // Small enough an error on a biased reading: double, since the bias falls faster.
+                _ => round = done.max(1),
+            }
+        } else if let Some(seconds) = options.round_seconds {
+            // Rounds of about `seconds` at the rate so far.
+            let rate = cast_batches as f64 / start.elapsed().as_secs_f64().max(1e-3);
+            round = ((rate * seconds) as u64).max(first_round);
+        } else {
+            // Doubling: few rounds, and a time budget is checked before every batch anyway.
+            round = state.batches_done().max(64);
+        }
+        round = round.min(max_round);
+    };
+    Ok(stop_reason)
+}
+
+/// Up to `count` batches from `cursor` to `end` that are not `done`, and where to look next.
+fn next_batches(done: &BatchSet, mut cursor: u64, end: u64, count: u64) -> (Vec<u64>, u64) {
+    let mut out = Vec::with_capacity(count.min(1 << 16) as usize);
+    while cursor < end && (out.len() as u64) < count {
+        if !done.contains(cursor) {
+            out.push(cursor);
+        }
+        cursor += 1;
+    }
+    (out, cursor)
+}
+
+/// The measures of a run's state: every reading with its standard error and verdict, the radiosity
+/// measures when the scene emits, and the warnings. `seconds` is the run's time, for the report.
+pub fn finish(
+    scene: &Scene,
+    cfg: &AnalysisConfig,
+    state: RunState,
+    stop_reason: StopReason,
+    seconds: f64,
+) -> Result<Analysis, AnalysisError> {
     let materials = if cfg.measures.radiosity {
         Some(PatchMaterials::of_scene(scene)?)
     } else {
         None
     };
     let lit = materials.as_ref().is_some_and(|m| m.any_emission());
-    let wanted = Wanted {
-        discrete: cfg.measures.discrete || lit || cfg.per_patch,
-        continuous: cfg.measures.continuous,
-        per_patch: cfg.per_patch && cfg.measures.continuous,
-    };
-    let (state, stop_reason) = cast(scene, tracer, cfg, wanted, control)?;
+    let wanted = state.wanted();
+    let plan = state.plan();
+    let covered = state.done().clone();
     let run = state.finish(scene);
     let enclose = cfg.enclose && run.groups.iter().any(|t| t.counters.escapes > 0);
     let jackknife = cfg.errors == ErrorMethod::Jackknife
@@ -371,8 +634,10 @@ pub fn analyze(
     Ok(Analysis {
         lines: total.counters.lines,
         seed: cfg.seed,
-        seconds: start.elapsed().as_secs_f64(),
+        seconds,
         stop_reason,
+        plan,
+        covered,
         groups: visibility.groups,
         estimator: cfg.estimator,
         errors: if visibility.jackknifed {
@@ -399,107 +664,6 @@ pub fn analyze(
     })
 }
 
-/// Casts the lines of a run in rounds until its line count, budget or a stop request ends it.
-fn cast(
-    scene: &Scene,
-    tracer: &dyn Tracer,
-    cfg: &AnalysisConfig,
-    wanted: Wanted,
-    control: &RunControl,
-) -> Result<(RunState, StopReason), TraceError> {
-    let start = Instant::now();
-    let open_ended = cfg.budget.is_open_ended();
-    let plan = if open_ended {
-        BatchPlan::open_ended(cfg.lines, cfg.source)
-    } else {
-        BatchPlan::for_source(cfg.lines, cfg.source)
-    };
-    let stream = LineStream {
-        plan,
-        source: cfg.source,
-        seed: cfg.seed,
-    };
-    let deadline = cfg
-        .budget
-        .seconds
-        .map(|s| start + Duration::from_secs_f64(s.max(0.0)));
-    // A short fixed run has fewer batches than groups: one group per batch then.
-    let groups = (cfg.groups.max(2) as u64).min(plan.batches().max(2)) as usize;
-    let mut state = RunState::new(groups, wanted);
-
-    let stop = |b: u64| {
-        let late = deadline.is_some_and(|d| Instant::now() >= d);
-        if control.stop_requested() || late {
-            return true;
-        }
-        control.started(plan.batch_len(b) as u64);
-        false
-    };
-    // Rounds bound the memory held in pair keys and let a budget run check itself; for a fixed run
-    // their sizes depend on the line count only, so the numbers do too.
-    let max_round = (MAX_ROUND_LINES / plan.batch_size).max(1);
-    let mut round = if open_ended {
-        (4 * state.group_count()).max(64)
-    } else {
-        max_round
-    };
-    // Batches traced so far, and the last round's when it is not counted yet: without a precision target
-    // the next round's size does not depend on the counts, so a round is counted while the next one is
-    // traced, which keeps both cores busy through the counting's serial parts.
-    let mut traced_to = 0;
-    let mut pending: Option<TracedBatches> = None;
-    let stop_reason = loop {
-        let batches = traced_to..(traced_to + round).min(plan.batches());
-        let trace = || TracedBatches::trace(scene, tracer, &stream, batches.clone(), wanted, &stop);
-        let (traced, complete) = match pending.take() {
-            Some(previous) => rayon::join(trace, || state.add(scene, previous)).0?,
-            None => trace()?,
-        };
-        traced_to += traced.len() as u64;
-        let ended = if !complete {
-            Some(if control.stop_requested() {
-                StopReason::Interrupted
-            } else {
-                StopReason::Seconds
-            })
-        } else if traced_to >= plan.batches() {
-            Some(StopReason::Lines)
-        } else if deadline.is_some_and(|d| Instant::now() >= d) {
-            Some(StopReason::Seconds)
-        } else {
-            None
-        };
-        if ended.is_some() || cfg.budget.target.is_some() {
-            state.add(scene, traced);
-        } else {
-            pending = Some(traced);
-        }
-        if let Some(reason) = ended {
-            break reason;
-        }
-        if let Some(target) = cfg.budget.target {
-            let done = state.batches_done();
-            let (se, verdict) = current_reading(scene, &state, cfg, wanted, target.measure);
-            let reliable = verdict == Some(Verdict::Ok);
-            match se {
-                Some(se) if se <= target.stderr && reliable => break StopReason::Target,
-                // stderr ~ 1/sqrt(lines): aim 10% past the predicted need, at most doubling per round.
-                Some(se) if se > target.stderr => {
-                    let need = done as f64 * (se / target.stderr).powi(2) * 1.1;
-                    round = ((need as u64).saturating_sub(done)).clamp(1, done.max(1));
-                }
-                // Small enough an error on a biased reading: double, since the bias falls faster.
-                _ => round = done.max(1),
-            }
-        } else {
-            // Doubling: few rounds, and a time budget is checked before every batch anyway.
-            round = traced_to.max(64);
-        }
-        round = round.min(max_round);
-    };
-    Ok((state, stop_reason))
-}
-
 /// The standard error of `measure` and the verdict on its reading, from the run so far. Batch means:
 /// the jackknife needs the total's counts, which a dense run merges only at the end; batch means are
 /// larger where they differ, so a target is never met early.
@@ -507,9 +671,9 @@ fn current_reading(
     scene: &Scene,
     state: &RunState,
     cfg: &AnalysisConfig,
-    wanted: Wanted,
     measure: TargetMeasure,
 ) -> (Option<f64>, Option<Verdict>) {
+    let wanted = state.wanted();
     let run = state.snapshot(scene);
     let enclose = cfg.enclose && run.groups.iter().any(|t| t.counters.escapes > 0);
     let v = visibility_estimates(scene, &run, cfg.estimator, enclose, false, wanted);
@@ -632,7 +796,7 @@ fn jackknife_replicates(
                     &g.escapes_by_patch,
                 )),
                 continuous: ContinuousValues::from_sum(
-                    total.counters.cmi_sum - g.counters.cmi_sum,
+                    total.counters.cmi_sum.minus(g.counters.cmi_sum).value(),
                     total.counters.cmi_pairs - g.counters.cmi_pairs,
                 ),
                 environment_area: None,

@@ -2,8 +2,6 @@
 //! random stream, hand them (traced, when asked) to a visitor, in parallel, and collect the results in
 //! batch order, so that whatever is added up from them does not depend on the thread count.
 
-use std::ops::Range;
-
 use rayon::prelude::*;
 
 use super::plan::BatchPlan;
@@ -51,19 +49,25 @@ pub struct Batch<'a> {
     pub lines: &'a [Line],
 }
 
-/// Results of batches in batch order, and whether every batch asked for ran.
-pub type Mapped<T> = (Vec<T>, bool);
+/// The results of the batches that ran, with their indices, in batch order; and whether every batch
+/// asked for ran.
+pub type Mapped<T> = (Vec<(u64, T)>, bool);
+
+/// Every batch of `stream`, in order.
+pub fn all_batches(stream: &LineStream) -> Vec<u64> {
+    (0..stream.plan.batches()).collect()
+}
 
 /// Draws the lines of `batches` and hands each batch to `visit` with a per-thread scratch `S`, in
 /// parallel; returns the results in batch order.
 ///
-/// `stop(b)` is asked before batch `b` starts; when it says yes the batch is skipped. Only the longest
-/// prefix of finished batches is kept, so what ran is always batches `start..start + k`; the flag says
-/// whether every batch ran.
+/// `stop(b)` is asked before batch `b` starts; when it says yes the batch is skipped. Every batch that
+/// finished is kept (a stop keeps the work done, whichever batches it was); the flag says whether every
+/// batch ran.
 pub fn map_batches<S, T, E>(
     stream: &LineStream,
     radius: f64,
-    batches: Range<u64>,
+    batches: &[u64],
     stop: &(dyn Fn(u64) -> bool + Sync),
     visit: impl Fn(&mut S, Batch<'_>) -> Result<T, E> + Sync + Send,
 ) -> Result<Mapped<T>, E>
@@ -72,8 +76,9 @@ where
     T: Send,
     E: Send,
 {
-    let per_batch: Vec<Option<T>> = batches
-        .into_par_iter()
+    let per_batch: Vec<Option<(u64, T)>> = batches
+        .par_iter()
+        .copied()
         .map_init(
             || (Vec::new(), S::default()),
             |(lines, scratch), b| {
@@ -87,12 +92,12 @@ where
                     first_line: stream.plan.first_line(b),
                     lines,
                 };
-                visit(scratch, batch).map(Some)
+                visit(scratch, batch).map(|t| Some((b, t)))
             },
         )
         .collect::<Result<_, _>>()?;
     let all = per_batch.len();
-    let finished: Vec<T> = per_batch.into_iter().map_while(|b| b).collect();
+    let finished: Vec<(u64, T)> = per_batch.into_iter().flatten().collect();
     let complete = finished.len() == all;
     Ok((finished, complete))
 }
@@ -117,7 +122,7 @@ pub fn map_traced_batches<S, T>(
     stream: &LineStream,
     tracer: &dyn Tracer,
     radius: f64,
-    batches: Range<u64>,
+    batches: &[u64],
     stop: &(dyn Fn(u64) -> bool + Sync),
     visit: impl Fn(&mut S, Batch<'_>, &LineHits) -> T + Sync + Send,
 ) -> Result<Mapped<T>, TraceError>

@@ -15,6 +15,7 @@ pub mod batches;
 pub mod control;
 pub mod errors;
 pub mod patches;
+pub mod persist;
 pub mod plan;
 pub mod radiosity;
 pub mod readings;
@@ -24,17 +25,19 @@ pub mod warnings;
 
 pub use analysis::TargetOutcome;
 pub use analysis::{
-    analyze, Analysis, AnalysisConfig, AnalysisError, Measures, DEFAULT_ESTIMATOR, DEFAULT_GROUPS,
+    analyze, cast, finish, plan_of, remaining_lines, start, Analysis, AnalysisConfig,
+    AnalysisError, CastOptions, Measures, Scope, DEFAULT_ESTIMATOR, DEFAULT_GROUPS,
 };
-pub use batches::{map_batches, map_traced_batches, Batch, LineStream, TraceBuffers};
+pub use batches::{all_batches, map_batches, map_traced_batches, Batch, LineStream, TraceBuffers};
 pub use control::{Budget, RunControl, StopReason, Target, TargetMeasure};
 pub use errors::{ErrorMethod, Spread};
 pub use patches::{PatchEstimate, PatchLight};
-pub use plan::BatchPlan;
+pub use persist::{PersistError, RunIdentity, SavedRun};
+pub use plan::{BatchPlan, BatchSet};
 pub use radiosity::{
     RadiosityEstimates, RadiosityOutcome, RadiosityReliability, SolveFailure, NOTHING_EMITS,
 };
 pub use readings::VisibilityEstimates;
 pub use reliability::{Reliability, SamplingReport, Verdict, VisibilityReliability};
-pub use state::{FinishedRun, RunState, TracedBatches};
+pub use state::{FinishedRun, MergeError, RunState, StateParts, TracedBatches};
 pub use warnings::{RunWarning, RunWarningKind};

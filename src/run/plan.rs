@@ -61,3 +61,154 @@ impl BatchPlan {
         b * self.batch_size
     }
 }
+
+/// A set of batch indices, as sorted disjoint ranges: the batches a run, a shard or a resumed run has
+/// done.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct BatchSet {
+    ranges: Vec<std::ops::Range<u64>>,
+}
+
+impl BatchSet {
+    /// The set `0..n`.
+    pub fn first(n: u64) -> Self {
+        let mut s = BatchSet::default();
+        s.insert_range(0..n);
+        s
+    }
+
+    /// The set of the given ranges (in any order; overlaps are joined).
+    pub fn from_ranges(ranges: impl IntoIterator<Item = std::ops::Range<u64>>) -> Self {
+        let mut s = BatchSet::default();
+        for r in ranges {
+            s.insert_range(r);
+        }
+        s
+    }
+
+    /// The sorted disjoint ranges.
+    pub fn ranges(&self) -> &[std::ops::Range<u64>] {
+        &self.ranges
+    }
+
+    /// Number of batches.
+    pub fn len(&self) -> u64 {
+        self.ranges.iter().map(|r| r.end - r.start).sum()
+    }
+
+    /// Whether the set is empty.
+    pub fn is_empty(&self) -> bool {
+        self.ranges.is_empty()
+    }
+
+    /// Whether batch `b` is in the set.
+    pub fn contains(&self, b: u64) -> bool {
+        let k = self.ranges.partition_point(|r| r.end <= b);
+        self.ranges.get(k).is_some_and(|r| r.start <= b)
+    }
+
+    /// Adds a batch.
+    pub fn insert(&mut self, b: u64) {
+        self.insert_range(b..b + 1);
+    }
+
+    /// Adds a range of batches.
+    pub fn insert_range(&mut self, r: std::ops::Range<u64>) {
+        if r.is_empty() {
+            return;
+        }
+        // The ranges touching or overlapping `r` merge with it.
+        let first = self.ranges.partition_point(|x| x.end < r.start);
+        let last = self.ranges.partition_point(|x| x.start <= r.end);
+        let start = self.ranges[first..last]
+            .iter()
+            .map(|x| x.start)
+            .fold(r.start, u64::min);
+        let end = self.ranges[first..last]
+            .iter()
+            .map(|x| x.end)
+            .fold(r.end, u64::max);
+        self.ranges.splice(first..last, std::iter::once(start..end));
+    }
+
+    /// Removes a batch.
+    pub fn remove(&mut self, b: u64) {
+        let k = self.ranges.partition_point(|r| r.end <= b);
+        let Some(r) = self.ranges.get(k).cloned().filter(|r| r.start <= b) else {
+            return;
+        };
+        let pieces = [r.start..b, b + 1..r.end];
+        self.ranges
+            .splice(k..k + 1, pieces.into_iter().filter(|p| !p.is_empty()));
+    }
+
+    /// Whether the two sets share a batch.
+    pub fn overlaps(&self, other: &BatchSet) -> bool {
+        other
+            .ranges
+            .iter()
+            .any(|r| self.intersection_len(r.clone()) > 0)
+    }
+
+    fn intersection_len(&self, r: std::ops::Range<u64>) -> u64 {
+        self.ranges
+            .iter()
+            .map(|x| x.end.min(r.end).saturating_sub(x.start.max(r.start)))
+            .sum()
+    }
+
+    /// The union with another set.
+    pub fn union(&mut self, other: &BatchSet) {
+        for r in &other.ranges {
+            self.insert_range(r.clone());
+        }
+    }
+
+    /// The batches of `0..n` not in the set.
+    pub fn missing(&self, n: u64) -> BatchSet {
+        let mut out = BatchSet::default();
+        let mut at = 0;
+        for r in &self.ranges {
+            if r.start >= n {
+                break;
+            }
+            out.insert_range(at..r.start);
+            at = r.end;
+        }
+        out.insert_range(at..n);
+        out
+    }
+
+    /// The batch indices of the set within `within`, in order.
+    pub fn indices_within(&self, within: std::ops::Range<u64>) -> Vec<u64> {
+        self.ranges
+            .iter()
+            .flat_map(|r| r.start.max(within.start)..r.end.min(within.end))
+            .collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn batch_sets_join_split_and_complement() {
+        let mut s = BatchSet::from_ranges([5..8, 0..2, 7..10]);
+        assert_eq!(s.ranges(), [0..2, 5..10]);
+        s.insert(2);
+        assert_eq!(s.ranges(), [0..3, 5..10]);
+        assert!(s.contains(6) && !s.contains(4) && !s.contains(10));
+        assert_eq!(s.missing(12).ranges(), [3..5, 10..12]);
+        s.remove(6);
+        assert_eq!(s.ranges(), [0..3, 5..6, 7..10]);
+        assert_eq!(s.len(), 7);
+        assert!(s.overlaps(&BatchSet::from_ranges(std::iter::once(9..20))));
+        assert!(!s.overlaps(&BatchSet::from_ranges([3..5, 6..7])));
+        assert_eq!(s.indices_within(2..8), [2, 5, 7]);
+        let mut u = BatchSet::from_ranges(std::iter::once(3..5));
+        u.union(&BatchSet::from_ranges(std::iter::once(6..7)));
+        u.union(&s);
+        assert_eq!(u.ranges(), std::slice::from_ref(&(0..10)));
+    }
+}

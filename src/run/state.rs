@@ -1,27 +1,28 @@
-//! A run's state as a value: the tallies of its standard-error groups as they fill up, batch by batch.
+//! A run's state as a value: the tallies of its standard-error groups as they fill up, batch by batch,
+//! and which batches are done. It can be saved, merged with the states of other shards of the same run,
+//! and resumed ([`super::persist`]).
 //!
 //! Batch `b` belongs to group `b mod G`. Membership depends on the batch index only, so the groups fill
-//! up evenly however long a run lasts, and a run can stop at any batch (a time budget, a precision
-//! target, Ctrl-C) and still have G comparable groups.
-
-use std::ops::Range;
+//! up evenly however long a run lasts, a run can stop at any batch (a time budget, a precision target,
+//! Ctrl-C) and still have G comparable groups, and the batches can be done in any order, on any
+//! machine: every count is an integer and every sum exact ([`crate::sample::exact`]), so the result is
+//! the same to the last bit.
 
 use rayon::prelude::*;
 
 use super::batches::{map_traced_batches, LineStream};
+use super::plan::{BatchPlan, BatchSet};
 use crate::sample::counts::{count_by_group, PairCounts, DENSE_MAX_PATCHES};
 use crate::sample::tally::{tally_lines, BatchTally, Tally, Wanted};
 use crate::scene::Scene;
 use crate::trace::{TraceError, Tracer};
 
-/// Consecutive batches of a run, traced and paired but not yet counted: the parallel part of a round,
-/// which [`RunState::add`] (the serial rest) may overlap with tracing the next round.
+/// Batches of a run, traced and paired but not yet counted: the parallel part of a round, which
+/// [`RunState::add`] (the serial rest) may overlap with tracing the next round.
 #[derive(Debug)]
 pub struct TracedBatches {
-    /// Index of the first batch.
-    first: u64,
-    /// The batches, consecutive from `first`.
-    batches: Vec<BatchTally>,
+    /// The batches and their indices, in batch order.
+    batches: Vec<(u64, BatchTally)>,
 }
 
 impl TracedBatches {
@@ -31,11 +32,10 @@ impl TracedBatches {
         scene: &Scene,
         tracer: &dyn Tracer,
         stream: &LineStream,
-        batches: Range<u64>,
+        batches: &[u64],
         wanted: Wanted,
         stop: &(dyn Fn(u64) -> bool + Sync),
     ) -> Result<(TracedBatches, bool), TraceError> {
-        let first = batches.start;
         let (batches, complete) = map_traced_batches(
             stream,
             tracer,
@@ -44,7 +44,7 @@ impl TracedBatches {
             stop,
             |_: &mut (), batch, hits| tally_lines(scene, batch.lines, hits, wanted),
         )?;
-        Ok((TracedBatches { first, batches }, complete))
+        Ok((TracedBatches { batches }, complete))
     }
 
     /// Number of batches.
@@ -57,30 +57,19 @@ impl TracedBatches {
         self.batches.is_empty()
     }
 
-    /// Adds the batches up in batch order and counts their pairs.
-    pub fn into_tally(self, scene: &Scene, wanted: Wanted) -> Tally {
-        Tally::from_batches(scene, wanted, self.batches)
-    }
-
     /// Deals the batches into `groups` groups by batch index modulo `groups`, keeping batch order within
     /// each group.
-    fn split_into_groups(self, groups: u64) -> Vec<TracedBatches> {
-        let first = self.first;
-        let mut out: Vec<TracedBatches> = (0..groups)
-            .map(|_| TracedBatches {
-                first,
-                batches: Vec::new(),
-            })
-            .collect();
-        for (k, b) in self.batches.into_iter().enumerate() {
-            out[((first + k as u64) % groups) as usize].batches.push(b);
+    fn split_into_groups(self, groups: u64) -> Vec<Vec<BatchTally>> {
+        let mut out: Vec<Vec<BatchTally>> = (0..groups).map(|_| Vec::new()).collect();
+        for (b, t) in self.batches {
+            out[(b % groups) as usize].push(t);
         }
         out
     }
 
-    /// Deals the batches into `groups` groups by batch index modulo `groups` and tallies each (`None`
-    /// for a group without batches). With sparse counts also returns the counts of all the groups
-    /// together, from the same sort ([`count_by_group`]).
+    /// Deals the batches into `groups` groups and tallies each (`None` for a group without batches).
+    /// With sparse counts also returns the counts of all the groups together, from the same sort
+    /// ([`count_by_group`]).
     fn into_group_tallies(
         self,
         scene: &Scene,
@@ -92,18 +81,14 @@ impl TracedBatches {
             let tallies = self
                 .split_into_groups(groups)
                 .into_par_iter()
-                .map(|piece| (!piece.is_empty()).then(|| piece.into_tally(scene, wanted)))
+                .map(|piece| (!piece.is_empty()).then(|| Tally::from_batches(scene, wanted, piece)))
                 .collect();
             return (tallies, None);
         }
         let keyed: Vec<(usize, &[u64])> = self
             .batches
             .iter()
-            .enumerate()
-            .map(|(k, b)| {
-                let group = (self.first + k as u64) % groups;
-                (group as usize, b.pair_keys.as_slice())
-            })
+            .map(|(b, t)| ((b % groups) as usize, t.pair_keys.as_slice()))
             .collect();
         let counted = count_by_group(patches, groups as usize, &keyed);
         let tallies = self
@@ -112,7 +97,7 @@ impl TracedBatches {
             .zip(counted.groups)
             .map(|(piece, counts)| {
                 (!piece.is_empty()).then(|| {
-                    let (mut tally, _) = Tally::sum_batches(scene, wanted, piece.batches);
+                    let (mut tally, _) = Tally::sum_batches(scene, wanted, piece);
                     tally.counts = Some(PairCounts::Sparse(counts));
                     tally
                 })
@@ -125,12 +110,20 @@ impl TracedBatches {
 /// The groups of a run as they fill up.
 #[derive(Clone, Debug)]
 pub struct RunState {
+    plan: BatchPlan,
     wanted: Wanted,
     groups: Vec<Option<Tally>>,
     /// With sparse counts, those of all the groups together (counted with the groups', so that the
-    /// total needs no merging of the groups at the end).
+    /// total needs no merging of the groups at the end); `None` when not kept (then summed at the end).
     total_counts: Option<PairCounts>,
-    batches_done: u64,
+    /// Whether `total_counts` follows every batch: only a state built batch by batch from empty (a
+    /// loaded or merged one sums its groups at the end instead).
+    keeps_total: bool,
+    /// The batches added, the partial last batch among them.
+    done: BatchSet,
+    /// The tally of the plan's last batch when it is partial (fewer lines than the others), kept apart
+    /// so that a run extended to more lines can trace that batch whole instead ([`RunState::extend`]).
+    tail: Option<(u64, Tally)>,
 }
 
 /// A run's tallies when it ends: all its lines, and each group that has lines.
@@ -142,15 +135,69 @@ pub struct FinishedRun {
     pub groups: Vec<Tally>,
 }
 
+/// Why two states cannot be merged.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum MergeError {
+    /// Different line plans or group counts: not shards of one run.
+    #[error("the states are not parts of one run ({0})")]
+    Mismatch(String),
+    /// A batch done in both.
+    #[error("the states overlap: batches {0} are in both")]
+    Overlap(String),
+}
+
 impl RunState {
-    /// An empty run of `groups` groups gathering `wanted`.
-    pub fn new(groups: usize, wanted: Wanted) -> Self {
+    /// An empty run of `groups` groups gathering `wanted` over the batches of `plan`.
+    pub fn new(plan: BatchPlan, groups: usize, wanted: Wanted) -> Self {
         RunState {
+            plan,
             wanted,
             groups: vec![None; groups],
             total_counts: None,
-            batches_done: 0,
+            keeps_total: true,
+            done: BatchSet::default(),
+            tail: None,
         }
+    }
+
+    /// The parts of a state, for saving ([`super::persist`]).
+    pub fn parts(&self) -> StateParts<'_> {
+        StateParts {
+            plan: self.plan,
+            wanted: self.wanted,
+            groups: &self.groups,
+            done: &self.done,
+            tail: self.tail.as_ref(),
+        }
+    }
+
+    /// A state from its saved parts (the total's counts are summed again when the run finishes).
+    pub fn from_parts(
+        plan: BatchPlan,
+        wanted: Wanted,
+        groups: Vec<Option<Tally>>,
+        done: BatchSet,
+        tail: Option<(u64, Tally)>,
+    ) -> Self {
+        RunState {
+            plan,
+            wanted,
+            groups,
+            total_counts: None,
+            keeps_total: false,
+            done,
+            tail,
+        }
+    }
+
+    /// The plan of the run.
+    pub fn plan(&self) -> BatchPlan {
+        self.plan
+    }
+
+    /// What the run gathers.
+    pub fn wanted(&self) -> Wanted {
+        self.wanted
     }
 
     /// The number of groups.
@@ -158,23 +205,41 @@ impl RunState {
         self.groups.len() as u64
     }
 
-    /// Batches added so far.
-    pub fn batches_done(&self) -> u64 {
-        self.batches_done
+    /// The batches done.
+    pub fn done(&self) -> &BatchSet {
+        &self.done
     }
 
-    /// The groups that have lines so far.
+    /// Batches done so far.
+    pub fn batches_done(&self) -> u64 {
+        self.done.len()
+    }
+
+    /// The groups that have lines so far (the partial last batch's lines not included).
     pub fn filled_groups(&self) -> Vec<&Tally> {
         self.groups.iter().flatten().collect()
     }
 
-    /// Adds traced batches (consecutive from `batches_done`) to their groups, counting the groups in
-    /// parallel.
-    pub fn add(&mut self, scene: &Scene, traced: TracedBatches) {
-        let batches = traced.len() as u64;
+    /// Whether batch `b` is the plan's last and has fewer lines than the others.
+    fn is_partial(&self, b: u64) -> bool {
+        b + 1 == self.plan.batches() && (self.plan.batch_len(b) as u64) < self.plan.batch_size
+    }
+
+    /// Adds traced batches (none of them done before) to their groups, counting the groups in parallel.
+    pub fn add(&mut self, scene: &Scene, mut traced: TracedBatches) {
+        for &(b, _) in &traced.batches {
+            debug_assert!(!self.done.contains(b), "batch {b} added twice");
+            self.done.insert(b);
+        }
+        if let Some(k) = traced.batches.iter().position(|(b, _)| self.is_partial(*b)) {
+            let (b, t) = traced.batches.remove(k);
+            self.tail = Some((b, Tally::from_batches(scene, self.wanted, vec![t])));
+        }
         let (tallies, total_counts) =
             traced.into_group_tallies(scene, self.wanted, self.group_count());
+        let keeps_total = self.keeps_total;
         let merge_total = || match (&mut self.total_counts, total_counts) {
+            _ if !keeps_total => {}
             (Some(t), Some(new)) => t.merge(&new),
             (slot, new) => *slot = slot.take().or(new),
         };
@@ -189,7 +254,58 @@ impl RunState {
                 });
         };
         rayon::join(merge_total, merge_groups);
-        self.batches_done += batches;
+    }
+
+    /// Adds the state of another part of the same run (a shard): the groups' tallies and the batches.
+    pub fn absorb(&mut self, other: RunState) -> Result<(), MergeError> {
+        if other.plan != self.plan || other.groups.len() != self.groups.len() {
+            return Err(MergeError::Mismatch(format!(
+                "{} lines in batches of {} and {} groups, against {} in batches of {} and {}",
+                self.plan.lines,
+                self.plan.batch_size,
+                self.groups.len(),
+                other.plan.lines,
+                other.plan.batch_size,
+                other.groups.len()
+            )));
+        }
+        if other.wanted != self.wanted {
+            return Err(MergeError::Mismatch("different measures".into()));
+        }
+        if self.done.overlaps(&other.done) {
+            let common: Vec<String> = other
+                .done
+                .ranges()
+                .iter()
+                .flat_map(|r| r.clone())
+                .filter(|&b| self.done.contains(b))
+                .take(3)
+                .map(|b| b.to_string())
+                .collect();
+            return Err(MergeError::Overlap(common.join(", ")));
+        }
+        self.done.union(&other.done);
+        self.tail = self.tail.take().or(other.tail);
+        for (slot, theirs) in self.groups.iter_mut().zip(other.groups) {
+            match (slot.as_mut(), theirs) {
+                (Some(t), Some(new)) => t.merge(&new),
+                (None, new) => *slot = new,
+                (Some(_), None) => {}
+            }
+        }
+        self.total_counts = None;
+        self.keeps_total = false;
+        Ok(())
+    }
+
+    /// The state of the same run extended to the longer plan `plan` (resuming to more lines): the
+    /// partial last batch of the old plan, whole in the new one, is dropped to be traced again.
+    pub fn extend(mut self, plan: BatchPlan) -> Self {
+        if let Some((b, _)) = self.tail.take() {
+            self.done.remove(b);
+        }
+        self.plan = plan;
+        self
     }
 
     /// The run so far as if it ended now (a copy: the run goes on).
@@ -198,28 +314,53 @@ impl RunState {
     }
 
     /// The total of every group, and the groups with lines.
-    pub fn finish(self, scene: &Scene) -> FinishedRun {
+    pub fn finish(mut self, scene: &Scene) -> FinishedRun {
+        if let Some((b, t)) = self.tail.take() {
+            let group = (b % self.groups.len() as u64) as usize;
+            let slot = &mut self.groups[group];
+            match slot {
+                Some(g) => g.merge(&t),
+                None => *slot = Some(t.clone()),
+            }
+            if let (Some(total), Some(c)) = (&mut self.total_counts, &t.counts) {
+                total.merge(c);
+            }
+        }
         let groups: Vec<Tally> = self.groups.into_iter().flatten().collect();
-        // The sums merge in a fixed tree; the counts are integers, added in any order: the sparse ones
-        // were counted with the groups', the dense ones are added up here.
+        // The counts are integers and the sums exact: added in any order. The sparse counts were counted
+        // with the groups'; the dense ones, or those of a loaded state, are added up here.
         let sums = groups.iter().map(Tally::without_counts).collect();
         let mut total = merge_tree(sums).unwrap_or_else(|| Tally::empty(scene, self.wanted));
-        total.counts = self.total_counts.or_else(|| dense_total(&groups));
+        total.counts = self.total_counts.or_else(|| counts_total(&groups));
         FinishedRun { total, groups }
     }
 }
 
-/// The sum of the groups' dense counts (`None` without counts).
-fn dense_total(groups: &[Tally]) -> Option<PairCounts> {
+/// A state's parts, as saved.
+#[derive(Clone, Copy, Debug)]
+pub struct StateParts<'a> {
+    /// The plan.
+    pub plan: BatchPlan,
+    /// What it gathers.
+    pub wanted: Wanted,
+    /// The groups' tallies.
+    pub groups: &'a [Option<Tally>],
+    /// The batches done.
+    pub done: &'a BatchSet,
+    /// The partial last batch's tally, kept apart.
+    pub tail: Option<&'a (u64, Tally)>,
+}
+
+/// The sum of the groups' counts (`None` without counts).
+fn counts_total(groups: &[Tally]) -> Option<PairCounts> {
     let mut counts = groups.iter().filter_map(|t| t.counts.as_ref());
     let mut total = counts.next()?.clone();
     counts.for_each(|c| total.merge(c));
     Some(total)
 }
 
-/// Merges tallies pairwise in a balanced binary tree, the two halves in parallel. The tree's shape
-/// depends only on the number of tallies, so the f64 sums are added in the same order whatever the
-/// thread count; every count is merged O(log G) times.
+/// Merges tallies pairwise in a balanced binary tree, the two halves in parallel; every count is merged
+/// O(log G) times.
 fn merge_tree(mut tallies: Vec<Tally>) -> Option<Tally> {
     if tallies.len() <= 1 {
         return tallies.pop();

@@ -3,11 +3,12 @@
 //!
 //! Inside the layer, data flows: [`lines`] draws the lines; [`pairs`] (with `order`) turns a line's
 //! canonical hits into segments; [`kernel`] and [`environment`] give a segment's eq. (27) term;
-//! [`tally`] adds segments up ([`patch_sums`] per patch, when asked); [`counts`] turns pair keys into the
-//! counts N_ij.
+//! [`tally`] adds segments up, with f64 sums kept [`exact`]ly ([`patch_sums`] per patch, when asked);
+//! [`counts`] turns pair keys into the counts N_ij.
 
 pub mod counts;
 pub mod environment;
+pub mod exact;
 pub mod kernel;
 pub mod lines;
 mod order;

@@ -4,9 +4,11 @@
 //! To share it out among the patches, every pair's term is credited to both of its end patches here
 //! (its `log2(cos_x cos_y / d^2)` part; the constant `log2(A_T / pi)` is added by the measure). Gathered
 //! only when asked for ([`super::tally::Wanted::per_patch`]): it costs one `log2` per pair and two
-//! additions into arrays of the patch count, which the hot loop otherwise skips.
+//! additions into arrays of the patch count, which the hot loop otherwise skips. The sums are exact
+//! ([`ExactSum`]), so batches, groups and shards can be added up in any order with the same bits.
 
 use super::counts::split_key;
+use super::exact::ExactSum;
 use super::kernel::kernel_without_pi;
 
 /// For each patch, the sum of `log2(cos_x cos_y / d^2)` over the visible pairs with an end on it (a
@@ -15,7 +17,7 @@ use super::kernel::kernel_without_pi;
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct PatchKernelSums {
     /// Per patch: the sum of the log kernel over its pair ends.
-    pub log2_kernel: Vec<f64>,
+    pub log2_kernel: Vec<ExactSum>,
     /// Per patch: the pair ends that entered `log2_kernel`.
     pub ends: Vec<u64>,
 }
@@ -24,7 +26,7 @@ impl PatchKernelSums {
     /// Empty sums for `patches` patches.
     pub fn new(patches: usize) -> Self {
         PatchKernelSums {
-            log2_kernel: vec![0.0; patches],
+            log2_kernel: vec![ExactSum::default(); patches],
             ends: vec![0; patches],
         }
     }
@@ -43,8 +45,9 @@ impl PatchKernelSums {
                 continue;
             }
             let (i, j) = split_key(key);
+            let term = ExactSum::of(term);
             for p in [i as usize, j as usize] {
-                self.log2_kernel[p] += term;
+                self.log2_kernel[p].add(term);
                 self.ends[p] += 1;
             }
         }
@@ -53,7 +56,7 @@ impl PatchKernelSums {
     /// Adds another set of lines' sums into these.
     pub fn merge(&mut self, other: &PatchKernelSums) {
         for (a, b) in self.log2_kernel.iter_mut().zip(&other.log2_kernel) {
-            *a += b;
+            a.add(*b);
         }
         for (a, b) in self.ends.iter_mut().zip(&other.ends) {
             *a += b;
@@ -83,6 +86,7 @@ mod tests {
         ];
         s.add_pairs(&keys, &terms);
         assert_eq!(s.ends, vec![1, 4, 1]);
-        assert_eq!(s.log2_kernel, vec![-1.0, -1.0 + 2.0 + 0.0 + 0.0, 2.0]);
+        let sums: Vec<f64> = s.log2_kernel.iter().map(|x| x.value()).collect();
+        assert_eq!(sums, vec![-1.0, -1.0 + 2.0 + 0.0 + 0.0, 2.0]);
     }
 }

@@ -7,6 +7,7 @@
 
 use super::counts::{pair_key, PairCounts};
 use super::environment;
+use super::exact::ExactSum;
 use super::kernel::Log2Sum;
 use super::pairs::{segments_counting_overlaps, Segment};
 use super::patch_sums::PatchKernelSums;
@@ -27,7 +28,7 @@ pub struct Wanted {
 
 /// The counters and sums of a set of lines: every number a run adds up but the pair counts and the
 /// escapes per patch.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Counters {
     /// Lines traced.
     pub lines: u64,
@@ -45,19 +46,19 @@ pub struct Counters {
     pub coincident_crossings: u64,
     /// Lines that hit nothing (for `--enclose`: a chord of the environment sphere).
     pub misses: u64,
-    /// Sum over pairs of log2(A_T cos cos / (pi d^2)), eq. (27).
-    pub cmi_sum: f64,
+    /// Sum over pairs of log2(A_T cos cos / (pi d^2)), eq. (27), exact in any order of addition.
+    pub cmi_sum: ExactSum,
     /// Pairs that entered `cmi_sum`.
     pub cmi_pairs: u64,
     /// Over the segments joining a surface, or the sphere itself, to the environment sphere (escapes and
     /// misses): the sum of log2(cos cos / d^2), for eq. (27) with `--enclose` ([`super::environment`]).
-    pub env_log2_sum: f64,
+    pub env_log2_sum: ExactSum,
     /// How many segments entered `env_log2_sum`.
     pub env_pairs: u64,
 }
 
 impl Counters {
-    /// Adds another set of lines' counters into these (the f64 sums in the order of the calls).
+    /// Adds another set of lines' counters into these (in any order: every sum is exact).
     pub fn add(&mut self, other: &Counters) {
         self.lines += other.lines;
         self.hits += other.hits;
@@ -67,9 +68,9 @@ impl Counters {
         self.degenerate_pairs += other.degenerate_pairs;
         self.coincident_crossings += other.coincident_crossings;
         self.misses += other.misses;
-        self.cmi_sum += other.cmi_sum;
+        self.cmi_sum.add(other.cmi_sum);
         self.cmi_pairs += other.cmi_pairs;
-        self.env_log2_sum += other.env_log2_sum;
+        self.env_log2_sum.add(other.env_log2_sum);
         self.env_pairs += other.env_pairs;
     }
 }
@@ -129,8 +130,10 @@ impl Tally {
         if let (Some(a), Some(b)) = (&mut self.counts, &other.counts) {
             a.merge(b);
         }
-        if let (Some(a), Some(b)) = (&mut self.kernel_by_patch, &other.kernel_by_patch) {
-            a.merge(b);
+        // Sums of only some of the lines would be silently wrong: both or none.
+        match (&mut self.kernel_by_patch, &other.kernel_by_patch) {
+            (Some(a), Some(b)) => a.merge(b),
+            _ => self.kernel_by_patch = None,
         }
     }
 
@@ -235,10 +238,12 @@ impl Tally {
 
         // Eq. (27) with A_T' = A_T + A_env: take the scene's log2(A_T / pi) back out of each term.
         let log2_over_pi = |a: f64| (a / std::f64::consts::PI).log2();
-        let raw = c.cmi_sum - c.cmi_pairs as f64 * log2_over_pi(a_scene);
+        let raw = c.cmi_sum.value() - c.cmi_pairs as f64 * log2_over_pi(a_scene);
         t.counters.cmi_pairs = c.cmi_pairs + c.env_pairs;
-        t.counters.cmi_sum =
-            raw + c.env_log2_sum + t.counters.cmi_pairs as f64 * log2_over_pi(a_scene + a_env);
+        t.counters.cmi_sum = ExactSum::of(
+            raw + c.env_log2_sum.value()
+                + t.counters.cmi_pairs as f64 * log2_over_pi(a_scene + a_env),
+        );
         (t, areas)
     }
 }
@@ -319,8 +324,10 @@ pub fn tally_lines(scene: &Scene, lines: &[Line], hits: &LineHits, wanted: Wante
         c.coincident_crossings += overlaps;
     }
     let log2_area_over_pi = (scene.total_area() / std::f64::consts::PI).log2();
-    (c.cmi_sum, c.cmi_pairs) = log2_sum.finish(log2_area_over_pi);
-    (c.env_log2_sum, c.env_pairs) = env_sum.finish(0.0);
+    let (cmi_sum, cmi_pairs) = log2_sum.finish(log2_area_over_pi);
+    let (env_sum, env_pairs) = env_sum.finish(0.0);
+    (c.cmi_sum, c.cmi_pairs) = (ExactSum::of(cmi_sum), cmi_pairs);
+    (c.env_log2_sum, c.env_pairs) = (ExactSum::of(env_sum), env_pairs);
     t.pair_keys = keys;
     t
 }

@@ -115,6 +115,40 @@ impl Scene {
         1.0
     }
 
+    /// A SHA-256 fingerprint of the loaded geometry and materials (hex): the same scene, however it was
+    /// loaded, gives the same fingerprint; any change of a vertex, a face or a material another. Saved
+    /// run states carry it, so that states of different scenes are never merged.
+    pub fn fingerprint(&self) -> String {
+        use sha2::{Digest, Sha256};
+        let mut h = Sha256::new();
+        for p in &self.positions {
+            for c in p {
+                h.update(c.to_bits().to_le_bytes());
+            }
+        }
+        for (t, &patch) in self.triangles.iter().zip(&self.triangle_patch) {
+            for v in t {
+                h.update(v.to_le_bytes());
+            }
+            h.update(patch.to_le_bytes());
+        }
+        for p in &self.patches {
+            for c in p.normal.to_array() {
+                h.update(c.to_bits().to_le_bytes());
+            }
+            h.update(p.offset.to_bits().to_le_bytes());
+            h.update(p.area.to_bits().to_le_bytes());
+            h.update(p.material.to_le_bytes());
+        }
+        for m in &self.materials {
+            h.update((m.name.len() as u64).to_le_bytes());
+            h.update(m.name.as_bytes());
+            h.update(m.emission.to_bits().to_le_bytes());
+            h.update(m.reflectance.to_bits().to_le_bytes());
+        }
+        h.finalize().iter().map(|b| format!("{b:02x}")).collect()
+    }
+
     /// The f64 unit normal of each triangle's patch, indexed by triangle.
     pub fn triangle_normals(&self) -> Vec<Normal> {
         self.triangle_patch

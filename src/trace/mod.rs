@@ -116,6 +116,21 @@ pub enum Query {
     Packet(usize),
 }
 
+impl Query {
+    /// Parses a query as [`Query`]'s `Display` writes it (`single`, `packet4`, `packet8`, `packet16`).
+    pub fn parse(s: &str) -> Result<Query, String> {
+        match s {
+            "single" => Ok(Query::Single),
+            "packet4" => Ok(Query::Packet(4)),
+            "packet8" => Ok(Query::Packet(8)),
+            "packet16" => Ok(Query::Packet(16)),
+            _ => Err(format!(
+                "`{s}`: expected single, packet4, packet8 or packet16"
+            )),
+        }
+    }
+}
+
 impl fmt::Display for Query {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {

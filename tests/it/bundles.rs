@@ -151,8 +151,8 @@ fn results_do_not_depend_on_the_thread_count() {
             "G = {grid}: identical counts"
         );
         assert_eq!(
-            one.tally.counters.cmi_sum.to_bits(),
-            two.tally.counters.cmi_sum.to_bits()
+            one.tally.counters.cmi_sum.value().to_bits(),
+            two.tally.counters.cmi_sum.value().to_bits()
         );
         let bits = |a: &Analysis| {
             let v = &a.visibility;

@@ -33,6 +33,8 @@ mod cli_radiosity;
 mod cli_render;
 #[cfg(feature = "cli")]
 mod cli_reproduce;
+#[cfg(feature = "cli")]
+mod runs;
 
 // The source's structure.
 mod layers;

@@ -291,6 +291,7 @@ fn refine_with(spec: &str, strategy: Strategy, target: usize) -> (Scene, Scene) 
         &scene,
         &|s| make_tracer(Backend::Rust, s, Query::Single),
         &cfg,
+        &RunControl::default(),
         &mut |_| {},
     )
     .unwrap();

@@ -64,7 +64,10 @@ fn assert_all_finite(a: &Analysis, what: &str) {
             }
         }
     }
-    assert!(a.tally.counters.cmi_sum.is_finite(), "{what}: eq. (27) sum");
+    assert!(
+        a.tally.counters.cmi_sum.value().is_finite(),
+        "{what}: eq. (27) sum"
+    );
 }
 
 /// Sum of the pair counts between the patches of `from` and those of `to` (ordered: N_ij for i in

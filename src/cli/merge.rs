@@ -1,0 +1,156 @@
+//! `scx merge`: the saved states of a run's shards (or of any parts of one run) joined into its report,
+//! identical to the report of the whole run cast at once.
+
+use std::path::PathBuf;
+
+use scene_complexity::run::persist;
+use scene_complexity::run::{finish, RunState, SavedRun, StopReason};
+use scene_complexity::trace::{Backend, Query};
+
+use super::analyze::{check_same_scene, persist_failure};
+use super::args::{parse_threads, ReportOutput};
+use super::output::{self, check_all, warn};
+use super::report::Format;
+use super::runner::Runner;
+use super::{report, Exit, Failure};
+
+/// Arguments of `scx merge`.
+#[derive(clap::Args, Debug)]
+pub struct MergeArgs {
+    /// The state files (`scx analyze ... --save`), in any order.
+    #[arg(required = true)]
+    states: Vec<PathBuf>,
+    /// Report even when batches are missing (the report then says which lines it covers); without it a
+    /// missing batch is an error naming the missing lines.
+    #[arg(long)]
+    partial: bool,
+    /// The scene, when it is not where the states say (it must be the same scene: its fingerprint is
+    /// checked).
+    #[arg(long)]
+    scene: Option<String>,
+    /// Also save the merged state to FILE (to continue it with `scx analyze --resume`).
+    #[arg(long, value_name = "FILE")]
+    save: Option<PathBuf>,
+    /// Worker threads for the measures; 0 or absent: all cores.
+    #[arg(long, value_parser = parse_threads, allow_negative_numbers = true)]
+    threads: Option<usize>,
+    /// Output format, as for `scx analyze`.
+    #[arg(long, value_enum, default_value_t = Format::Table)]
+    format: Format,
+    #[command(flatten)]
+    out: ReportOutput,
+}
+
+/// Loads every state, refusing, with the files named, states of different runs and overlapping ones.
+fn merged(args: &MergeArgs) -> Result<(SavedRun, String), Failure> {
+    let mut seconds = 0.0;
+    let mut runs = Vec::new();
+    for path in &args.states {
+        runs.push((
+            path.display().to_string(),
+            persist::load(path).map_err(persist_failure)?,
+        ));
+    }
+    seconds += runs.iter().map(|(_, r)| r.seconds).sum::<f64>();
+    let (first_name, first) = runs.remove(0);
+    let mut state: RunState = first.state;
+    let identity = first.identity;
+    for (name, run) in runs {
+        if let Some((setting, ours, theirs)) = identity.difference(&run.identity, false) {
+            return Err(Failure::bad_input(format!(
+                "{name} and {first_name} are not parts of one run: their {setting} differs ({theirs} \
+                 against {ours})"
+            )));
+        }
+        state
+            .absorb(run.state)
+            .map_err(|e| Failure::bad_input(format!("{name} cannot join {first_name}: {e}")))?;
+    }
+    Ok((
+        SavedRun {
+            identity,
+            state,
+            seconds,
+        },
+        first_name,
+    ))
+}
+
+/// Runs `scx merge`.
+pub fn run(args: &MergeArgs) -> Result<Exit, Failure> {
+    check_all(
+        [args.out.output.as_deref(), args.save.as_deref()]
+            .into_iter()
+            .flatten(),
+    )?;
+    let (
+        SavedRun {
+            identity,
+            state,
+            seconds,
+        },
+        first,
+    ) = merged(args)?;
+    let plan = state.plan();
+    let missing = state.done().missing(plan.batches());
+    if !missing.is_empty() {
+        let lines: Vec<String> = missing
+            .ranges()
+            .iter()
+            .map(|r| {
+                format!(
+                    "{}..{}",
+                    plan.first_line(r.start),
+                    plan.first_line(r.end - 1) + plan.batch_len(r.end - 1) as u64
+                )
+            })
+            .collect();
+        let message = format!(
+            "the states cover {} of the run's {} batches; lines {} are missing{}",
+            state.done().len(),
+            plan.batches(),
+            lines.join(", "),
+            identity
+                .shard
+                .map(|(_, m)| format!(" (the run was cut into {m} shards)"))
+                .unwrap_or_default()
+        );
+        if !args.partial {
+            return Err(Failure::bad_input(format!(
+                "{message}; merge every shard, or add --partial for a report of these lines only"
+            )));
+        }
+        warn(&message);
+    }
+    let spec = args.scene.clone().unwrap_or_else(|| identity.scene.clone());
+    let backend = match identity.tracer.as_str() {
+        "embree" => Backend::Embree,
+        _ => Backend::Rust,
+    };
+    let query = Query::parse(&identity.query).map_err(Failure::bad_input)?;
+    let runner = Runner::with(&spec, backend, query, args.threads)?;
+    check_same_scene(&first, &identity, &runner)?;
+    let cfg = identity
+        .config()
+        .map_err(|e| Failure::bad_input(format!("{first}: {e}")))?;
+    if let Some(path) = &args.save {
+        persist::save(path, &identity, &state, seconds).map_err(persist_failure)?;
+        output::wrote(path);
+    }
+    let analysis = runner
+        .in_pool(None, "", || {
+            finish(&runner.scene, &cfg, state, StopReason::Lines, seconds)
+        })
+        .map_err(Failure::of)?;
+    for w in &analysis.warnings {
+        warn(&w.message);
+    }
+    let info = report::RunInfo {
+        bundle: identity.bundle,
+        shard: None,
+        ..runner.info()
+    };
+    let text = report::render(args.format, &info, &analysis);
+    output::emit(args.out.output.as_deref(), &text)?;
+    Ok(Exit::Ok)
+}

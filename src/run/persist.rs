@@ -1,0 +1,580 @@
+//! Saved run states (`scx analyze --save/--checkpoint`, `scx merge`, `--resume`): everything needed to
+//! report a run or to continue it, in a versioned, checksummed file.
+//!
+//! Layout: the 8 bytes `SCXSTATE`, the format version (u32, little-endian), the payload's length (u64)
+//! and its CRC-32 (u32), then the payload: one CBOR (RFC 8949) document, so that integers are stored as
+//! integers in their shortest form and the file can be read from other languages (Python's `cbor2`).
+//! The payload holds the run's identity ([`RunIdentity`]: scene fingerprint, scx version, seed, line
+//! source, tracer, groups, estimator, ...), its batch plan, the batches done, and each group's tally: its
+//! counters, and its escapes and pair counts as sparse lists whose sorted keys are stored as differences
+//! (mostly one or two bytes each).
+//!
+//! Files are written atomically (a temporary file beside the target, synced, then renamed over it), so a
+//! run killed while saving leaves the previous state intact.
+
+use std::io::Write;
+use std::path::Path;
+
+use serde::{Deserialize, Serialize};
+
+use super::analysis::{AnalysisConfig, Measures};
+use super::control::{Budget, Target, TargetMeasure};
+use super::errors::ErrorMethod;
+use super::plan::{BatchPlan, BatchSet};
+use super::state::RunState;
+use crate::measure::estimators::EntropyEstimator;
+use crate::sample::counts::{pair_key, split_key, PairCounts};
+use crate::sample::lines::LineSource;
+use crate::sample::tally::{Counters, Tally, Wanted};
+use crate::scene::Scene;
+
+/// The format version this scx writes and reads.
+pub const FORMAT_VERSION: u32 = 1;
+
+const MAGIC: &[u8; 8] = b"SCXSTATE";
+const HEADER: usize = 8 + 4 + 8 + 4;
+
+/// What a run is: two states can be merged, or one resumed, only when these agree (the shard and the
+/// line count aside).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RunIdentity {
+    /// The scx version that wrote the state.
+    pub scx_version: String,
+    /// The scene as named on the command line (a file path or a built-in).
+    pub scene: String,
+    /// [`crate::scene::Scene::fingerprint`] of the loaded scene.
+    pub fingerprint: String,
+    /// Its patches.
+    pub patches: u64,
+    /// Seed of the line streams.
+    pub seed: u64,
+    /// Lines per side of a bundle, 0 for independent lines.
+    pub bundle: u32,
+    /// The tracer's name.
+    pub tracer: String,
+    /// The ray query.
+    pub query: String,
+    /// Lines asked for (the plan's; a cap when a budget is set).
+    pub lines: u64,
+    /// Standard-error groups asked for.
+    pub groups: u64,
+    /// Which measures: discrete, continuous, radiosity.
+    pub measures: [bool; 3],
+    /// `--enclose`.
+    pub enclose: bool,
+    /// The estimator of the corrected readings.
+    pub estimator: String,
+    /// The standard-error method.
+    pub errors: String,
+    /// `--seconds`, when given.
+    pub seconds: Option<f64>,
+    /// `--target-stderr` and its measure, when given.
+    pub target: Option<(String, f64)>,
+    /// The shard (index from 1, count), when the run was one.
+    pub shard: Option<(u32, u32)>,
+}
+
+impl RunIdentity {
+    /// The identity of a run of `cfg` on `scene` (named `spec` on the command line) with the tracer
+    /// `tracer` and query `query`, as shard `shard` when it is one.
+    pub fn of(
+        spec: &str,
+        scene: &Scene,
+        cfg: &AnalysisConfig,
+        tracer: &str,
+        query: &str,
+        shard: Option<(u32, u32)>,
+    ) -> Self {
+        RunIdentity {
+            scx_version: env!("CARGO_PKG_VERSION").into(),
+            scene: spec.into(),
+            fingerprint: scene.fingerprint(),
+            patches: scene.patch_count() as u64,
+            seed: cfg.seed,
+            bundle: match cfg.source {
+                LineSource::Independent => 0,
+                LineSource::Bundles { grid } => grid,
+            },
+            tracer: tracer.into(),
+            query: query.into(),
+            lines: cfg.lines,
+            groups: cfg.groups as u64,
+            measures: [
+                cfg.measures.discrete,
+                cfg.measures.continuous,
+                cfg.measures.radiosity,
+            ],
+            enclose: cfg.enclose,
+            estimator: cfg.estimator.name().into(),
+            errors: cfg.errors.name().into(),
+            seconds: cfg.budget.seconds,
+            target: cfg
+                .budget
+                .target
+                .map(|t| (t.measure.name().to_string(), t.stderr)),
+            shard,
+        }
+    }
+
+    /// The configuration of the run (its radiosity solve the default one).
+    pub fn config(&self) -> Result<AnalysisConfig, String> {
+        let target = match &self.target {
+            Some((name, stderr)) => Some(Target {
+                measure: TargetMeasure::from_name(name)
+                    .ok_or_else(|| format!("unknown target measure `{name}`"))?,
+                stderr: *stderr,
+            }),
+            None => None,
+        };
+        Ok(AnalysisConfig {
+            measures: Measures {
+                discrete: self.measures[0],
+                continuous: self.measures[1],
+                radiosity: self.measures[2],
+            },
+            groups: self.groups as usize,
+            estimator: EntropyEstimator::from_name(&self.estimator)
+                .ok_or_else(|| format!("unknown estimator `{}`", self.estimator))?,
+            errors: ErrorMethod::from_name(&self.errors)
+                .ok_or_else(|| format!("unknown error method `{}`", self.errors))?,
+            budget: Budget {
+                seconds: self.seconds,
+                target,
+            },
+            source: LineSource::bundles(self.bundle)?,
+            enclose: self.enclose,
+            ..AnalysisConfig::new(self.lines, self.seed)
+        })
+    }
+
+    /// The first setting in which two runs differ (the shard and, when `lines_may_differ`, the line
+    /// count aside), as `(setting, ours, theirs)`.
+    pub fn difference(
+        &self,
+        other: &RunIdentity,
+        lines_may_differ: bool,
+    ) -> Option<(&'static str, String, String)> {
+        let pairs: [(&'static str, String, String); 16] = [
+            (
+                "scx version",
+                self.scx_version.clone(),
+                other.scx_version.clone(),
+            ),
+            (
+                "scene fingerprint",
+                self.fingerprint.clone(),
+                other.fingerprint.clone(),
+            ),
+            (
+                "patches",
+                self.patches.to_string(),
+                other.patches.to_string(),
+            ),
+            ("seed", self.seed.to_string(), other.seed.to_string()),
+            ("bundle", self.bundle.to_string(), other.bundle.to_string()),
+            ("tracer", self.tracer.clone(), other.tracer.clone()),
+            ("query", self.query.clone(), other.query.clone()),
+            (
+                "lines",
+                self.lines.to_string(),
+                if lines_may_differ {
+                    self.lines.to_string()
+                } else {
+                    other.lines.to_string()
+                },
+            ),
+            ("groups", self.groups.to_string(), other.groups.to_string()),
+            (
+                "measures",
+                format!("{:?}", self.measures),
+                format!("{:?}", other.measures),
+            ),
+            (
+                "enclose",
+                self.enclose.to_string(),
+                other.enclose.to_string(),
+            ),
+            ("estimator", self.estimator.clone(), other.estimator.clone()),
+            ("errors", self.errors.clone(), other.errors.clone()),
+            (
+                "seconds",
+                format!("{:?}", self.seconds),
+                format!("{:?}", other.seconds),
+            ),
+            (
+                "target",
+                format!("{:?}", self.target),
+                format!("{:?}", other.target),
+            ),
+            (
+                "shard count",
+                format!("{:?}", self.shard.map(|s| s.1)),
+                format!("{:?}", other.shard.map(|s| s.1)),
+            ),
+        ];
+        pairs.into_iter().find(|(_, a, b)| a != b)
+    }
+}
+
+/// A saved run: what it is, and how far it got.
+#[derive(Clone, Debug)]
+pub struct SavedRun {
+    /// The run's identity.
+    pub identity: RunIdentity,
+    /// Its state.
+    pub state: RunState,
+    /// Seconds spent on it so far (summed over resumes and, once merged, over shards).
+    pub seconds: f64,
+}
+
+/// Why a state file could not be saved or loaded.
+#[derive(Debug, thiserror::Error)]
+pub enum PersistError {
+    /// The file system refused.
+    #[error("cannot {doing} {path}: {source}")]
+    Io {
+        /// What was being done (`read`, `write`).
+        doing: &'static str,
+        /// The file.
+        path: String,
+        /// The system's reason.
+        source: std::io::Error,
+    },
+    /// The file is not a state file, or is damaged.
+    #[error("{path}: {problem}")]
+    Bad {
+        /// The file.
+        path: String,
+        /// What is wrong with it.
+        problem: String,
+    },
+}
+
+impl PersistError {
+    /// Whether the file's contents are at fault (not the file system).
+    pub fn is_bad_input(&self) -> bool {
+        matches!(self, PersistError::Bad { .. })
+    }
+}
+
+#[derive(Serialize, Deserialize)]
+struct Wire {
+    identity: RunIdentity,
+    plan_lines: u64,
+    batch_size: u64,
+    discrete: bool,
+    continuous: bool,
+    done: Vec<[u64; 2]>,
+    groups: Vec<Option<TallyWire>>,
+    tail: Option<(u64, TallyWire)>,
+    seconds: f64,
+}
+
+#[derive(Serialize, Deserialize)]
+struct TallyWire {
+    counters: Counters,
+    /// Non-zero escapes per patch.
+    escapes: Sparse,
+    /// Pair counts by pair key.
+    counts: Option<Sparse>,
+}
+
+/// Sorted `(key, value)` entries as key differences and values.
+#[derive(Serialize, Deserialize)]
+struct Sparse {
+    key_steps: Vec<u64>,
+    values: Vec<u64>,
+}
+
+impl Sparse {
+    fn of(entries: impl IntoIterator<Item = (u64, u64)>) -> Self {
+        let (mut key_steps, mut values, mut last) = (Vec::new(), Vec::new(), 0u64);
+        for (k, v) in entries {
+            key_steps.push(k - last);
+            values.push(v);
+            last = k;
+        }
+        Sparse { key_steps, values }
+    }
+
+    fn entries(&self) -> Option<Vec<(u64, u64)>> {
+        if self.key_steps.len() != self.values.len() {
+            return None;
+        }
+        let mut key = 0u64;
+        self.key_steps
+            .iter()
+            .zip(&self.values)
+            .map(|(&step, &v)| {
+                key = key.checked_add(step)?;
+                Some((key, v))
+            })
+            .collect()
+    }
+}
+
+fn tally_wire(t: &Tally) -> TallyWire {
+    TallyWire {
+        counters: t.counters,
+        escapes: Sparse::of(
+            t.escapes_by_patch
+                .iter()
+                .enumerate()
+                .filter(|(_, &e)| e > 0)
+                .map(|(i, &e)| (i as u64, e)),
+        ),
+        counts: t.counts.as_ref().map(|c| {
+            let mut entries = Vec::with_capacity(c.distinct_pairs());
+            c.for_each(|i, j, n| entries.push((pair_key(i, j), n)));
+            Sparse::of(entries)
+        }),
+    }
+}
+
+fn tally_of(w: &TallyWire, patches: usize, wanted: Wanted) -> Option<Tally> {
+    let mut escapes_by_patch = if wanted.discrete {
+        vec![0; patches]
+    } else {
+        Vec::new()
+    };
+    for (i, e) in w.escapes.entries()? {
+        *escapes_by_patch.get_mut(usize::try_from(i).ok()?)? = e;
+    }
+    let counts = match (&w.counts, wanted.discrete) {
+        (Some(c), true) => {
+            let entries = c.entries()?;
+            let fits = entries.iter().all(|&(k, _)| {
+                let (i, j) = split_key(k);
+                (j as usize) < patches && i <= j
+            });
+            fits.then(|| PairCounts::from_entries(patches, entries))
+        }
+        (None, false) => None,
+        _ => return None,
+    };
+    Some(Tally {
+        counters: w.counters,
+        escapes_by_patch,
+        counts,
+        kernel_by_patch: None,
+    })
+}
+
+/// The bytes of the state file of a run that took `seconds` so far.
+pub fn encode(identity: &RunIdentity, state: &RunState, seconds: f64) -> Vec<u8> {
+    let parts = state.parts();
+    let wire = Wire {
+        identity: identity.clone(),
+        plan_lines: parts.plan.lines,
+        batch_size: parts.plan.batch_size,
+        discrete: parts.wanted.discrete,
+        continuous: parts.wanted.continuous,
+        done: parts
+            .done
+            .ranges()
+            .iter()
+            .map(|r| [r.start, r.end])
+            .collect(),
+        groups: parts
+            .groups
+            .iter()
+            .map(|g| g.as_ref().map(tally_wire))
+            .collect(),
+        tail: parts.tail.map(|(b, t)| (*b, tally_wire(t))),
+        seconds,
+    };
+    let mut payload = Vec::new();
+    ciborium::into_writer(&wire, &mut payload).expect("writing CBOR to memory");
+    let mut out = Vec::with_capacity(HEADER + payload.len());
+    out.extend_from_slice(MAGIC);
+    out.extend_from_slice(&FORMAT_VERSION.to_le_bytes());
+    out.extend_from_slice(&(payload.len() as u64).to_le_bytes());
+    out.extend_from_slice(&crc32fast::hash(&payload).to_le_bytes());
+    out.extend_from_slice(&payload);
+    out
+}
+
+/// A state from the bytes of a state file called `path` (for messages).
+pub fn decode(path: &str, bytes: &[u8]) -> Result<SavedRun, PersistError> {
+    let bad = |problem: String| PersistError::Bad {
+        path: path.to_string(),
+        problem,
+    };
+    if bytes.len() < HEADER || &bytes[..8] != MAGIC {
+        return Err(bad(
+            "not an scx run state (it does not start with SCXSTATE)".into(),
+        ));
+    }
+    let version = u32::from_le_bytes(bytes[8..12].try_into().expect("4 bytes"));
+    if version != FORMAT_VERSION {
+        return Err(bad(format!(
+            "written in run-state format {version}; this scx reads format {FORMAT_VERSION}"
+        )));
+    }
+    let length = u64::from_le_bytes(bytes[12..20].try_into().expect("8 bytes"));
+    let crc = u32::from_le_bytes(bytes[20..24].try_into().expect("4 bytes"));
+    let payload = &bytes[HEADER..];
+    if payload.len() as u64 != length {
+        return Err(bad(format!(
+            "truncated or extended: the header announces {length} bytes of state, the file holds {}",
+            payload.len()
+        )));
+    }
+    if crc32fast::hash(payload) != crc {
+        return Err(bad(
+            "corrupted: its checksum does not match its contents (a damaged or edited file)".into(),
+        ));
+    }
+    let wire: Wire = ciborium::from_reader(payload)
+        .map_err(|e| bad(format!("cannot be read as a run state ({e})")))?;
+    state_of(wire).ok_or_else(|| bad("inconsistent contents".into()))
+}
+
+fn state_of(w: Wire) -> Option<SavedRun> {
+    let plan = BatchPlan {
+        lines: w.plan_lines,
+        batch_size: w.batch_size,
+    };
+    if plan.batch_size == 0 || w.groups.is_empty() {
+        return None;
+    }
+    // The per-patch sums of eq. (27) are not kept in a run state: a resumed run has none.
+    let wanted = Wanted {
+        discrete: w.discrete,
+        continuous: w.continuous,
+        per_patch: false,
+    };
+    let patches = usize::try_from(w.identity.patches).ok()?;
+    let groups = w
+        .groups
+        .iter()
+        .map(|g| match g {
+            Some(t) => tally_of(t, patches, wanted).map(Some),
+            None => Some(None),
+        })
+        .collect::<Option<Vec<_>>>()?;
+    let done = BatchSet::from_ranges(
+        w.done
+            .iter()
+            .filter(|r| r[0] < r[1] && r[1] <= plan.batches())
+            .map(|r| r[0]..r[1]),
+    );
+    if done.len()
+        != w.done
+            .iter()
+            .map(|r| r[1].saturating_sub(r[0]))
+            .sum::<u64>()
+    {
+        return None;
+    }
+    let tail = match &w.tail {
+        Some((b, t)) => Some((*b, tally_of(t, patches, wanted)?)),
+        None => None,
+    };
+    Some(SavedRun {
+        identity: w.identity,
+        state: RunState::from_parts(plan, wanted, groups, done, tail),
+        seconds: w.seconds,
+    })
+}
+
+/// Writes the state file of a run that took `seconds` so far, atomically: a temporary file beside
+/// `path`, synced, renamed over it.
+pub fn save(
+    path: &Path,
+    identity: &RunIdentity,
+    state: &RunState,
+    seconds: f64,
+) -> Result<(), PersistError> {
+    let io = |source| PersistError::Io {
+        doing: "write",
+        path: path.display().to_string(),
+        source,
+    };
+    let bytes = encode(identity, state, seconds);
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+        _ => std::path::PathBuf::from("."),
+    };
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "state".into());
+    let temporary = dir.join(format!(".{name}.{}.tmp", std::process::id()));
+    let mut file = std::fs::File::create(&temporary).map_err(io)?;
+    file.write_all(&bytes).map_err(io)?;
+    file.sync_all().map_err(io)?;
+    drop(file);
+    std::fs::rename(&temporary, path).map_err(io)?;
+    // The rename itself is durable once the folder is synced (where the system allows it).
+    if let Ok(d) = std::fs::File::open(&dir) {
+        let _ = d.sync_all();
+    }
+    Ok(())
+}
+
+/// Reads a state file.
+pub fn load(path: &Path) -> Result<SavedRun, PersistError> {
+    let shown = path.display().to_string();
+    let bytes = std::fs::read(path).map_err(|source| PersistError::Io {
+        doing: "read",
+        path: shown.clone(),
+        source,
+    })?;
+    decode(&shown, &bytes)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::run::analysis::{cast, start, CastOptions};
+    use crate::run::control::RunControl;
+    use crate::trace::{make_tracer, Backend, Query};
+
+    /// A state saved and read back reports the same numbers, bit for bit; a truncated file, a flipped
+    /// byte and a stranger are refused with a sentence.
+    #[test]
+    fn states_round_trip_and_damage_is_caught() {
+        for spec in ["@cube:2", "@cubes512"] {
+            let scene = crate::scenes::load(spec).unwrap();
+            let tracer = make_tracer(Backend::Rust, &scene, Query::Single).unwrap();
+            let cfg = AnalysisConfig::new(20_000, 3);
+            let mut state = start(&scene, &cfg).unwrap();
+            cast(
+                &scene,
+                tracer.as_ref(),
+                &cfg,
+                &mut state,
+                CastOptions::default(),
+                &RunControl::default(),
+                &mut |_| {},
+            )
+            .unwrap();
+            let identity = RunIdentity::of(spec, &scene, &cfg, "rust", "single", None);
+            let bytes = encode(&identity, &state, 1.5);
+            let back = decode("s.scx", &bytes).unwrap();
+            assert_eq!(back.identity, identity);
+            assert_eq!(back.seconds, 1.5);
+            let (a, b) = (state.finish(&scene), back.state.finish(&scene));
+            assert_eq!(a.total.counters, b.total.counters, "{spec}");
+            assert_eq!(a.total.escapes_by_patch, b.total.escapes_by_patch);
+            let entries = |t: &Tally| {
+                let mut v = Vec::new();
+                t.counts
+                    .as_ref()
+                    .unwrap()
+                    .for_each(|i, j, c| v.push((i, j, c)));
+                v
+            };
+            assert_eq!(entries(&a.total), entries(&b.total), "{spec}");
+            assert_eq!(a.groups.len(), b.groups.len());
+
+            let message = |bytes: &[u8]| decode("s.scx", bytes).unwrap_err().to_string();
+            assert!(message(&bytes[..bytes.len() - 7]).contains("truncated"));
+            let mut flipped = bytes.clone();
+            flipped[bytes.len() / 2] ^= 0x10;
+            assert!(message(&flipped).contains("checksum"));
+            assert!(message(b"v 0 0 0\nf 1 2 3\n").contains("not an scx run state"));
+        }
+    }
+}
