@@ -300,3 +300,48 @@ fn per_patch_files_are_checked_before_work() {
     let out = scx(&["analyze", "@cube:2", "--patches", "/no/such/folder/p.csv"]);
     assert_eq!(out.status.code(), Some(3));
 }
+
+/// A resumed run keeps no per-patch sums of eq. (27): it says so, and leaves those columns empty
+/// rather than filling them from part of the lines.
+#[test]
+fn a_resumed_run_leaves_the_continuous_columns_empty_and_says_so() {
+    let dir = tempfile::tempdir().unwrap();
+    let (state, csv) = (dir.path().join("run.state"), dir.path().join("p.csv"));
+    let out = scx(&[
+        "analyze",
+        "@cube:2",
+        "--lines",
+        "3e5",
+        "-q",
+        "--save",
+        state.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let out = scx(&[
+        "analyze",
+        "--resume",
+        state.to_str().unwrap(),
+        "--lines",
+        "4e5",
+        "--patches",
+        csv.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(String::from_utf8_lossy(&out.stderr).contains("stay empty"));
+    let (header, rows) = read_csv(&csv);
+    let col = |name: &str| header.iter().position(|h| h == name).unwrap();
+    assert_eq!(rows.len(), 24);
+    for r in &rows {
+        assert!(r[col("continuous_mutual_information_term")].is_empty());
+        assert!(r[col("lost_information")].is_empty());
+        assert!(!r[col("mutual_information_term")].is_empty());
+    }
+}

@@ -154,3 +154,26 @@ fn refines_information_scores_are_the_tables_lost_information() {
         assert!(delta[0].abs() < 0.01, "{spec}: delta {}", delta[0]);
     }
 }
+
+/// The per-patch results are bit-identical whatever the thread count (every sum is exact or added in
+/// batch order).
+#[test]
+fn per_patch_results_do_not_depend_on_the_threads() {
+    let scene = scenes::load("@cube:30").unwrap();
+    let tracer = make_tracer(Backend::Rust, &scene, Query::Single).unwrap();
+    let cfg = AnalysisConfig {
+        per_patch: true,
+        ..AnalysisConfig::new(60_000, 3)
+    };
+    let run = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| analyze(&scene, tracer.as_ref(), &cfg, &RunControl::default()))
+            .unwrap()
+            .patches
+            .unwrap()
+    };
+    assert_eq!(run(1), run(2));
+}
