@@ -99,7 +99,9 @@ enum Command {
         "Examples:\n",
         "  scx render @fig2:a --color lost-information --per-area --lines 1e7 -o fig2a.png\n",
         "  scx render @cornell --color radiosity -o cornell.png --patches-mesh cornell.ply\n",
-        "  scx render @cube:10 --color row-entropy --camera 0.5,0.5,0.02,0.5,0.5,1,0,1,0,70 -o cube.png"
+        "  scx render @cube:10 --color row-entropy --camera 0.5,0.5,0.02,0.5,0.5,1,0,1,0,70 -o cube.png\n\n",
+        "Exit codes: 0 success, 1 the tracer failed, 2 bad input, 3 a file could not be written, \
+         130 interrupted."
     ))]
     Render(render::RenderArgs),
     /// Trace the same lines with Embree and the pure-Rust tracer, compare them hit for hit and measure
