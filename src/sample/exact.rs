@@ -2,7 +2,7 @@
 //! any number of threads, in rounds, in shards on other machines, or after a resume, and the result is
 //! that of one sequential run to the last bit.
 //!
-//! Each value is turned into a fixed-point integer with 2^-[`FRACTION_BITS`] resolution, exactly for
+//! Each value is turned into a fixed-point integer with 2^-`FRACTION_BITS` resolution, exactly for
 //! every value whose last mantissa bit is at least that (any |x| >= 2^-8: the batch sums of eq. (27)'s
 //! terms, thousands of bits each, always are), and integers add associatively. An i128 holds sums up
 //! to 2^67, far beyond 10^12 lines of eq. (27) terms.
