@@ -32,8 +32,9 @@
 //! * [`sample`]: global lines, pairing of hits into mutually visible points, tallies and pair counts;
 //! * [`measure`]: the paper's measures from counts and sums (sec. 3 and 4);
 //! * [`run`]: the run engine (batches, rounds, groups and standard errors, budgets) and [`analyze`];
-//! * the applications: [`reproduce`] (the paper's tables), [`mod@refine`] (meshing strategies) and
-//!   [`mod@crosscheck`] (the two tracers, hit for hit).
+//! * the applications: [`reproduce`] (the paper's tables), [`mod@refine`] (meshing strategies),
+//!   [`render`] (pictures of the per-patch results) and [`mod@crosscheck`] (the two tracers, hit for
+//!   hit).
 
 #![deny(missing_docs)]
 #![deny(unsafe_code)]
@@ -43,6 +44,7 @@ pub mod crosscheck;
 pub mod geom;
 pub mod measure;
 pub mod refine;
+pub mod render;
 pub mod reproduce;
 pub mod run;
 pub mod sample;

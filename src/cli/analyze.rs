@@ -16,7 +16,7 @@ use super::args::{parse_count, parse_positive, parse_target_measure, ReportOutpu
 use super::output::{self, warn};
 use super::report::{self, Format};
 use super::runner::Runner;
-use super::{Exit, Failure};
+use super::{patches, Exit, Failure};
 
 /// Arguments of `scx analyze`.
 #[derive(clap::Args, Debug)]
@@ -86,6 +86,23 @@ pub struct AnalyzeArgs {
         "target_stderr", "target_measure", "bundle", "enclose", "shard", "planarity",
         "strict_planarity", "flip_normals", "two_sided"])]
     resume: Option<PathBuf>,
+    #[command(flatten)]
+    files: PatchFiles,
+}
+
+/// The per-patch files of `scx analyze`.
+#[derive(clap::Args, Debug)]
+struct PatchFiles {
+    /// Also write one row per patch to FILE (.csv): id (the order `scx export` writes faces), material,
+    /// area, centroid and normal in the scene's units, segments N_i, row entropy, its terms of I_s and
+    /// I_s^c, the information it loses, radiosity when lit, each with its standard error. Repeat to
+    /// write several files.
+    #[arg(long, value_name = "FILE")]
+    patches: Vec<PathBuf>,
+    /// Also write the sparse form-factor matrix to FILE: `.csv` (i, j, n_ij, n_i, f_ij, f_ij_stderr) or
+    /// `.mtx` (Matrix Market, for scipy.io.mmread). Repeat to write both.
+    #[arg(long, value_name = "FILE")]
+    form_factors: Vec<PathBuf>,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -110,6 +127,37 @@ fn parse_shard(s: &str) -> Result<(u32, u32), String> {
         return Err(format!("`{s}`: need 1 <= K <= M"));
     }
     Ok((k, m))
+}
+
+/// Checks the per-patch files before any work: their kinds, that they can be written, and that the run
+/// will have what they need.
+fn check_patch_files(args: &AnalyzeArgs) -> Result<(), Failure> {
+    let f = &args.files;
+    if f.patches.is_empty() && f.form_factors.is_empty() {
+        return Ok(());
+    }
+    patches::check_patch_files(&f.patches)?;
+    patches::check_matrix_files(&f.form_factors)?;
+    if args.enclose {
+        return Err(Failure::bad_input(
+            "--patches and --form-factors describe the scene's own patches; they do not take --enclose",
+        ));
+    }
+    if !f.form_factors.is_empty()
+        && args.measures.as_ref().is_some_and(|m| {
+            !m.contains(&MeasureArg::Discrete) && !m.contains(&MeasureArg::Radiosity)
+        })
+    {
+        return Err(Failure::bad_input(
+            "--form-factors needs the pair counts: add `discrete` to --measures",
+        ));
+    }
+    output::check_all(
+        f.patches
+            .iter()
+            .chain(&f.form_factors)
+            .map(PathBuf::as_path),
+    )
 }
 
 fn parse_bundle(s: &str) -> Result<u32, String> {
@@ -147,6 +195,7 @@ fn config_of(args: &AnalyzeArgs, runner: &Runner) -> Result<AnalysisConfig, Fail
         budget,
         source: LineSource::bundles(args.bundle).map_err(Failure::bad_input)?,
         enclose: args.enclose,
+        per_patch: !args.files.patches.is_empty(),
         ..runner.config(&args.run, lines, args.run.seed)
     })
 }
@@ -315,6 +364,7 @@ pub fn run(args: &AnalyzeArgs) -> Result<Exit, Failure> {
             .into_iter()
             .flatten(),
     )?;
+    check_patch_files(args)?;
     let Prepared {
         runner,
         cfg,
@@ -324,6 +374,16 @@ pub fn run(args: &AnalyzeArgs) -> Result<Exit, Failure> {
     } = match &args.resume {
         Some(file) => resumed_run(args, file)?,
         None => new_run(args, args.scene.as_deref().unwrap_or("-"))?,
+    };
+    if args.resume.is_some() && !args.files.patches.is_empty() {
+        warn(
+            "a run state keeps no per-patch sums of eq. (27): the I_s^c and lost-information columns \
+             of --patches stay empty for a resumed run",
+        );
+    }
+    let cfg = AnalysisConfig {
+        per_patch: !args.files.patches.is_empty(),
+        ..cfg
     };
     let scope = match identity.shard {
         Some((index, count)) => Scope::Shard { index, count },
@@ -375,6 +435,10 @@ pub fn run(args: &AnalyzeArgs) -> Result<Exit, Failure> {
         shard: identity.shard,
         ..runner.info()
     };
+    runner.pool.install(|| {
+        patches::write_patches(&args.files.patches, &runner.scene, &analysis)?;
+        patches::write_form_factors(&args.files.form_factors, &runner.scene, &analysis)
+    })?;
     let text = report::render(args.format, &run, &analysis);
     output::emit(args.out.output.as_deref(), &text)?;
     Ok(if analysis.stop_reason == StopReason::Interrupted {

@@ -9,9 +9,11 @@ mod export;
 mod input;
 mod merge;
 mod output;
+mod patches;
 mod plot;
 mod progress;
 mod refine;
+mod render;
 mod report;
 mod reproduce;
 mod runner;
@@ -66,6 +68,7 @@ enum Command {
         "  scx analyze @cube:10 --lines 1e7\n",
         "  scx analyze room.obj --format json -o room.json\n",
         "  scx analyze @cube:30 --target-stderr 0.002 --lines 1e9\n",
+        "  scx analyze @fig2:a --lines 1e7 --patches patches.csv --form-factors ff.mtx\n",
         "  cat room.obj | scx analyze - --lines 1e6\n\n",
         "Exit codes: 0 success, 1 the tracer failed, 2 bad input, 3 a file could not be written, \
          130 interrupted (the report covers the lines gathered)."
@@ -89,6 +92,18 @@ enum Command {
         "  scx refine @cornell --strategy information --patches 460 -o cornell_460.obj"
     ))]
     Refine(refine::RefineArgs),
+    /// Draw the scene with each patch coloured by a per-patch result of a run (row entropy, lost
+    /// information, segments, radiosity, ...), with a labelled colour bar (PNG); optionally the coloured
+    /// mesh (PLY).
+    #[command(after_help = concat!(
+        "Examples:\n",
+        "  scx render @fig2:a --color lost-information --per-area --lines 1e7 -o fig2a.png\n",
+        "  scx render @cornell --color radiosity -o cornell.png --patches-mesh cornell.ply\n",
+        "  scx render @cube:10 --color row-entropy --camera 0.5,0.5,0.02,0.5,0.5,1,0,1,0,70 -o cube.png\n\n",
+        "Exit codes: 0 success, 1 the tracer failed, 2 bad input, 3 a file could not be written, \
+         130 interrupted."
+    ))]
+    Render(render::RenderArgs),
     /// Trace the same lines with Embree and the pure-Rust tracer, compare them hit for hit and measure
     /// for measure; exit 1 when a line differs beyond the tolerance.
     #[command(after_help = "Example:\n  scx crosscheck @cubes512 --lines 1e6")]
@@ -182,6 +197,7 @@ pub fn main() -> ExitCode {
         Command::Export(args) => export::run(&args),
         Command::Convergence(args) => convergence::run(&args),
         Command::Refine(args) => refine::run(&args),
+        Command::Render(args) => render::run(&args),
         Command::Crosscheck(args) => crosscheck::run(&args),
         Command::Reproduce(args) => reproduce::run(&args),
         Command::Merge(args) => merge::run(&args),

@@ -62,7 +62,7 @@ fn extension(path: &Path) -> String {
         .to_ascii_lowercase()
 }
 
-fn font_path() -> Result<String, String> {
+pub(super) fn font_path() -> Result<String, String> {
     std::env::var("SCX_FONT")
         .into_iter()
         .chain(FONT_PATHS.iter().map(|s| s.to_string()))
@@ -75,7 +75,7 @@ fn font_path() -> Result<String, String> {
 }
 
 /// Loads a TrueType font for the labels (plotters draws text with it, SVG and PNG alike).
-fn register_font() -> Result<(), String> {
+pub(super) fn register_font() -> Result<(), String> {
     let path = font_path()?;
     let bytes = std::fs::read(&path).map_err(|e| format!("{path}: {e}"))?;
     // plotters keeps fonts for the life of the process.

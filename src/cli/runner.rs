@@ -14,7 +14,7 @@ use super::{progress, report, Exit, Failure};
 pub struct Runner {
     pub scene: Scene,
     pub tracer: Box<dyn Tracer>,
-    pool: rayon::ThreadPool,
+    pub pool: rayon::ThreadPool,
     pub threads: usize,
     query: Query,
     pub control: Arc<RunControl>,

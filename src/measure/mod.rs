@@ -1,12 +1,15 @@
 //! The paper's measures, computed from counts and sums (sections 3.1, 3.2, 3.3, and 4 for radiosity).
 //!
 //! Logarithms are base 2 (bits). `0 log 0 = 0` everywhere ([`entropy::xlog2x`]).
+//!
+//! [`patches`] shares the visibility measures out among the patches (where the complexity is).
 
 pub mod bias;
 pub mod channel;
 pub mod entropy;
 pub mod estimate;
 pub mod estimators;
+pub mod patches;
 pub mod radiosity;
 pub mod rows;
 pub mod sampling;

@@ -12,7 +12,7 @@
 //! * [`Strategy::Smoothness`]: largest variation of received radiosity over the patch (a linear trend
 //!   fitted to the radiosity arriving along the lines, [`oracle::smoothness`]).
 //! * [`Strategy::Information`]: largest share of the information transfer lost by the discretisation
-//!   ([`oracle::information`]).
+//!   ([`crate::measure::patches::information_loss`], the per-patch module's score).
 
 pub mod mesh;
 pub mod oracle;
@@ -20,6 +20,7 @@ pub mod oracle;
 use std::fmt;
 use std::time::Instant;
 
+use crate::measure::patches;
 use crate::measure::radiosity::{self, FormFactors, MaterialError, PatchMaterials, SolveOptions};
 use crate::run::{RunControl, SolveFailure};
 use crate::scene::{Scene, SceneError};
@@ -246,7 +247,9 @@ fn measure_round(
             let m = oracle::arrivals(scene, tracer, cfg.lines_per_round, seed, &s.radiosity)?;
             oracle::smoothness(&a, &m)
         }
-        (Strategy::Information, s) => oracle::information(&a, &sample, s.as_ref()),
+        (Strategy::Information, s) => {
+            patches::information_loss(&a, &sample, s.as_ref().map(|s| s.radiosity.as_slice()))
+        }
         _ => a.clone(),
     };
     Ok((scores, mi))

@@ -1,10 +1,11 @@
 //! What a refinement round measures: pair counts with the sum of `log2 F(x, y)` per patch pair, and the
-//! per-patch scores of the strategies.
+//! per-patch scores of the strategies (the `information` score is the per-patch module's,
+//! [`crate::measure::patches::information_loss`]).
 
 use rayon::prelude::*;
 
 use crate::geom::{orthonormal_basis, Direction};
-use crate::measure::channel::row_totals;
+use crate::measure::patches::PairKernelSums;
 use crate::measure::radiosity::{FormFactors, Solution};
 use crate::run::{all_batches, map_traced_batches, LineStream};
 use crate::sample::counts::{pair_key, PairCounts};
@@ -12,20 +13,6 @@ use crate::sample::kernel::kernel_without_pi;
 use crate::sample::pairs::{segments, LineF64, Segment};
 use crate::scene::Scene;
 use crate::trace::{TraceError, Tracer};
-
-/// What one round's lines found, per unordered patch pair.
-#[derive(Clone, Debug)]
-pub struct PairSample {
-    /// Pair counts `N_ij` (sparse, sorted by pair key).
-    pub counts: PairCounts,
-    /// Per entry of `counts` (in pair-key order, the order of [`PairCounts::for_each`]): the sum of `log2 F(x, y)` over its pairs of points, with
-    /// `F(x, y) = cos_x cos_y / (pi d^2)` in tracing space (the point-to-point form factor of eq. (25)).
-    pub log_kernel_sums: Vec<f64>,
-    /// Per entry: how many pairs entered the sum (pairs of coincident points are left out).
-    pub log_kernel_pairs: Vec<u64>,
-    /// Escapes per patch.
-    pub escapes: Vec<u64>,
-}
 
 /// Traces `lines` global lines in batches (in parallel) and hands every segment, with its line, to
 /// `visit`, which fills one `T` per batch; the results come back in batch order, so whatever is merged
@@ -56,13 +43,14 @@ fn trace_segments<T: Default + Send>(
     Ok(per_batch.into_iter().map(|(_, t)| t).collect())
 }
 
-/// Casts `lines` global lines and gathers a [`PairSample`].
+/// Casts `lines` global lines and gathers, per unordered patch pair, its count and the sum of
+/// `log2 F(x, y)` over its pairs of points, in tracing space ([`PairKernelSums`]).
 pub fn sample_pairs(
     scene: &Scene,
     tracer: &dyn Tracer,
     lines: u64,
     seed: u64,
-) -> Result<PairSample, TraceError> {
+) -> Result<PairKernelSums, TraceError> {
     let log2_pi = std::f64::consts::PI.log2();
     let per_batch = trace_segments(
         scene,
@@ -111,7 +99,7 @@ pub fn sample_pairs(
             used[last] += 1;
         }
     }
-    Ok(PairSample {
+    Ok(PairKernelSums {
         counts: PairCounts::Sparse(list),
         log_kernel_sums: sums,
         log_kernel_pairs: used,
@@ -245,45 +233,7 @@ pub fn smoothness(areas: &[f64], moments: &[ArrivalMoments]) -> Vec<f64> {
         .collect()
 }
 
-/// Information: each patch's share of the information transfer the discretisation loses.
-///
-/// For the transformed scene of sec. 4 with the patch radiosities held constant over each patch, the
-/// loss `𝓘^c - 𝓘_s` (eq. (25) against eq. (35)) is a sum over ordered patch pairs of
-///
-/// ```text
-///   (B_i B_j / 𝒜_T) [ ∫_i ∫_j F(x,y) log F(x,y) dx dy  -  A_i F_ij log(F_ij / A_j) ],
-/// ```
-///
-/// the radiosity-weighted visibility loss of the pair; each bracket is >= 0 (log-sum inequality; 0 when
-/// F(x, y) is constant over the pair). Patch i's score is its row of the sum (𝒜_T dropped: a common
-/// factor). The integral is `A_i F_ij` times the mean of `log2 F(x, y)` over the sampled pairs of
-/// points between i and j. Without light, `B = 1` gives the visibility loss `I_s^c - I_s` (sec. 3.3).
-pub fn information(areas: &[f64], sample: &PairSample, radiosity: Option<&Solution>) -> Vec<f64> {
-    let n = areas.len();
-    let totals = row_totals(n, &sample.counts, &sample.escapes);
-    let b = |i: usize| radiosity.map_or(1.0, |s| s.radiosity[i]);
-    let mut score = vec![0.0; n];
-    // Both layouts visit their entries in pair-key order, the order of the sums.
-    let mut k = 0;
-    sample.counts.for_each(|i, j, count| {
-        let entry = k;
-        k += 1;
-        let (i, j) = (i as usize, j as usize);
-        let used = sample.log_kernel_pairs[entry];
-        if i == j || used == 0 {
-            return; // A planar patch cannot see itself; no usable pair of points.
-        }
-        let mean_log = sample.log_kernel_sums[entry] / used as f64;
-        let weight = b(i) * b(j);
-        for (p, q) in [(i, j), (j, i)] {
-            let f = count as f64 / totals[p];
-            score[p] += weight * areas[p] * f * (mean_log - (f / areas[q]).log2());
-        }
-    });
-    score
-}
-
 /// The form factors of a sample.
-pub fn form_factors(scene: &Scene, sample: &PairSample) -> FormFactors {
+pub fn form_factors(scene: &Scene, sample: &PairKernelSums) -> FormFactors {
     FormFactors::from_counts(scene.patch_count(), &sample.counts, &sample.escapes)
 }

@@ -15,6 +15,7 @@ use rayon::prelude::*;
 use super::batches::LineStream;
 use super::control::{Budget, RunControl, StopReason, TargetMeasure};
 use super::errors::{ErrorMethod, Spread};
+use super::patches::{self as per_patch, PatchEstimate, PatchLight};
 use super::plan::{BatchPlan, BatchSet, MAX_ROUND_LINES};
 use super::radiosity::{self, RadiosityOutcome, SolveFailure};
 use super::readings::VisibilityEstimates;
@@ -96,6 +97,9 @@ pub struct AnalysisConfig {
     pub enclose: bool,
     /// How the radiosity system is solved.
     pub solve: SolveOptions,
+    /// Also share the measures out among the patches ([`Analysis::patches`]); gathers eq. (27)'s terms
+    /// per patch, which costs nothing when left off. Not with `enclose` on an open scene.
+    pub per_patch: bool,
 }
 
 impl AnalysisConfig {
@@ -112,6 +116,7 @@ impl AnalysisConfig {
             source: LineSource::Independent,
             enclose: false,
             solve: SolveOptions::default(),
+            per_patch: false,
         }
     }
 }
@@ -192,6 +197,9 @@ pub struct Analysis {
     pub orientation: Vec<ObjectSides>,
     /// The full-run counts, for form factors (when counted).
     pub tally: Tally,
+    /// Each patch's results, with standard errors, when [`AnalysisConfig::per_patch`] asked for them
+    /// (`None` as well for an enclosed open scene).
+    pub patches: Option<Vec<PatchEstimate>>,
 }
 
 impl Analysis {
@@ -358,8 +366,9 @@ fn gathered(scene: &Scene, cfg: &AnalysisConfig) -> Result<Wanted, AnalysisError
         false
     };
     Ok(Wanted {
-        discrete: cfg.measures.discrete || lit,
+        discrete: cfg.measures.discrete || lit || cfg.per_patch,
         continuous: cfg.measures.continuous,
+        per_patch: cfg.per_patch && cfg.measures.continuous,
     })
 }
 
@@ -608,6 +617,15 @@ pub fn finish(
                 .expect("radiosity counts the pairs"),
         )?,
     };
+    let patches = (cfg.per_patch && !enclose)
+        .then(|| {
+            let light = materials.as_ref().filter(|_| lit).map(|m| PatchLight {
+                materials: m,
+                solve: &cfg.solve,
+            });
+            per_patch::estimates(scene, &run, cfg.estimator, light)
+        })
+        .flatten();
     let FinishedRun { total, .. } = run;
     let mut warnings = warnings::of_run(
         &scene.name,
@@ -650,6 +668,7 @@ pub fn finish(
         warnings,
         orientation: total.orientation.clone(),
         tally: total,
+        patches,
     })
 }
 

@@ -7,13 +7,15 @@
 //! * [`state`]: a run's groups as they fill up, a value ([`RunState`]);
 //! * [`errors`]: standard errors from the groups (batch means, the delete-a-group jackknife);
 //! * [`control`]: budgets, stop reasons and the handle that watches and stops a run;
-//! * [`analysis`]: the analysis of a scene, [`analyze`], with [`radiosity`] and [`warnings`].
+//! * [`analysis`]: the analysis of a scene, [`analyze`], with [`radiosity`], [`warnings`] and the
+//!   per-patch results ([`patches`]).
 
 pub mod analysis;
 pub mod batches;
 pub mod control;
 pub mod errors;
 mod orientation;
+pub mod patches;
 pub mod persist;
 pub mod plan;
 pub mod radiosity;
@@ -30,6 +32,7 @@ pub use analysis::{
 pub use batches::{all_batches, map_batches, map_traced_batches, Batch, LineStream, TraceBuffers};
 pub use control::{Budget, RunControl, StopReason, Target, TargetMeasure};
 pub use errors::{ErrorMethod, Spread};
+pub use patches::{PatchEstimate, PatchLight};
 pub use persist::{PersistError, RunIdentity, SavedRun};
 pub use plan::{BatchPlan, BatchSet};
 pub use radiosity::{

@@ -384,6 +384,7 @@ fn tally_of(w: &TallyWire, patches: usize, wanted: Wanted) -> Option<Tally> {
         orientation,
         escapes_by_patch,
         counts,
+        kernel_by_patch: None,
     })
 }
 
@@ -465,9 +466,11 @@ fn state_of(w: Wire) -> Option<SavedRun> {
     if plan.batch_size == 0 || w.groups.is_empty() {
         return None;
     }
+    // The per-patch sums of eq. (27) are not kept in a run state: a resumed run has none.
     let wanted = Wanted {
         discrete: w.discrete,
         continuous: w.continuous,
+        per_patch: false,
     };
     let patches = usize::try_from(w.identity.patches).ok()?;
     let groups = w

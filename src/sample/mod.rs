@@ -3,8 +3,8 @@
 //!
 //! Inside the layer, data flows: [`lines`] draws the lines; [`pairs`] (with `order`) turns a line's
 //! canonical hits into segments; [`kernel`] and [`environment`] give a segment's eq. (27) term;
-//! [`tally`] adds segments up, with f64 sums kept [`exact`]ly; [`counts`] turns pair keys into the
-//! counts N_ij.
+//! [`tally`] adds segments up, with f64 sums kept [`exact`]ly ([`patch_sums`] per patch, when asked);
+//! [`counts`] turns pair keys into the counts N_ij.
 
 pub mod counts;
 pub mod environment;
@@ -13,4 +13,5 @@ pub mod kernel;
 pub mod lines;
 mod order;
 pub mod pairs;
+pub mod patch_sums;
 pub mod tally;

@@ -10,6 +10,7 @@ use super::environment;
 use super::exact::ExactSum;
 use super::kernel::Log2Sum;
 use super::pairs::{segments_and_ends, Segment};
+use super::patch_sums::PatchKernelSums;
 use crate::scene::Scene;
 use crate::trace::{Line, LineHits};
 
@@ -20,6 +21,9 @@ pub struct Wanted {
     pub discrete: bool,
     /// The per-pair sum of eq. (27) for the continuous mutual information.
     pub continuous: bool,
+    /// Eq. (27)'s terms summed per patch ([`PatchKernelSums`]) for the per-patch results; needs
+    /// `discrete` (the pair keys say which patches a term belongs to).
+    pub per_patch: bool,
 }
 
 /// The counters and sums of a set of lines: every number a run adds up but the pair counts and the
@@ -137,6 +141,8 @@ pub struct Tally {
     pub escapes_by_patch: Vec<u64>,
     /// Pair counts (only when the discrete measures are wanted).
     pub counts: Option<PairCounts>,
+    /// Eq. (27)'s terms summed per patch (only when [`Wanted::per_patch`]).
+    pub kernel_by_patch: Option<PatchKernelSums>,
 }
 
 impl Tally {
@@ -153,6 +159,9 @@ impl Tally {
             counts: wanted
                 .discrete
                 .then(|| PairCounts::new(scene.patch_count())),
+            kernel_by_patch: wanted
+                .per_patch
+                .then(|| PatchKernelSums::new(scene.patch_count())),
         }
     }
 
@@ -163,6 +172,7 @@ impl Tally {
             orientation: self.orientation.clone(),
             escapes_by_patch: self.escapes_by_patch.clone(),
             counts: None,
+            kernel_by_patch: self.kernel_by_patch.clone(),
         }
     }
 
@@ -179,6 +189,11 @@ impl Tally {
         }
         if let (Some(a), Some(b)) = (&mut self.counts, &other.counts) {
             a.merge(b);
+        }
+        // Sums of only some of the lines would be silently wrong: both or none.
+        match (&mut self.kernel_by_patch, &other.kernel_by_patch) {
+            (Some(a), Some(b)) => a.merge(b),
+            _ => self.kernel_by_patch = None,
         }
     }
 
@@ -199,6 +214,7 @@ impl Tally {
                 (Some(t), Some(p)) => Some(t.without(p)),
                 _ => None,
             },
+            kernel_by_patch: None,
         }
     }
 
@@ -228,12 +244,18 @@ impl Tally {
                 Vec::new()
             },
             counts: None,
+            kernel_by_patch: wanted
+                .per_patch
+                .then(|| PatchKernelSums::new(scene.patch_count())),
         };
         let mut batch_keys = Vec::with_capacity(batches.len());
         for b in batches {
             tally.counters.add(&b.counters);
             for e in &b.side_events {
                 tally.orientation[e.object as usize].count(e.kind);
+            }
+            if let Some(k) = &mut tally.kernel_by_patch {
+                k.add_pairs(&b.pair_keys, &b.pair_terms);
             }
             for &p in &b.escape_patches {
                 tally.escapes_by_patch[p as usize] += 1;
@@ -302,6 +324,9 @@ pub struct BatchTally {
     pub escape_patches: Vec<u32>,
     /// How the batch's lines met the objects' sides, event by event.
     pub side_events: Vec<SideEvent>,
+    /// Beside each pair key, its log kernel ([`PatchKernelSums::pair_term`]), when
+    /// [`Wanted::per_patch`].
+    pub pair_terms: Vec<f64>,
 }
 
 /// Pairs the canonical hits of a batch of lines and tallies the segments (paper sec. 3.2.2): the hot
@@ -333,6 +358,7 @@ pub fn tally_lines(scene: &Scene, lines: &[Line], hits: &LineHits, wanted: Wante
             continue;
         }
         let events = &mut t.side_events;
+        let pair_terms = &mut t.pair_terms;
         let ends = segments_and_ends(scene, line, line_hits, |s| match s {
             Segment::Pair {
                 from,
@@ -344,6 +370,9 @@ pub fn tally_lines(scene: &Scene, lines: &[Line], hits: &LineHits, wanted: Wante
                 c.pairs += 1;
                 if wanted.discrete {
                     keys.push(pair_key(from, to));
+                }
+                if wanted.per_patch {
+                    pair_terms.push(PatchKernelSums::pair_term(cos_from * cos_to, distance));
                 }
                 if wanted.continuous && !log2_sum.add(cos_from * cos_to, distance) {
                     c.degenerate_pairs += 1;

@@ -11,7 +11,9 @@ mod embree_backend;
 mod errors;
 mod findings;
 mod lines_and_tracers;
+mod patches;
 mod radiosity;
+mod render;
 mod rust_bvh;
 mod scene_files;
 mod stability;
@@ -25,7 +27,11 @@ mod cli;
 #[cfg(feature = "cli")]
 mod cli_honest;
 #[cfg(feature = "cli")]
+mod cli_patches;
+#[cfg(feature = "cli")]
 mod cli_radiosity;
+#[cfg(feature = "cli")]
+mod cli_render;
 #[cfg(feature = "cli")]
 mod cli_reproduce;
 #[cfg(feature = "cli")]

@@ -5,6 +5,7 @@
 use crate::support;
 use scene_complexity::scenes;
 
+use scene_complexity::measure::patches::information_loss;
 use scene_complexity::measure::radiosity::{
     for_each_transition, solve, transformed_areas, FormFactors, PatchMaterials, SolveOptions,
 };
@@ -259,7 +260,7 @@ fn information_scores_add_up_to_the_discretisation_loss() {
     let tracer = rust_tracer(&scene);
     let sample = oracle::sample_pairs(&scene, tracer.as_ref(), 400_000, 3).unwrap();
     let areas: Vec<f64> = scene.patches.iter().map(|p| p.area).collect();
-    let scores = oracle::information(&areas, &sample, None);
+    let scores = information_loss(&areas, &sample, None);
     let loss = scores.iter().sum::<f64>() / scene.total_area();
     assert!(
         (loss - (1.6093 - exact_is)).abs() < 0.01,

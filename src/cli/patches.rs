@@ -1,0 +1,336 @@
+//! `scx analyze --patches FILE` and `--form-factors FILE`: the per-patch results and the sparse
+//! form-factor matrix, written for pandas, polars, numpy and scipy.
+//!
+//! * `--patches x.csv`: one row per patch, in the order `scx export` writes the faces (README,
+//!   "Per-patch results" lists the columns and their units);
+//! * `--form-factors x.csv`: one row per non-zero `F_ij` (i, j, N_ij, N_i, F_ij and its standard error
+//!   `sqrt(F (1 - F) / N_i)`, the binomial error of a row's share);
+//! * `--form-factors x.mtx`: the same matrix as Matrix Market coordinates (`scipy.io.mmread`), 1-based.
+
+use std::fmt::Write as _;
+use std::io::{BufWriter, Write};
+use std::path::{Path, PathBuf};
+
+use rayon::prelude::*;
+
+use scene_complexity::geom::Point;
+use scene_complexity::measure::Estimate;
+use scene_complexity::run::{Analysis, PatchEstimate};
+use scene_complexity::sample::counts::PairCounts;
+use scene_complexity::scene::Scene;
+
+use super::output::{io_failure, wrote};
+use super::Failure;
+
+/// The kinds of form-factor file, by extension.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum MatrixFormat {
+    Csv,
+    MatrixMarket,
+}
+
+fn extension(path: &Path) -> String {
+    path.extension()
+        .and_then(|e| e.to_str())
+        .unwrap_or("")
+        .to_ascii_lowercase()
+}
+
+/// Checks, before any work, that every per-patch file is a `.csv`.
+pub fn check_patch_files(paths: &[PathBuf]) -> Result<(), Failure> {
+    for p in paths {
+        if extension(p) != "csv" {
+            return Err(Failure::bad_input(format!(
+                "{}: --patches writes a .csv file",
+                p.display()
+            )));
+        }
+    }
+    Ok(())
+}
+
+fn matrix_format(path: &Path) -> Result<MatrixFormat, Failure> {
+    match extension(path).as_str() {
+        "csv" => Ok(MatrixFormat::Csv),
+        "mtx" => Ok(MatrixFormat::MatrixMarket),
+        _ => Err(Failure::bad_input(format!(
+            "{}: --form-factors writes a .csv or a Matrix Market .mtx file",
+            path.display()
+        ))),
+    }
+}
+
+/// Checks, before any work, that every form-factor file has a known extension.
+pub fn check_matrix_files(paths: &[PathBuf]) -> Result<(), Failure> {
+    paths.iter().try_for_each(|p| matrix_format(p).map(drop))
+}
+
+/// Writes the per-patch results to every file in `paths`.
+pub fn write_patches(paths: &[PathBuf], scene: &Scene, a: &Analysis) -> Result<(), Failure> {
+    if paths.is_empty() {
+        return Ok(());
+    }
+    let Some(patches) = &a.patches else {
+        return Err(Failure::bad_input(
+            "no per-patch results: the run counted no patch pairs, or closed the scene with --enclose",
+        ));
+    };
+    for path in paths {
+        write_with(path, |w| patches_csv(w, scene, patches))?;
+    }
+    Ok(())
+}
+
+/// Writes the form-factor matrix to every file in `paths`.
+pub fn write_form_factors(paths: &[PathBuf], scene: &Scene, a: &Analysis) -> Result<(), Failure> {
+    if paths.is_empty() {
+        return Ok(());
+    }
+    let Some(counts) = &a.tally.counts else {
+        return Err(Failure::bad_input(
+            "no form factors: the run counted no patch pairs (--measures without discrete)",
+        ));
+    };
+    let entries = ordered_entries(counts);
+    let totals = row_totals(scene.patch_count(), &entries, &a.tally.escapes_by_patch);
+    for path in paths {
+        match matrix_format(path)? {
+            MatrixFormat::Csv => write_with(path, |w| matrix_csv(w, &entries, &totals))?,
+            MatrixFormat::MatrixMarket => {
+                write_with(path, |w| matrix_market(w, scene, a, &entries, &totals))?
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Creates `path`, hands a buffered writer to `fill`, and says so.
+fn write_with(
+    path: &Path,
+    fill: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
+) -> Result<(), Failure> {
+    let file = std::fs::File::create(path).map_err(|e| io_failure(path, "write", &e))?;
+    let mut w = BufWriter::new(file);
+    fill(&mut w)
+        .and_then(|()| w.flush())
+        .map_err(|e| io_failure(path, "write", &e))?;
+    wrote(path);
+    Ok(())
+}
+
+/// Every `(i, j, N_ij)` with `N_ij > 0`, both directions of each pair, sorted by `i` then `j`; a
+/// segment from a patch back to itself enters `N_ii` twice (as in the measures).
+fn ordered_entries(counts: &PairCounts) -> Vec<(u32, u32, u64)> {
+    let mut entries = Vec::with_capacity(2 * counts.distinct_pairs());
+    counts.for_each(|i, j, c| {
+        if i == j {
+            entries.push((i, i, 2 * c));
+        } else {
+            entries.push((i, j, c));
+            entries.push((j, i, c));
+        }
+    });
+    entries.par_sort_unstable_by_key(|&(i, j, _)| (i, j));
+    entries
+}
+
+/// `N_i`: each row's counts plus its escapes.
+fn row_totals(patches: usize, entries: &[(u32, u32, u64)], escapes: &[u64]) -> Vec<u64> {
+    let mut n = escapes.to_vec();
+    n.resize(patches, 0);
+    for &(i, _, c) in entries {
+        n[i as usize] += c;
+    }
+    n
+}
+
+/// `F_ij = N_ij / N_i` and its binomial standard error `sqrt(F (1 - F) / N_i)`.
+fn form_factor(count: u64, total: u64) -> (f64, f64) {
+    let n = total as f64;
+    let f = count as f64 / n;
+    (f, (f * (1.0 - f) / n).max(0.0).sqrt())
+}
+
+/// Entries formatted per chunk, in parallel: a fine mesh has millions of them, and formatting the
+/// numbers, not writing them, is what takes the time.
+const CHUNK: usize = 1 << 16;
+
+/// Writes `entries` in order, each chunk turned into bytes by `format` on the thread pool, a few
+/// chunks at a time (so that the whole file is never held in memory).
+fn write_in_chunks(
+    w: &mut dyn Write,
+    entries: &[(u32, u32, u64)],
+    format: impl Fn(&[(u32, u32, u64)]) -> std::io::Result<Vec<u8>> + Sync,
+) -> std::io::Result<()> {
+    for round in entries.chunks(16 * CHUNK) {
+        let parts: Vec<std::io::Result<Vec<u8>>> = round.par_chunks(CHUNK).map(&format).collect();
+        for part in parts {
+            w.write_all(&part?)?;
+        }
+    }
+    Ok(())
+}
+
+fn matrix_csv(
+    w: &mut dyn Write,
+    entries: &[(u32, u32, u64)],
+    totals: &[u64],
+) -> std::io::Result<()> {
+    let mut header = csv::Writer::from_writer(&mut *w);
+    header.write_record(["i", "j", "n_ij", "n_i", "f_ij", "f_ij_stderr"])?;
+    header.flush()?;
+    drop(header);
+    write_in_chunks(w, entries, |chunk| {
+        let mut out = csv::WriterBuilder::new()
+            .has_headers(false)
+            .from_writer(Vec::with_capacity(56 * chunk.len()));
+        let mut fields: [String; 6] = Default::default();
+        for &(i, j, c) in chunk {
+            let n_i = totals[i as usize];
+            let (f, se) = form_factor(c, n_i);
+            fields.iter_mut().for_each(String::clear);
+            let [fi, fj, fc, fn_, ff, fse] = &mut fields;
+            let _ = (
+                write!(fi, "{i}"),
+                write!(fj, "{j}"),
+                write!(fc, "{c}"),
+                write!(fn_, "{n_i}"),
+                write!(ff, "{f}"),
+                write!(fse, "{se}"),
+            );
+            out.write_record(&fields)?;
+        }
+        out.into_inner().map_err(|e| e.into_error())
+    })
+}
+
+fn matrix_market(
+    w: &mut dyn Write,
+    scene: &Scene,
+    a: &Analysis,
+    entries: &[(u32, u32, u64)],
+    totals: &[u64],
+) -> std::io::Result<()> {
+    let n = scene.patch_count();
+    writeln!(w, "%%MatrixMarket matrix coordinate real general")?;
+    writeln!(
+        w,
+        "% form factors F_ij = N_ij / N_i of {} from {} global lines (seed {}), written by scx {}",
+        scene.name.replace('\n', " "),
+        a.lines,
+        a.seed,
+        env!("CARGO_PKG_VERSION")
+    )?;
+    writeln!(w, "% row i, column j (1-based: patch index + 1)")?;
+    writeln!(w, "{n} {n} {}", entries.len())?;
+    write_in_chunks(w, entries, |chunk| {
+        let mut out = Vec::with_capacity(32 * chunk.len());
+        for &(i, j, c) in chunk {
+            let (f, _) = form_factor(c, totals[i as usize]);
+            writeln!(out, "{} {} {f}", i + 1, j + 1)?;
+        }
+        Ok(out)
+    })
+}
+
+/// The area-weighted centroid of a patch's triangles, in the scene's own units and frame.
+fn centroid(scene: &Scene, patch: usize) -> Point {
+    let p = &scene.patches[patch];
+    let first = p.first_triangle as usize;
+    let (mut sum, mut weight) = (Point::ZERO, 0.0);
+    for t in &scene.triangles[first..first + p.triangle_count as usize] {
+        let [a, b, c] = t.map(|v| scene.vertices[v as usize]);
+        let area = 0.5 * (b - a).cross(c - a).length();
+        sum += area * (a + b + c) / 3.0;
+        weight += area;
+    }
+    if weight > 0.0 {
+        sum / weight
+    } else {
+        scene.vertices[scene.triangles[first][0] as usize]
+    }
+}
+
+/// The columns of the per-patch file after the geometry: each estimate as value and standard error.
+const ESTIMATE_COLUMNS: [&str; 9] = [
+    "row_entropy",
+    "row_entropy_corrected",
+    "mutual_information_term",
+    "mutual_information_term_corrected",
+    "continuous_mutual_information_term",
+    "lost_information",
+    "lost_information_corrected",
+    "radiosity",
+    "incoming_radiosity",
+];
+
+fn estimates_of(p: &PatchEstimate) -> [Option<Estimate>; 9] {
+    [
+        Some(p.row_entropy),
+        Some(p.row_entropy_corrected),
+        Some(p.mutual_information_term),
+        Some(p.mutual_information_term_corrected),
+        p.continuous_term,
+        p.lost_information,
+        p.lost_information_corrected,
+        p.radiosity,
+        p.incoming_radiosity,
+    ]
+}
+
+fn patches_csv(w: &mut dyn Write, scene: &Scene, patches: &[PatchEstimate]) -> std::io::Result<()> {
+    let mut out = csv::Writer::from_writer(w);
+    let mut header: Vec<String> = [
+        "id",
+        "object",
+        "material",
+        "area",
+        "centroid_x",
+        "centroid_y",
+        "centroid_z",
+        "normal_x",
+        "normal_y",
+        "normal_z",
+        "area_fraction",
+        "segments",
+        "escapes",
+        "sampled",
+    ]
+    .map(String::from)
+    .to_vec();
+    for name in ESTIMATE_COLUMNS {
+        header.push(name.to_string());
+        header.push(format!("{name}_stderr"));
+    }
+    out.write_record(&header)?;
+    let norm = scene.normalization;
+    let total_area = scene.total_area();
+    let num = |x: Option<f64>| x.map(|v| format!("{}", v + 0.0)).unwrap_or_default();
+    for (i, (patch, p)) in scene.patches.iter().zip(patches).enumerate() {
+        let c = centroid(scene, i);
+        let n = patch.normal;
+        let material = &scene.materials[patch.material as usize].name;
+        let mut row = vec![
+            i.to_string(),
+            String::new(),
+            material.clone(),
+            num(Some(patch.area * norm.scale * norm.scale)),
+            num(Some(c.x)),
+            num(Some(c.y)),
+            num(Some(c.z)),
+            num(Some(n.x)),
+            num(Some(n.y)),
+            num(Some(n.z)),
+            num(Some(patch.area / total_area)),
+            p.segments.to_string(),
+            p.escapes.to_string(),
+            p.sampled().to_string(),
+        ];
+        for e in estimates_of(p) {
+            row.push(num(e.map(|e| e.value)));
+            row.push(num(e.and_then(|e| e.stderr)));
+        }
+        out.write_record(&row)?;
+    }
+    out.flush()
+}

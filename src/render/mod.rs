@@ -1,0 +1,18 @@
+//! Pictures of where the complexity is: the scene drawn from a camera with each patch coloured by a
+//! per-patch quantity of a run ([`crate::run::PatchEstimate`]), and the coloured mesh as PLY.
+//!
+//! * [`camera`]: the pinhole camera and the default view (inside a room when the scene is one);
+//! * [`image`]: first-hit rays through the camera, traced by the run's own tracer, and the picture's
+//!   pixels (shaded by the viewing angle, back sides grey, patch outlines darkened);
+//! * [`colour`]: the quantities and the viridis colour scale;
+//! * [`ply`]: the mesh with a colour per patch.
+
+pub mod camera;
+pub mod colour;
+pub mod image;
+pub mod ply;
+
+pub use camera::{default_camera, Camera, CameraError};
+pub use colour::{ColourScale, Quantity, NO_DATA};
+pub use image::{trace_view, PatchImage, Sample, BACKGROUND, BACK_SIDE};
+pub use ply::write_ply;

@@ -1,0 +1,150 @@
+//! The per-patch results of a run ([`crate::measure::patches`]), each with its standard error.
+//!
+//! Every group of lines gets its own per-patch terms (and, when the scene emits, its own radiosity
+//! solution), and each full-run value gets the batch-means standard error of the group values, as the
+//! scene's measures do ([`super::errors`]); like theirs, the errors of the plug-in terms of undersampled
+//! rows measure the statistical error only, not the bias.
+
+use rayon::prelude::*;
+
+use super::state::FinishedRun;
+use crate::measure::estimators::EntropyEstimator;
+use crate::measure::patches::{patch_values, ContinuousSums, PatchValues};
+use crate::measure::radiosity::{self, FormFactors, PatchMaterials, SolveOptions};
+use crate::measure::Estimate;
+use crate::sample::tally::Tally;
+use crate::scene::Scene;
+
+/// One patch's results (patch `k` of the scene is entry `k`). Bits for the entropies and terms; the
+/// radiosities in the units of the scene's emissions.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PatchEstimate {
+    /// `N_i`: segments leaving the patch's front side (to patches, or escaping).
+    pub segments: u64,
+    /// Of them, the escapes.
+    pub escapes: u64,
+    /// `H_i = -sum_j F_ij log2 F_ij`, the plug-in row entropy (eq. (17)'s inner sum).
+    pub row_entropy: Estimate,
+    /// `H_i` by the run's bias-correcting estimator.
+    pub row_entropy_corrected: Estimate,
+    /// `a_i sum_j F_ij log2(F_ij / a_j)`, the patch's term of eq. (21).
+    pub mutual_information_term: Estimate,
+    /// The same with the corrected `H_i`.
+    pub mutual_information_term_corrected: Estimate,
+    /// The patch's share of eq. (27) (`None` when I_s^c was not computed).
+    pub continuous_term: Option<Estimate>,
+    /// The information the discretisation loses at the patch: `continuous_term -
+    /// mutual_information_term`.
+    pub lost_information: Option<Estimate>,
+    /// `continuous_term - mutual_information_term_corrected`.
+    pub lost_information_corrected: Option<Estimate>,
+    /// `B_i`, the radiosity (eq. (2)), when the scene emits.
+    pub radiosity: Option<Estimate>,
+    /// `B_i^in = sum_j F_ij B_j`, the radiosity arriving, when the scene emits.
+    pub incoming_radiosity: Option<Estimate>,
+}
+
+impl PatchEstimate {
+    /// Whether any segment left the patch (an unsampled patch's terms are 0 and say nothing).
+    pub fn sampled(&self) -> bool {
+        self.segments > 0
+    }
+}
+
+/// The radiosity side of the per-patch results: the scene's materials and how to solve.
+#[derive(Clone, Copy, Debug)]
+pub struct PatchLight<'a> {
+    /// Emission and reflectance per patch.
+    pub materials: &'a PatchMaterials,
+    /// How the radiosity system is solved.
+    pub solve: &'a SolveOptions,
+}
+
+/// One tally's per-patch values and, when lit, its radiosities `(B, B^in)`.
+struct TallyPatches {
+    values: PatchValues,
+    light: Option<(Vec<f64>, Vec<f64>)>,
+}
+
+/// Every patch's results from a finished run; `None` without pair counts.
+pub(crate) fn estimates(
+    scene: &Scene,
+    run: &FinishedRun,
+    estimator: EntropyEstimator,
+    light: Option<PatchLight<'_>>,
+) -> Option<Vec<PatchEstimate>> {
+    let of = |t: &Tally| of_tally(scene, t, estimator, light);
+    let (all, groups): (Option<TallyPatches>, Vec<Option<TallyPatches>>) = rayon::join(
+        || of(&run.total),
+        || run.groups.par_iter().map(of).collect(),
+    );
+    let all = all?;
+    let groups: Vec<TallyPatches> = groups.into_iter().flatten().collect();
+    Some(
+        (0..scene.patch_count())
+            .map(|i| patch_estimate(i, &all, &groups))
+            .collect(),
+    )
+}
+
+fn of_tally(
+    scene: &Scene,
+    t: &Tally,
+    estimator: EntropyEstimator,
+    light: Option<PatchLight<'_>>,
+) -> Option<TallyPatches> {
+    let counts = t.counts.as_ref()?;
+    let areas: Vec<f64> = scene.patches.iter().map(|p| p.area).collect();
+    let continuous = t.kernel_by_patch.as_ref().map(|sums| ContinuousSums {
+        sums,
+        total_area: scene.total_area(),
+    });
+    let values = patch_values(&areas, counts, &t.escapes_by_patch, estimator, continuous);
+    // A group whose own solve fails (too few lines) only loses the standard errors of B.
+    let light = light.and_then(|l| {
+        let ff = FormFactors::from_counts(areas.len(), counts, &t.escapes_by_patch);
+        let s = radiosity::solve(&ff, l.materials, l.solve).ok()?;
+        Some((s.radiosity, s.incoming))
+    });
+    Some(TallyPatches { values, light })
+}
+
+/// Patch `i`'s values from all the lines, with the batch-means standard errors of the groups'.
+fn patch_estimate(i: usize, all: &TallyPatches, groups: &[TallyPatches]) -> PatchEstimate {
+    let est = |f: &dyn Fn(&TallyPatches) -> Option<f64>| -> Option<Estimate> {
+        let value = f(all)?;
+        let per_group: Option<Vec<f64>> = groups.iter().map(f).collect();
+        Some(match per_group {
+            Some(g) => Estimate::from_groups(value, &g),
+            None => Estimate {
+                value,
+                stderr: None,
+            },
+        })
+    };
+    let always = |f: &dyn Fn(&PatchValues) -> f64| {
+        est(&|t| Some(f(&t.values))).expect("every tally has its counts' values")
+    };
+    let continuous = |t: &TallyPatches| Some(t.values.continuous_term.as_ref()?[i]);
+    let lost = |t: &TallyPatches, corrected: bool| {
+        let discrete = if corrected {
+            t.values.mutual_information_term_corrected[i]
+        } else {
+            t.values.mutual_information_term[i]
+        };
+        Some(continuous(t)? - discrete)
+    };
+    PatchEstimate {
+        segments: all.values.segments[i],
+        escapes: all.values.escapes[i],
+        row_entropy: always(&|v| v.row_entropy[i]),
+        row_entropy_corrected: always(&|v| v.row_entropy_corrected[i]),
+        mutual_information_term: always(&|v| v.mutual_information_term[i]),
+        mutual_information_term_corrected: always(&|v| v.mutual_information_term_corrected[i]),
+        continuous_term: est(&continuous),
+        lost_information: est(&|t| lost(t, false)),
+        lost_information_corrected: est(&|t| lost(t, true)),
+        radiosity: est(&|t| Some(t.light.as_ref()?.0[i])),
+        incoming_radiosity: est(&|t| Some(t.light.as_ref()?.1[i])),
+    }
+}

@@ -1,0 +1,347 @@
+//! `scx analyze --patches` and `--form-factors` against independent truth: the form factors of `@cube:4`
+//! agree with the closed forms of parallel and perpendicular squares (a chi-square over every entry);
+//! rows of F sum to 1 in a closed scene and reciprocity holds within the errors; the geometry columns are
+//! the scene's own.
+
+use crate::support::{area_form_factor, scx, AxisRect};
+use scene_complexity::scenes;
+
+/// Reads a CSV without quoted fields (the numeric files) into its header and rows.
+fn read_csv(path: &std::path::Path) -> (Vec<String>, Vec<Vec<String>>) {
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut lines = text.lines();
+    let header = lines.next().unwrap().split(',').map(String::from).collect();
+    let rows = lines
+        .map(|l| l.split(',').map(String::from).collect())
+        .collect();
+    (header, rows)
+}
+
+/// The upper tail of the chi-square distribution with `df` degrees of freedom (Wilson–Hilferty: the
+/// cube root of chi^2 / df is close to normal; good to ~1e-3 at the hundreds of degrees used here).
+fn chi_square_p_value(chi2: f64, df: f64) -> f64 {
+    let k = 2.0 / (9.0 * df);
+    let z = ((chi2 / df).cbrt() - (1.0 - k)) / k.sqrt();
+    0.5 * erfc(z / std::f64::consts::SQRT_2)
+}
+
+/// The complementary error function (Numerical Recipes' `erfcc`, relative error below 1.2e-7).
+fn erfc(x: f64) -> f64 {
+    let z = x.abs();
+    let t = 1.0 / (1.0 + 0.5 * z);
+    let r = t
+        * (-z * z - 1.26551223
+            + t * (1.00002368
+                + t * (0.37409196
+                    + t * (0.09678418
+                        + t * (-0.18628806
+                            + t * (0.27886807
+                                + t * (-1.13520398
+                                    + t * (1.48851587 + t * (-0.82215223 + t * 0.17087277)))))))))
+            .exp();
+    if x >= 0.0 {
+        r
+    } else {
+        2.0 - r
+    }
+}
+
+/// `scx analyze @cube:4 --lines 1e7 --form-factors ff.csv`: every entry of F against the closed forms
+/// of parallel and perpendicular squares. The segments of an empty convex room are independent (one
+/// per line that meets it), so the unordered pair counts are multinomial with `p_ij = 2 A_i F_ij / A_T`;
+/// Pearson's chi-square over every pair of patches that see each other must look like chance, every
+/// entry must lie within 5 of its reported standard errors, no coplanar pair may be counted, every row
+/// must sum to 1 and reciprocity `A_i F_ij = A_j F_ji` must hold within the errors.
+#[test]
+fn form_factors_of_the_unit_cube_agree_with_the_closed_forms() {
+    let dir = tempfile::tempdir().unwrap();
+    let (csv, mtx) = (dir.path().join("ff.csv"), dir.path().join("ff.mtx"));
+    let out = scx(&[
+        "analyze",
+        "@cube:4",
+        "--lines",
+        "1e7",
+        "--seed",
+        "3",
+        "-q",
+        "--format",
+        "json",
+        "--form-factors",
+        csv.to_str().unwrap(),
+        "--form-factors",
+        mtx.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let scene = scenes::load("@cube:4").unwrap();
+    let n = scene.patch_count();
+    let rects: Vec<AxisRect> = (0..n).map(|p| AxisRect::of_patch(&scene, p)).collect();
+    let area = |_: usize| 1.0 / 16.0;
+    let exact = |i: usize, j: usize| area_form_factor(&rects[i], &rects[j]) / area(i);
+
+    let (header, rows) = read_csv(&csv);
+    assert_eq!(header, ["i", "j", "n_ij", "n_i", "f_ij", "f_ij_stderr"]);
+    let mut counts = vec![vec![0u64; n]; n];
+    let mut f = vec![vec![0.0; n]; n];
+    let mut se = vec![vec![0.0; n]; n];
+    let mut row_total = vec![0u64; n];
+    for r in &rows {
+        let (i, j): (usize, usize) = (r[0].parse().unwrap(), r[1].parse().unwrap());
+        counts[i][j] = r[2].parse().unwrap();
+        row_total[i] = r[3].parse().unwrap();
+        f[i][j] = r[4].parse().unwrap();
+        se[i][j] = r[5].parse().unwrap();
+    }
+
+    // Pearson's chi-square over the unordered pairs that see each other.
+    let pairs: u64 = (0..n)
+        .flat_map(|i| (i + 1..n).map(move |j| (i, j)))
+        .map(|(i, j)| counts[i][j])
+        .sum();
+    let (mut chi2, mut cells, mut worst) = (0.0, 0usize, (0.0f64, 0, 0));
+    for i in 0..n {
+        for j in 0..n {
+            let fe = exact(i, j);
+            if fe <= 1e-12 {
+                assert_eq!(
+                    counts[i][j], 0,
+                    "coplanar patches {i} and {j} cannot see each other"
+                );
+                continue;
+            }
+            let z = (f[i][j] - fe) / se[i][j];
+            if z.abs() > worst.0.abs() {
+                worst = (z, i, j);
+            }
+            if j > i {
+                let expected = pairs as f64 * 2.0 * area(i) * fe / 6.0;
+                chi2 += (counts[i][j] as f64 - expected).powi(2) / expected;
+                cells += 1;
+            }
+        }
+    }
+    let df = (cells - 1) as f64;
+    let p = chi_square_p_value(chi2, df);
+    let report = format!(
+        "chi-square {chi2:.1} on {df} degrees of freedom (p = {p:.3}) over {cells} pairs of patches from \
+         {pairs} segments; largest deviation {:.2} standard errors (F_{}_{})",
+        worst.0, worst.1, worst.2
+    );
+    eprintln!("{report}");
+    assert_eq!(cells, 3840, "{report}");
+    assert!((1e-3..=0.999).contains(&p), "{report}");
+    assert!(worst.0.abs() < 5.0, "{report}");
+
+    // Rows sum to 1 (a closed scene: no escapes), reciprocity within the errors.
+    for i in 0..n {
+        let s: f64 = f[i].iter().sum();
+        assert!((s - 1.0).abs() < 1e-12, "row {i} sums to {s}");
+        assert_eq!(counts[i].iter().sum::<u64>(), row_total[i]);
+    }
+    let (mut z2, mut k) = (0.0, 0);
+    for i in 0..n {
+        for j in i + 1..n {
+            if counts[i][j] == 0 {
+                continue;
+            }
+            let d = area(i) * f[i][j] - area(j) * f[j][i];
+            let s = (area(i) * se[i][j]).hypot(area(j) * se[j][i]);
+            assert!(
+                (d / s).abs() < 5.0,
+                "reciprocity of {i} and {j}: {d} against {s}"
+            );
+            z2 += (d / s).powi(2);
+            k += 1;
+        }
+    }
+    // The two sides share N_ij, so their difference scatters less than the independent errors say.
+    assert!(
+        z2 / f64::from(k) < 1.0,
+        "mean squared reciprocity deviation {}",
+        z2 / f64::from(k)
+    );
+
+    // The Matrix Market file holds the same matrix, 1-based.
+    let text = std::fs::read_to_string(&mtx).unwrap();
+    let mut lines = text.lines().filter(|l| !l.starts_with('%'));
+    assert!(text.starts_with("%%MatrixMarket matrix coordinate real general\n"));
+    assert_eq!(lines.next().unwrap(), format!("{n} {n} {}", rows.len()));
+    for (line, r) in lines.zip(&rows) {
+        let v: Vec<&str> = line.split(' ').collect();
+        let (i, j): (usize, usize) = (v[0].parse().unwrap(), v[1].parse().unwrap());
+        assert_eq!(
+            (i - 1, j - 1),
+            (r[0].parse().unwrap(), r[1].parse().unwrap())
+        );
+        assert_eq!(v[2], r[4]);
+    }
+}
+
+/// The per-patch file's geometry is the scene's own: on `@cube:4` (the unit cube, 4 x 4 squares per
+/// face) every centroid is the middle of a square of side 1/4 on a face, every normal points into the
+/// cube, every area is 1/16; on `@cornell` (millimetres) the areas add up to the box's.
+#[test]
+fn per_patch_file_has_the_scenes_own_geometry() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("p.csv");
+    let out = scx(&[
+        "analyze",
+        "@cube:4",
+        "--lines",
+        "2e5",
+        "-q",
+        "--patches",
+        path.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let (header, rows) = read_csv(&path);
+    assert_eq!(rows.len(), 96);
+    let col = |name: &str| {
+        header
+            .iter()
+            .position(|h| h == name)
+            .unwrap_or_else(|| panic!("{name}"))
+    };
+    let num = |r: &Vec<String>, name: &str| -> f64 { r[col(name)].parse().unwrap() };
+    for (k, r) in rows.iter().enumerate() {
+        assert_eq!(r[col("id")], k.to_string());
+        assert!((num(r, "area") - 1.0 / 16.0).abs() < 1e-12);
+        let c = ["centroid_x", "centroid_y", "centroid_z"].map(|n| num(r, n));
+        let nrm = ["normal_x", "normal_y", "normal_z"].map(|n| num(r, n));
+        let on_face = (0..3).filter(|&a| c[a] == 0.0 || c[a] == 1.0).count();
+        assert_eq!(on_face, 1, "patch {k}: centroid {c:?}");
+        for a in 0..3 {
+            if c[a] == 0.0 || c[a] == 1.0 {
+                assert_eq!(
+                    nrm[a],
+                    if c[a] == 0.0 { 1.0 } else { -1.0 },
+                    "patch {k}: normal {nrm:?}"
+                );
+            } else {
+                assert_eq!(nrm[a], 0.0);
+                assert!(
+                    ((c[a] * 8.0) - (c[a] * 8.0).round()).abs() < 1e-12
+                        && (c[a] * 8.0).round() % 2.0 == 1.0
+                );
+            }
+        }
+        assert_eq!(r[col("sampled")], "true");
+        assert!(r[col("radiosity")].is_empty(), "nothing emits");
+    }
+
+    let out = scx(&[
+        "analyze",
+        "@cornell",
+        "--lines",
+        "1e5",
+        "-q",
+        "--format",
+        "json",
+        "--patches",
+        path.to_str().unwrap(),
+    ]);
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let (header, rows) = read_csv(&path);
+    let area_col = header.iter().position(|h| h == "area").unwrap();
+    let total: f64 = rows
+        .iter()
+        .map(|r| r[area_col].parse::<f64>().unwrap())
+        .sum();
+    let reported = report["area"].as_f64().unwrap();
+    assert!(
+        (total - reported).abs() < 1e-9 * reported,
+        "{total} vs {reported} mm^2"
+    );
+    let b = header.iter().position(|h| h == "radiosity").unwrap();
+    assert!(
+        rows.iter().all(|r| r[b].parse::<f64>().unwrap() >= 0.0),
+        "lit: every B_i is given"
+    );
+}
+
+/// Wrong kinds of file and --enclose are refused before any line is cast, with exit code 2.
+#[test]
+fn per_patch_files_are_checked_before_work() {
+    for args in [
+        &["analyze", "@cube:2", "--patches", "p.txt"][..],
+        &["analyze", "@cube:2", "--form-factors", "f.json"],
+        &[
+            "analyze",
+            "@cornell-open",
+            "--enclose",
+            "--patches",
+            "p.csv",
+        ],
+        &[
+            "analyze",
+            "@cube:2",
+            "--measures",
+            "continuous",
+            "--form-factors",
+            "f.csv",
+        ],
+    ] {
+        let out = scx(args);
+        assert_eq!(out.status.code(), Some(2), "{args:?}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            err.contains("--patches") || err.contains("--form-factors"),
+            "{args:?}: {err}"
+        );
+        assert!(!err.contains("panicked"));
+    }
+    let out = scx(&["analyze", "@cube:2", "--patches", "/no/such/folder/p.csv"]);
+    assert_eq!(out.status.code(), Some(3));
+}
+
+/// A resumed run keeps no per-patch sums of eq. (27): it says so, and leaves those columns empty
+/// rather than filling them from part of the lines.
+#[test]
+fn a_resumed_run_leaves_the_continuous_columns_empty_and_says_so() {
+    let dir = tempfile::tempdir().unwrap();
+    let (state, csv) = (dir.path().join("run.state"), dir.path().join("p.csv"));
+    let out = scx(&[
+        "analyze",
+        "@cube:2",
+        "--lines",
+        "3e5",
+        "-q",
+        "--save",
+        state.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let out = scx(&[
+        "analyze",
+        "--resume",
+        state.to_str().unwrap(),
+        "--lines",
+        "4e5",
+        "--patches",
+        csv.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(String::from_utf8_lossy(&out.stderr).contains("stay empty"));
+    let (header, rows) = read_csv(&csv);
+    let col = |name: &str| header.iter().position(|h| h == name).unwrap();
+    assert_eq!(rows.len(), 24);
+    for r in &rows {
+        assert!(r[col("continuous_mutual_information_term")].is_empty());
+        assert!(r[col("lost_information")].is_empty());
+        assert!(!r[col("mutual_information_term")].is_empty());
+    }
+}

@@ -1,0 +1,179 @@
+//! The per-patch results against invariants: the per-patch terms add up to the scene's measures, and
+//! the radiosity columns solve eq. (2). (`cli_patches` checks the files `scx analyze` writes.)
+
+use scene_complexity::measure::patches::information_loss;
+use scene_complexity::refine::oracle;
+use scene_complexity::run::{analyze, Analysis, AnalysisConfig, RunControl};
+use scene_complexity::scenes;
+use scene_complexity::trace::{make_tracer, Backend, Query};
+use scene_complexity::EntropyEstimator;
+
+fn run_with_patches(
+    spec: &str,
+    lines: u64,
+    estimator: EntropyEstimator,
+) -> (scene_complexity::Scene, Analysis) {
+    let scene = scenes::load(spec).unwrap();
+    let tracer = make_tracer(Backend::Rust, &scene, Query::Single).unwrap();
+    let cfg = AnalysisConfig {
+        per_patch: true,
+        estimator,
+        ..AnalysisConfig::new(lines, 7)
+    };
+    let a = analyze(&scene, tracer.as_ref(), &cfg, &RunControl::default()).unwrap();
+    (scene, a)
+}
+
+fn close(x: f64, y: f64) -> bool {
+    (x - y).abs() <= 1e-10 * x.abs().max(y.abs()).max(1.0)
+}
+
+/// H_s = sum a_i H_i, I_s = sum I_i and I_s^c = sum I_i^c, plug-in and corrected, to rounding: in a
+/// closed lit scene (dense counts), an open one (escapes), and a mesh with sparse counts and unsampled
+/// patches; with the one-pass estimators and with Chao–Shen (two passes).
+#[test]
+fn per_patch_terms_add_up_to_the_scene_measures() {
+    for (spec, lines, estimator) in [
+        ("@cornell", 200_000, EntropyEstimator::ChaoWangJost),
+        ("@cornell-open", 200_000, EntropyEstimator::Grassberger),
+        ("@cube:4", 100_000, EntropyEstimator::ChaoShen),
+        ("@cube:30", 20_000, EntropyEstimator::ChaoWangJost),
+    ] {
+        let (scene, a) = run_with_patches(spec, lines, estimator);
+        let p = a.patches.as_ref().expect("asked for");
+        assert_eq!(p.len(), scene.patch_count());
+        let v = &a.visibility;
+        let total_area = scene.total_area();
+        let a_i = |i: usize| scene.patches[i].area / total_area;
+        let sum = |f: &dyn Fn(usize) -> f64| (0..p.len()).map(f).sum::<f64>();
+        let checks = [
+            (
+                "H_s",
+                sum(&|i| a_i(i) * p[i].row_entropy.value),
+                v.entropy.unwrap().value,
+            ),
+            (
+                "H_s corrected",
+                sum(&|i| a_i(i) * p[i].row_entropy_corrected.value),
+                v.entropy_corrected.unwrap().value,
+            ),
+            (
+                "I_s",
+                sum(&|i| p[i].mutual_information_term.value),
+                v.mutual_information.unwrap().value,
+            ),
+            (
+                "I_s corrected",
+                sum(&|i| p[i].mutual_information_term_corrected.value),
+                v.mutual_information_corrected.unwrap().value,
+            ),
+            (
+                "I_s^c",
+                sum(&|i| p[i].continuous_term.unwrap().value),
+                v.continuous_mutual_information.unwrap().value,
+            ),
+            (
+                "I_s^c - I_s",
+                sum(&|i| p[i].lost_information.unwrap().value),
+                v.continuous_mutual_information.unwrap().value
+                    - v.mutual_information.unwrap().value,
+            ),
+        ];
+        for (name, parts, whole) in checks {
+            assert!(
+                close(parts, whole),
+                "{spec}: {name}: sum of patches {parts} vs scene {whole}"
+            );
+        }
+        // Every value with a standard error, no NaN from an unsampled patch.
+        for (i, e) in p.iter().enumerate() {
+            for x in [
+                e.row_entropy,
+                e.mutual_information_term,
+                e.continuous_term.unwrap(),
+            ] {
+                assert!(
+                    x.value.is_finite() && x.stderr.is_some_and(f64::is_finite),
+                    "{spec} {i}: {e:?}"
+                );
+            }
+            assert_eq!(
+                e.radiosity.is_some(),
+                spec == "@cornell" || spec == "@cornell-open"
+            );
+        }
+        if spec == "@cube:30" {
+            assert!(
+                p.iter().any(|e| !e.sampled()),
+                "20 000 lines leave patches of @cube:30 unsampled"
+            );
+        }
+    }
+}
+
+/// The radiosity columns solve eq. (2): B_i = E_i + R_i B_i^in for every patch.
+#[test]
+fn per_patch_radiosities_solve_the_radiosity_equation() {
+    let (scene, a) = run_with_patches("@cornell", 300_000, EntropyEstimator::ChaoWangJost);
+    for (i, e) in a.patches.as_ref().unwrap().iter().enumerate() {
+        let m = &scene.materials[scene.patches[i].material as usize];
+        let (b, b_in) = (e.radiosity.unwrap(), e.incoming_radiosity.unwrap());
+        let residual = b.value - m.emission - m.reflectance * b_in.value;
+        assert!(
+            residual.abs() <= 1e-8 * m.emission.max(b.value),
+            "patch {i}: {residual}"
+        );
+        assert!(b.stderr.is_some_and(|se| se > 0.0 || m.reflectance == 0.0));
+    }
+}
+
+/// One computation: on the same lines (same seed and count), the `information` meshing strategy's
+/// scores with B = 1, divided by A_T, are the per-patch table's lost information but for the table's
+/// common correction `a_i delta` (the same `delta` for every patch), in a closed scene.
+#[test]
+fn refines_information_scores_are_the_tables_lost_information() {
+    let (lines, seed) = (300_000, 7);
+    for spec in ["@cube:4", "@cornell:2"] {
+        let (scene, a) = run_with_patches(spec, lines, EntropyEstimator::PlugIn);
+        assert_eq!(a.seed, seed);
+        let tracer = make_tracer(Backend::Rust, &scene, Query::Single).unwrap();
+        let sample = oracle::sample_pairs(&scene, tracer.as_ref(), lines, seed).unwrap();
+        let areas: Vec<f64> = scene.patches.iter().map(|p| p.area).collect();
+        let scores = information_loss(&areas, &sample, None);
+        let total = scene.total_area();
+        let p = a.patches.unwrap();
+        let delta: Vec<f64> = (0..p.len())
+            .map(|i| {
+                let a_i = areas[i] / total;
+                (p[i].lost_information.unwrap().value - scores[i] / total) / a_i
+            })
+            .collect();
+        for d in &delta {
+            assert!((d - delta[0]).abs() < 1e-9, "{spec}: {delta:?}");
+        }
+        assert!(delta[0].abs() < 0.01, "{spec}: delta {}", delta[0]);
+    }
+}
+
+/// The per-patch results are bit-identical whatever the thread count (every sum is exact or added in
+/// batch order).
+#[test]
+fn per_patch_results_do_not_depend_on_the_threads() {
+    let scene = scenes::load("@cube:30").unwrap();
+    let tracer = make_tracer(Backend::Rust, &scene, Query::Single).unwrap();
+    let cfg = AnalysisConfig {
+        per_patch: true,
+        ..AnalysisConfig::new(60_000, 3)
+    };
+    let run = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| analyze(&scene, tracer.as_ref(), &cfg, &RunControl::default()))
+            .unwrap()
+            .patches
+            .unwrap()
+    };
+    assert_eq!(run(1), run(2));
+}
