@@ -14,9 +14,10 @@ use scene_complexity::trace::{Backend, Query};
 
 use super::args::{parse_count, parse_positive, parse_target_measure, ReportOutput, RunOptions};
 use super::output::{self, warn};
+use super::patches::PatchFiles;
 use super::report::{self, Format};
 use super::runner::Runner;
-use super::{patches, Exit, Failure};
+use super::{Exit, Failure};
 
 /// Arguments of `scx analyze`.
 #[derive(clap::Args, Debug)]
@@ -90,21 +91,6 @@ pub struct AnalyzeArgs {
     files: PatchFiles,
 }
 
-/// The per-patch files of `scx analyze`.
-#[derive(clap::Args, Debug)]
-struct PatchFiles {
-    /// Also write one row per patch to FILE (.csv): id (the order `scx export` writes faces), material,
-    /// area, centroid and normal in the scene's units, segments N_i, row entropy, its terms of I_s and
-    /// I_s^c, the information it loses, radiosity when lit, each with its standard error. Repeat to
-    /// write several files.
-    #[arg(long, value_name = "FILE")]
-    patches: Vec<PathBuf>,
-    /// Also write the sparse form-factor matrix to FILE: `.csv` (i, j, n_ij, n_i, f_ij, f_ij_stderr) or
-    /// `.mtx` (Matrix Market, for scipy.io.mmread). Repeat to write both.
-    #[arg(long, value_name = "FILE")]
-    form_factors: Vec<PathBuf>,
-}
-
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 enum MeasureArg {
     Discrete,
@@ -129,15 +115,14 @@ fn parse_shard(s: &str) -> Result<(u32, u32), String> {
     Ok((k, m))
 }
 
-/// Checks the per-patch files before any work: their kinds, that they can be written, and that the run
-/// will have what they need.
+/// Checks the per-patch files before any work: their kinds, that they can be written, and that a new
+/// run will have what they need (a resumed one is checked once its state is read).
 fn check_patch_files(args: &AnalyzeArgs) -> Result<(), Failure> {
     let f = &args.files;
-    if f.patches.is_empty() && f.form_factors.is_empty() {
+    if f.is_empty() {
         return Ok(());
     }
-    patches::check_patch_files(&f.patches)?;
-    patches::check_matrix_files(&f.form_factors)?;
+    f.check()?;
     if args.enclose {
         return Err(Failure::bad_input(
             "--patches and --form-factors describe the scene's own patches; they do not take --enclose",
@@ -152,12 +137,7 @@ fn check_patch_files(args: &AnalyzeArgs) -> Result<(), Failure> {
             "--form-factors needs the pair counts: add `discrete` to --measures",
         ));
     }
-    output::check_all(
-        f.patches
-            .iter()
-            .chain(&f.form_factors)
-            .map(PathBuf::as_path),
-    )
+    Ok(())
 }
 
 fn parse_bundle(s: &str) -> Result<u32, String> {
@@ -249,7 +229,17 @@ fn resumed_run(args: &AnalyzeArgs, file: &Path) -> Result<Prepared, Failure> {
     };
     let query = Query::parse(&identity.query).map_err(Failure::bad_input)?;
     let runner = Runner::with(&spec, &identity.reading, backend, query, args.run.threads)?;
-    check_same_scene(&file.display().to_string(), &identity, &runner)?;
+    let shown = file.display().to_string();
+    check_same_scene(&shown, &identity, &runner)?;
+    // A state keeps the per-patch sums when its first run was asked for --patches, and a resumed run
+    // goes on gathering what its state holds: without them from the start, they cannot be had now.
+    let wanted = saved.state.wanted();
+    let without_sums: Vec<String> = (!wanted.per_patch)
+        .then(|| shown.clone())
+        .into_iter()
+        .collect();
+    args.files
+        .check_saved(&shown, &identity, wanted, &without_sums)?;
     let mut cfg = identity
         .config()
         .map_err(|e| Failure::bad_input(format!("{}: {e}", file.display())))?;
@@ -375,12 +365,6 @@ pub fn run(args: &AnalyzeArgs) -> Result<Exit, Failure> {
         Some(file) => resumed_run(args, file)?,
         None => new_run(args, args.scene.as_deref().unwrap_or("-"))?,
     };
-    if args.resume.is_some() && !args.files.patches.is_empty() {
-        warn(
-            "a run state keeps no per-patch sums of eq. (27): the I_s^c and lost-information columns \
-             of --patches stay empty for a resumed run",
-        );
-    }
     let cfg = AnalysisConfig {
         per_patch: !args.files.patches.is_empty(),
         ..cfg
@@ -435,10 +419,9 @@ pub fn run(args: &AnalyzeArgs) -> Result<Exit, Failure> {
         shard: identity.shard,
         ..runner.info()
     };
-    runner.pool.install(|| {
-        patches::write_patches(&args.files.patches, &runner.scene, &analysis)?;
-        patches::write_form_factors(&args.files.form_factors, &runner.scene, &analysis)
-    })?;
+    runner
+        .pool
+        .install(|| args.files.write(&runner.scene, &analysis))?;
     let text = report::render(args.format, &run, &analysis);
     output::emit(args.out.output.as_deref(), &text)?;
     Ok(if analysis.stop_reason == StopReason::Interrupted {

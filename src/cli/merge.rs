@@ -4,12 +4,13 @@
 use std::path::PathBuf;
 
 use scene_complexity::run::persist;
-use scene_complexity::run::{finish, RunState, SavedRun, StopReason};
+use scene_complexity::run::{finish, AnalysisConfig, RunState, SavedRun, StopReason};
 use scene_complexity::trace::{Backend, Query};
 
 use super::analyze::{check_same_scene, persist_failure};
 use super::args::{parse_threads, ReportOutput};
 use super::output::{self, check_all, warn};
+use super::patches::PatchFiles;
 use super::report::Format;
 use super::runner::Runner;
 use super::{report, Exit, Failure};
@@ -39,10 +40,20 @@ pub struct MergeArgs {
     format: Format,
     #[command(flatten)]
     out: ReportOutput,
+    #[command(flatten)]
+    files: PatchFiles,
+}
+
+/// The states merged: the whole run, the first state's file, and the files of the states that keep no
+/// per-patch sums of eq. (27).
+struct Merged {
+    run: SavedRun,
+    first: String,
+    without_sums: Vec<String>,
 }
 
 /// Loads every state, refusing, with the files named, states of different runs and overlapping ones.
-fn merged(args: &MergeArgs) -> Result<(SavedRun, String), Failure> {
+fn merged(args: &MergeArgs) -> Result<Merged, Failure> {
     let mut seconds = 0.0;
     let mut runs = Vec::new();
     for path in &args.states {
@@ -52,6 +63,11 @@ fn merged(args: &MergeArgs) -> Result<(SavedRun, String), Failure> {
         ));
     }
     seconds += runs.iter().map(|(_, r)| r.seconds).sum::<f64>();
+    let without_sums = runs
+        .iter()
+        .filter(|(_, r)| !r.state.wanted().per_patch)
+        .map(|(name, _)| name.clone())
+        .collect();
     let (first_name, first) = runs.remove(0);
     let mut state: RunState = first.state;
     let identity = first.identity;
@@ -66,14 +82,15 @@ fn merged(args: &MergeArgs) -> Result<(SavedRun, String), Failure> {
             .absorb(run.state)
             .map_err(|e| Failure::bad_input(format!("{name} cannot join {first_name}: {e}")))?;
     }
-    Ok((
-        SavedRun {
+    Ok(Merged {
+        run: SavedRun {
             identity,
             state,
             seconds,
         },
-        first_name,
-    ))
+        first: first_name,
+        without_sums,
+    })
 }
 
 /// Runs `scx merge`.
@@ -83,14 +100,16 @@ pub fn run(args: &MergeArgs) -> Result<Exit, Failure> {
             .into_iter()
             .flatten(),
     )?;
-    let (
-        SavedRun {
+    args.files.check()?;
+    let Merged {
+        run: SavedRun {
             identity,
             state,
             seconds,
         },
         first,
-    ) = merged(args)?;
+        without_sums,
+    } = merged(args)?;
     let plan = state.plan();
     let missing = state.done().missing(plan.batches());
     if !missing.is_empty() {
@@ -130,9 +149,15 @@ pub fn run(args: &MergeArgs) -> Result<Exit, Failure> {
     let query = Query::parse(&identity.query).map_err(Failure::bad_input)?;
     let runner = Runner::with(&spec, &identity.reading, backend, query, args.threads)?;
     check_same_scene(&first, &identity, &runner)?;
+    args.files
+        .check_saved(&first, &identity, state.wanted(), &without_sums)?;
     let cfg = identity
         .config()
         .map_err(|e| Failure::bad_input(format!("{first}: {e}")))?;
+    let cfg = AnalysisConfig {
+        per_patch: !args.files.patches.is_empty(),
+        ..cfg
+    };
     if let Some(path) = &args.save {
         persist::save(path, &identity, &state, seconds).map_err(persist_failure)?;
         output::wrote(path);
@@ -150,6 +175,9 @@ pub fn run(args: &MergeArgs) -> Result<Exit, Failure> {
         shard: None,
         ..runner.info()
     };
+    runner
+        .pool
+        .install(|| args.files.write(&runner.scene, &analysis))?;
     let text = report::render(args.format, &info, &analysis);
     output::emit(args.out.output.as_deref(), &text)?;
     Ok(Exit::Ok)

@@ -113,7 +113,8 @@ enum Command {
     #[command(after_help = concat!(
         "Example:\n",
         "  for k in 1 2 3 4; do scx analyze @cube:30 --lines 1e9 --shard $k/4 --save part-$k.scx & done; wait\n",
-        "  scx merge part-*.scx --format json -o cube30.json"
+        "  scx merge part-*.scx --format json -o cube30.json\n",
+        "  scx merge part-*.scx --patches patches.csv --form-factors ff.mtx   (shards run with --patches)"
     ))]
     Merge(merge::MergeArgs),
     /// Regenerate the paper's Tables 1 to 9 and print each beside the published values (Markdown).

@@ -1,5 +1,5 @@
-//! `scx analyze --patches FILE` and `--form-factors FILE`: the per-patch results and the sparse
-//! form-factor matrix, written for pandas, polars, numpy and scipy.
+//! `--patches FILE` and `--form-factors FILE` of `scx analyze` and `scx merge`: the per-patch results
+//! and the sparse form-factor matrix, written for pandas, polars, numpy and scipy.
 //!
 //! * `--patches x.csv`: one row per patch, in the order `scx export` writes the faces (README,
 //!   "Per-patch results" lists the columns and their units);
@@ -15,12 +15,97 @@ use rayon::prelude::*;
 
 use scene_complexity::geom::Point;
 use scene_complexity::measure::Estimate;
-use scene_complexity::run::{Analysis, PatchEstimate};
+use scene_complexity::run::{Analysis, PatchEstimate, RunIdentity};
 use scene_complexity::sample::counts::PairCounts;
+use scene_complexity::sample::tally::Wanted;
 use scene_complexity::scene::Scene;
 
-use super::output::{io_failure, wrote};
+use super::output::{self, io_failure, warn, wrote};
 use super::Failure;
+
+/// The per-patch files of `scx analyze` and `scx merge`.
+#[derive(clap::Args, Debug)]
+pub struct PatchFiles {
+    /// Also write one row per patch to FILE (.csv): id (the order `scx export` writes faces), material,
+    /// area, centroid and normal in the scene's units, segments N_i, row entropy, its terms of I_s and
+    /// I_s^c, the information it loses, radiosity when lit, each with its standard error. Repeat to
+    /// write several files. After --resume or `scx merge`, the I_s^c and lost-information columns need
+    /// the per-patch sums a run state keeps only when its run was asked for --patches.
+    #[arg(long, value_name = "FILE")]
+    pub patches: Vec<PathBuf>,
+    /// Also write the sparse form-factor matrix to FILE: `.csv` (i, j, n_ij, n_i, f_ij, f_ij_stderr) or
+    /// `.mtx` (Matrix Market, for scipy.io.mmread). Repeat to write both.
+    #[arg(long, value_name = "FILE")]
+    pub form_factors: Vec<PathBuf>,
+}
+
+impl PatchFiles {
+    /// Whether no per-patch file was asked for.
+    pub fn is_empty(&self) -> bool {
+        self.patches.is_empty() && self.form_factors.is_empty()
+    }
+
+    /// Checks, before any work, the files' kinds and that they can be written.
+    pub fn check(&self) -> Result<(), Failure> {
+        if self.is_empty() {
+            return Ok(());
+        }
+        check_patch_files(&self.patches)?;
+        check_matrix_files(&self.form_factors)?;
+        output::check_all(
+            self.patches
+                .iter()
+                .chain(&self.form_factors)
+                .map(PathBuf::as_path),
+        )
+    }
+
+    /// Checks, before any line is cast or any measure computed, that a saved run (read from `file`, or
+    /// the merge of states whose first is `file`) can give these files: it must have counted patch
+    /// pairs and not closed the scene. `wanted` is what the run gathers, and `without_sums` the state
+    /// files that keep no per-patch sums of eq. (27) although their run computes I_s^c (their run was
+    /// not asked for `--patches`): then the I_s^c columns are left empty, and a warning names them,
+    /// rather than sharing out sums of only some of the lines.
+    pub fn check_saved(
+        &self,
+        file: &str,
+        identity: &RunIdentity,
+        wanted: Wanted,
+        without_sums: &[String],
+    ) -> Result<(), Failure> {
+        if self.is_empty() {
+            return Ok(());
+        }
+        if identity.enclose {
+            return Err(Failure::bad_input(format!(
+                "{file}: the run closed the scene with --enclose; --patches and --form-factors \
+                 describe the scene's own patches"
+            )));
+        }
+        if !wanted.discrete {
+            return Err(Failure::bad_input(format!(
+                "{file}: the run counted no patch pairs (--measures without discrete): it has no \
+                 per-patch results or form factors"
+            )));
+        }
+        if !self.patches.is_empty() && wanted.continuous && !without_sums.is_empty() {
+            warn(&format!(
+                "{}: saved without the per-patch sums of eq. (27) (the run was not asked for \
+                 --patches), so the continuous_mutual_information_term and lost_information columns \
+                 of --patches stay empty; give --patches to the first run (to every shard) to have \
+                 them",
+                without_sums.join(", ")
+            ));
+        }
+        Ok(())
+    }
+
+    /// Writes every file asked for from a finished analysis.
+    pub fn write(&self, scene: &Scene, a: &Analysis) -> Result<(), Failure> {
+        write_patches(&self.patches, scene, a)?;
+        write_form_factors(&self.form_factors, scene, a)
+    }
+}
 
 /// The kinds of form-factor file, by extension.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -37,7 +122,7 @@ fn extension(path: &Path) -> String {
 }
 
 /// Checks, before any work, that every per-patch file is a `.csv`.
-pub fn check_patch_files(paths: &[PathBuf]) -> Result<(), Failure> {
+fn check_patch_files(paths: &[PathBuf]) -> Result<(), Failure> {
     for p in paths {
         if extension(p) != "csv" {
             return Err(Failure::bad_input(format!(
@@ -61,12 +146,12 @@ fn matrix_format(path: &Path) -> Result<MatrixFormat, Failure> {
 }
 
 /// Checks, before any work, that every form-factor file has a known extension.
-pub fn check_matrix_files(paths: &[PathBuf]) -> Result<(), Failure> {
+fn check_matrix_files(paths: &[PathBuf]) -> Result<(), Failure> {
     paths.iter().try_for_each(|p| matrix_format(p).map(drop))
 }
 
 /// Writes the per-patch results to every file in `paths`.
-pub fn write_patches(paths: &[PathBuf], scene: &Scene, a: &Analysis) -> Result<(), Failure> {
+fn write_patches(paths: &[PathBuf], scene: &Scene, a: &Analysis) -> Result<(), Failure> {
     if paths.is_empty() {
         return Ok(());
     }
@@ -82,7 +167,7 @@ pub fn write_patches(paths: &[PathBuf], scene: &Scene, a: &Analysis) -> Result<(
 }
 
 /// Writes the form-factor matrix to every file in `paths`.
-pub fn write_form_factors(paths: &[PathBuf], scene: &Scene, a: &Analysis) -> Result<(), Failure> {
+fn write_form_factors(paths: &[PathBuf], scene: &Scene, a: &Analysis) -> Result<(), Failure> {
     if paths.is_empty() {
         return Ok(());
     }

@@ -7,7 +7,10 @@
 //! The payload holds the run's identity ([`RunIdentity`]: scene fingerprint, scx version, seed, line
 //! source, tracer, groups, estimator, ...), its batch plan, the batches done, and each group's tally: its
 //! counters, and its escapes and pair counts as sparse lists whose sorted keys are stored as differences
-//! (mostly one or two bytes each).
+//! (mostly one or two bytes each); and, when the run was asked for per-patch results (`--patches`), its
+//! per-patch sums of eq. (27) ([`PatchKernelSums`]), without which a resumed or merged run could not
+//! share I_s^c out among the patches. States written before those sums were kept load as states without
+//! them.
 //!
 //! Files are written atomically (a temporary file beside the target, synced, then renamed over it), so a
 //! run killed while saving leaves the previous state intact.
@@ -24,7 +27,9 @@ use super::plan::{BatchPlan, BatchSet};
 use super::state::RunState;
 use crate::measure::estimators::EntropyEstimator;
 use crate::sample::counts::{pair_key, split_key, PairCounts};
+use crate::sample::exact::ExactSum;
 use crate::sample::lines::LineSource;
+use crate::sample::patch_sums::PatchKernelSums;
 use crate::sample::tally::{Counters, ObjectSides, Tally, Wanted};
 use crate::scene::{Scene, SceneOptions};
 
@@ -270,6 +275,10 @@ struct Wire {
     batch_size: u64,
     discrete: bool,
     continuous: bool,
+    /// Whether the tallies hold the per-patch sums of eq. (27) (absent from the states of scx before
+    /// they were kept: those have none).
+    #[serde(default)]
+    per_patch: bool,
     done: Vec<[u64; 2]>,
     groups: Vec<Option<TallyWire>>,
     tail: Option<(u64, TallyWire)>,
@@ -287,6 +296,20 @@ struct TallyWire {
     /// back sides seen from front sides.
     #[serde(default)]
     orientation: Vec<[u64; 4]>,
+    /// Per patch, the sum of eq. (27)'s log kernel over its pair ends and how many ends, when the run
+    /// gathers them ([`Wanted::per_patch`]). The sums are stored as their fixed-point integers, so a
+    /// state read back, resumed or merged adds up to the same bits as the run cast at once.
+    #[serde(default)]
+    kernel_by_patch: Option<KernelWire>,
+}
+
+/// [`PatchKernelSums`] as stored: one entry per patch in each list. Dense, not sparse: in any run
+/// long enough to be worth a per-patch table every patch of a group has pair ends, and a patch without
+/// any costs two bytes.
+#[derive(Serialize, Deserialize)]
+struct KernelWire {
+    log2_kernel: Vec<ExactSum>,
+    ends: Vec<u64>,
 }
 
 /// Sorted `(key, value)` entries as key differences and values.
@@ -343,6 +366,10 @@ fn tally_wire(t: &Tally) -> TallyWire {
             .iter()
             .map(|o| [o.back_from_open, o.back_to_open, o.front_open, o.back_seen])
             .collect(),
+        kernel_by_patch: t.kernel_by_patch.as_ref().map(|k| KernelWire {
+            log2_kernel: k.log2_kernel.clone(),
+            ends: k.ends.clone(),
+        }),
     }
 }
 
@@ -379,12 +406,27 @@ fn tally_of(w: &TallyWire, patches: usize, wanted: Wanted) -> Option<Tally> {
             },
         )
         .collect();
+    // Sums for a run that gathers none, or none for one that does, would make the state's groups
+    // disagree on what they hold: inconsistent.
+    let kernel_by_patch = match (&w.kernel_by_patch, wanted.per_patch) {
+        (Some(k), true) => {
+            if k.log2_kernel.len() != patches || k.ends.len() != patches {
+                return None;
+            }
+            Some(PatchKernelSums {
+                log2_kernel: k.log2_kernel.clone(),
+                ends: k.ends.clone(),
+            })
+        }
+        (None, false) => None,
+        _ => return None,
+    };
     Some(Tally {
         counters: w.counters,
         orientation,
         escapes_by_patch,
         counts,
-        kernel_by_patch: None,
+        kernel_by_patch,
     })
 }
 
@@ -397,6 +439,7 @@ pub fn encode(identity: &RunIdentity, state: &RunState, seconds: f64) -> Vec<u8>
         batch_size: parts.plan.batch_size,
         discrete: parts.wanted.discrete,
         continuous: parts.wanted.continuous,
+        per_patch: parts.wanted.per_patch,
         done: parts
             .done
             .ranges()
@@ -466,11 +509,14 @@ fn state_of(w: Wire) -> Option<SavedRun> {
     if plan.batch_size == 0 || w.groups.is_empty() {
         return None;
     }
-    // The per-patch sums of eq. (27) are not kept in a run state: a resumed run has none.
+    // The per-patch sums need the pair keys (the discrete counts) to be gathered at all.
+    if w.per_patch && !w.discrete {
+        return None;
+    }
     let wanted = Wanted {
         discrete: w.discrete,
         continuous: w.continuous,
-        per_patch: false,
+        per_patch: w.per_patch,
     };
     let patches = usize::try_from(w.identity.patches).ok()?;
     let groups = w
@@ -612,5 +658,138 @@ mod tests {
             assert!(message(&flipped).contains("checksum"));
             assert!(message(b"v 0 0 0\nf 1 2 3\n").contains("not an scx run state"));
         }
+    }
+
+    /// A run of `cfg` on `@cube:3`, cast at once, its scene and state.
+    fn cube_run(cfg: &AnalysisConfig) -> (Scene, RunState) {
+        let scene = crate::scenes::load("@cube:3").unwrap();
+        let tracer = make_tracer(Backend::Rust, &scene, Query::Single).unwrap();
+        let mut state = start(&scene, cfg).unwrap();
+        cast(
+            &scene,
+            tracer.as_ref(),
+            cfg,
+            &mut state,
+            CastOptions::default(),
+            &RunControl::default(),
+            &mut |_| {},
+        )
+        .unwrap();
+        (scene, state)
+    }
+
+    /// The bytes of a state file around a CBOR payload (what `encode` adds).
+    fn framed(payload: &[u8]) -> Vec<u8> {
+        let mut out = MAGIC.to_vec();
+        out.extend_from_slice(&FORMAT_VERSION.to_le_bytes());
+        out.extend_from_slice(&(payload.len() as u64).to_le_bytes());
+        out.extend_from_slice(&crc32fast::hash(payload).to_le_bytes());
+        out.extend_from_slice(payload);
+        out
+    }
+
+    /// The per-patch sums of eq. (27) of a run asked for per-patch results survive a save, to the last
+    /// bit, in every group and the partial last batch; a run not asked for them saves none.
+    #[test]
+    fn per_patch_sums_round_trip() {
+        // 70 000 lines: batches of 1024 and a partial last one, kept apart in the state.
+        for per_patch in [true, false] {
+            let cfg = AnalysisConfig {
+                per_patch,
+                ..AnalysisConfig::new(70_000, 5)
+            };
+            let (scene, state) = cube_run(&cfg);
+            assert!(state.parts().tail.is_some(), "the run has a partial batch");
+            let identity = RunIdentity::of(
+                "@cube:3",
+                &SceneOptions::default(),
+                &scene,
+                &cfg,
+                "rust",
+                "single",
+                None,
+            );
+            let back = decode("s.scx", &encode(&identity, &state, 0.5))
+                .unwrap()
+                .state;
+            assert_eq!(back.wanted(), state.wanted());
+            assert_eq!(back.wanted().per_patch, per_patch);
+            let sums = |s: &RunState| -> Vec<Option<PatchKernelSums>> {
+                let parts = s.parts();
+                let tail = parts.tail.map(|(_, t)| t);
+                parts
+                    .groups
+                    .iter()
+                    .flatten()
+                    .chain(tail)
+                    .map(|t| t.kernel_by_patch.clone())
+                    .collect()
+            };
+            let (ours, theirs) = (sums(&state), sums(&back));
+            assert_eq!(ours, theirs);
+            assert!(ours.iter().all(|k| k.is_some() == per_patch));
+            let (a, b) = (state.finish(&scene), back.finish(&scene));
+            assert_eq!(a.total.kernel_by_patch, b.total.kernel_by_patch);
+        }
+    }
+
+    /// A state written before the per-patch sums were kept (no `per_patch` and no `kernel_by_patch`
+    /// fields) still loads, as a state without them; one that claims the sums but lacks them in a group
+    /// is refused.
+    #[test]
+    fn states_without_the_per_patch_fields_load() {
+        let cfg = AnalysisConfig {
+            per_patch: true,
+            ..AnalysisConfig::new(20_000, 2)
+        };
+        let (scene, state) = cube_run(&cfg);
+        assert!(state.parts().tail.is_some(), "the run has a partial batch");
+        let identity = RunIdentity::of(
+            "@cube:3",
+            &SceneOptions::default(),
+            &scene,
+            &cfg,
+            "rust",
+            "single",
+            None,
+        );
+        let bytes = encode(&identity, &state, 1.0);
+        let mut doc: ciborium::Value = ciborium::from_reader(&bytes[HEADER..]).unwrap();
+        let strip = |doc: &mut ciborium::Value, per_patch_flag: bool| {
+            let map = doc.as_map_mut().unwrap();
+            if per_patch_flag {
+                map.retain(|(k, _)| k.as_text() != Some("per_patch"));
+            }
+            // The groups' tallies, and the partial last batch's (`[batch, tally]`).
+            for (k, v) in map.iter_mut() {
+                let tallies = match k.as_text() {
+                    Some("groups") => v.as_array_mut().unwrap(),
+                    Some("tail") => match v.as_array_mut() {
+                        Some(pair) => &mut pair[1..],
+                        None => continue,
+                    },
+                    _ => continue,
+                };
+                for t in tallies.iter_mut().filter_map(|t| t.as_map_mut()) {
+                    t.retain(|(k, _)| k.as_text() != Some("kernel_by_patch"));
+                }
+            }
+        };
+        // Only the groups' sums removed: the state says it has them and does not.
+        let mut damaged = doc.clone();
+        strip(&mut damaged, false);
+        let mut payload = Vec::new();
+        ciborium::into_writer(&damaged, &mut payload).unwrap();
+        let message = decode("d.scx", &framed(&payload)).unwrap_err().to_string();
+        assert!(message.contains("inconsistent"), "{message}");
+        // Both removed: a state of an older scx.
+        strip(&mut doc, true);
+        let mut payload = Vec::new();
+        ciborium::into_writer(&doc, &mut payload).unwrap();
+        let old = decode("old.scx", &framed(&payload)).unwrap();
+        assert!(!old.state.wanted().per_patch);
+        let (a, b) = (state.finish(&scene), old.state.finish(&scene));
+        assert_eq!(a.total.counters, b.total.counters);
+        assert!(b.total.kernel_by_patch.is_none());
     }
 }

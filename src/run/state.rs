@@ -257,6 +257,7 @@ impl RunState {
     }
 
     /// Adds the state of another part of the same run (a shard): the groups' tallies and the batches.
+    /// The result keeps the per-patch sums of eq. (27) only when both parts have them.
     pub fn absorb(&mut self, other: RunState) -> Result<(), MergeError> {
         if other.plan != self.plan || other.groups.len() != self.groups.len() {
             return Err(MergeError::Mismatch(format!(
@@ -269,7 +270,8 @@ impl RunState {
                 other.groups.len()
             )));
         }
-        if other.wanted != self.wanted {
+        let measures = |w: Wanted| (w.discrete, w.continuous);
+        if measures(other.wanted) != measures(self.wanted) {
             return Err(MergeError::Mismatch("different measures".into()));
         }
         if self.done.overlaps(&other.done) {
@@ -293,9 +295,23 @@ impl RunState {
                 (Some(_), None) => {}
             }
         }
+        // A part without the per-patch sums of eq. (27) (its run was not asked for per-patch results)
+        // leaves the whole without them: sums over only some of the lines would be silently wrong.
+        if !(self.wanted.per_patch && other.wanted.per_patch) {
+            self.drop_per_patch();
+        }
         self.total_counts = None;
         self.keeps_total = false;
         Ok(())
+    }
+
+    /// Forgets the per-patch sums of eq. (27), in every group and the partial last batch.
+    fn drop_per_patch(&mut self) {
+        self.wanted.per_patch = false;
+        let tail = self.tail.as_mut().map(|(_, t)| t);
+        for t in self.groups.iter_mut().flatten().chain(tail) {
+            t.kernel_by_patch = None;
+        }
     }
 
     /// The state of the same run extended to the longer plan `plan` (resuming to more lines): the

@@ -301,10 +301,11 @@ fn per_patch_files_are_checked_before_work() {
     assert_eq!(out.status.code(), Some(3));
 }
 
-/// A resumed run keeps no per-patch sums of eq. (27): it says so, and leaves those columns empty
-/// rather than filling them from part of the lines.
+/// A run resumed from a state whose first run was not asked for `--patches` has no per-patch sums of
+/// eq. (27): it says so, and leaves those columns empty rather than filling them from part of the lines
+/// (with the sums kept, `tests/it/runs.rs` checks the files against the run cast at once).
 #[test]
-fn a_resumed_run_leaves_the_continuous_columns_empty_and_says_so() {
+fn a_resumed_run_without_the_sums_leaves_the_continuous_columns_empty_and_says_so() {
     let dir = tempfile::tempdir().unwrap();
     let (state, csv) = (dir.path().join("run.state"), dir.path().join("p.csv"));
     let out = scx(&[

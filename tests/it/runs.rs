@@ -340,3 +340,276 @@ fn resumed_and_merged_runs_read_the_scene_file_as_first_read() {
     ]);
     assert_eq!(flipped["pairs"], 0, "a room turned inside out has no pairs");
 }
+
+/// The per-patch files asked of a run: the per-patch table and the form factors in both formats, as
+/// command-line arguments writing into `dir` with names beginning with `stem`.
+fn patch_file_args(dir: &Path, stem: &str) -> Vec<String> {
+    let file = |ext: &str| {
+        dir.join(format!("{stem}{ext}"))
+            .to_str()
+            .unwrap()
+            .to_string()
+    };
+    vec![
+        "--patches".into(),
+        file("-patches.csv"),
+        "--form-factors".into(),
+        file("-ff.csv"),
+        "--form-factors".into(),
+        file("-ff.mtx"),
+    ]
+}
+
+/// The bytes of the per-patch files of `patch_file_args(dir, stem)`.
+fn patch_files(dir: &Path, stem: &str) -> Vec<(String, Vec<u8>)> {
+    ["-patches.csv", "-ff.csv", "-ff.mtx"]
+        .iter()
+        .map(|ext| {
+            let name = format!("{stem}{ext}");
+            let bytes = std::fs::read(dir.join(&name))
+                .unwrap_or_else(|e| panic!("{name} was not written: {e}"));
+            (name, bytes)
+        })
+        .collect()
+}
+
+/// Asserts that two runs' per-patch files are the same bytes.
+fn assert_same_files(a: &[(String, Vec<u8>)], b: &[(String, Vec<u8>)], what: &str) {
+    for ((name_a, x), (name_b, y)) in a.iter().zip(b) {
+        assert!(!x.is_empty(), "{what}: {name_a} is empty");
+        assert!(x == y, "{what}: {name_b} differs from {name_a}");
+    }
+}
+
+/// `a` followed by `b`.
+fn joined<'a>(a: &[&'a str], b: &[&'a str]) -> Vec<&'a str> {
+    a.iter().chain(b).copied().collect()
+}
+
+/// Runs scx with `args` and the per-patch file arguments, and checks it succeeded.
+fn run_with_files(args: &[&str], files: &[String]) -> serde_json::Value {
+    let mut all: Vec<&str> = args.to_vec();
+    all.extend(files.iter().map(String::as_str));
+    run_json(&all)
+}
+
+/// `--patches` and `--form-factors` after `--resume` from a half-way state, and from `scx merge` of 3
+/// shards, write the very bytes of the run cast at once: the per-patch sums of eq. (27) travel in the
+/// states, as exact integers. On a closed cube and on the lit Cornell box (radiosity columns).
+#[test]
+fn per_patch_files_of_resumed_and_merged_runs_are_the_single_runs() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let state = |name: &str| d.join(name).to_str().unwrap().to_string();
+    let cornell = scene_file("cornell.obj");
+    for scene in ["@cube:4", cornell.as_str()] {
+        let base = ["analyze", scene, "--tracer", "rust", "--format", "json"];
+        let single = run_with_files(
+            &joined(&base, &["--lines", "6e5"]),
+            &patch_file_args(d, "single"),
+        );
+        let single_files = patch_files(d, "single");
+        // The columns that need the per-patch sums are filled, and the radiosities of the lit box.
+        let text = String::from_utf8_lossy(&single_files[0].1).to_string();
+        let mut lines = text.lines().map(|l| l.split(',').collect::<Vec<_>>());
+        let (header, row) = (lines.next().unwrap(), lines.next().unwrap());
+        let cell = |name: &str| row[header.iter().position(|h| *h == name).unwrap()];
+        assert!(
+            !cell("continuous_mutual_information_term").is_empty(),
+            "{scene}"
+        );
+        assert!(
+            !cell("lost_information_corrected_stderr").is_empty(),
+            "{scene}"
+        );
+        assert_eq!(cell("radiosity").is_empty(), scene == "@cube:4", "{scene}");
+
+        // (a) Half the lines saved (the half-way run asked for the per-patch table too, so its state
+        // keeps the sums), then resumed to all of them.
+        let half = state("half.scx");
+        run_with_files(
+            &joined(&base, &["--lines", "3e5", "--save", &half, "-q"]),
+            &patch_file_args(d, "half"),
+        );
+        let resumed = run_with_files(
+            &[
+                "analyze", "--resume", &half, "--lines", "6e5", "--format", "json", "-q",
+            ],
+            &patch_file_args(d, "resumed"),
+        );
+        assert_same(&single, &resumed, &format!("{scene} resumed"));
+        assert_same_files(
+            &single_files,
+            &patch_files(d, "resumed"),
+            &format!("{scene} resumed"),
+        );
+
+        // (b) 3 shards, merged in another order.
+        let mut parts = Vec::new();
+        for k in 1..=3 {
+            let part = state(&format!("part{k}.scx"));
+            let shard = format!("{k}/3");
+            run_with_files(
+                &joined(
+                    &base,
+                    &["--lines", "6e5", "--shard", &shard, "--save", &part, "-q"],
+                ),
+                &patch_file_args(d, &format!("shard{k}")),
+            );
+            parts.push(part);
+        }
+        let merge: Vec<&str> = ["merge", "--format", "json", "-q"]
+            .into_iter()
+            .chain(parts.iter().rev().map(String::as_str))
+            .collect();
+        let merged = run_with_files(&merge, &patch_file_args(d, "merged"));
+        assert_same(&single, &merged, &format!("{scene} merged"));
+        assert_same_files(
+            &single_files,
+            &patch_files(d, "merged"),
+            &format!("{scene} merged"),
+        );
+    }
+}
+
+/// The columns of the per-patch table that need the per-patch sums of eq. (27).
+const CONTINUOUS_COLUMNS: [&str; 3] = [
+    "continuous_mutual_information_term",
+    "lost_information",
+    "lost_information_corrected",
+];
+
+/// A state saved without the per-patch sums (its run was not asked for `--patches`) cannot give the
+/// I_s^c columns: `--resume` and `scx merge` with `--patches` say so in a warning naming the file, leave
+/// those columns (and their errors) empty and write every other cell as the run cast at once. A state
+/// of a run that counted no pairs cannot give per-patch files at all: exit 2 naming it, before any work.
+#[test]
+fn states_without_per_patch_sums_say_so() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let file = |name: &str| d.join(name).to_str().unwrap().to_string();
+    let base = ["analyze", "@cube:4", "--tracer", "rust", "--format", "json"];
+    run_with_files(
+        &joined(&base, &["--lines", "6e5"]),
+        &patch_file_args(d, "single"),
+    );
+    let single = patch_files(d, "single");
+
+    // Each table without its I_s^c cells, which must be empty in the second.
+    let check = |files: &[(String, Vec<u8>)], what: &str| {
+        let table = |bytes: &[u8]| -> Vec<Vec<String>> {
+            String::from_utf8_lossy(bytes)
+                .lines()
+                .map(|l| l.split(',').map(String::from).collect())
+                .collect()
+        };
+        let (ours, theirs) = (table(&single[0].1), table(&files[0].1));
+        let header = &ours[0];
+        let continuous: Vec<usize> = (0..header.len())
+            .filter(|&k| {
+                CONTINUOUS_COLUMNS
+                    .iter()
+                    .any(|c| header[k] == *c || header[k] == format!("{c}_stderr"))
+            })
+            .collect();
+        assert_eq!(continuous.len(), 6, "{header:?}");
+        assert_eq!(ours.len(), theirs.len());
+        for (a, b) in ours.iter().zip(&theirs).skip(1) {
+            for (k, (x, y)) in a.iter().zip(b).enumerate() {
+                if continuous.contains(&k) {
+                    assert!(!x.is_empty() && y.is_empty(), "{what}: {} `{y}`", header[k]);
+                } else {
+                    assert_eq!(x, y, "{what}: {}", header[k]);
+                }
+            }
+        }
+        // The form factors need only the pair counts, which every state keeps.
+        assert_same_files(&single[1..], &files[1..], what);
+    };
+
+    let half = file("bare-half.scx");
+    run_json(&joined(&base, &["--lines", "3e5", "--save", &half, "-q"]));
+    let mut args = vec![
+        "analyze", "--resume", &half, "--lines", "6e5", "--format", "json",
+    ];
+    let files = patch_file_args(d, "resumed");
+    args.extend(files.iter().map(String::as_str));
+    let out = scx(&args);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    assert!(
+        err.contains("bare-half.scx") && err.contains("per-patch sums") && err.contains("empty"),
+        "{err}"
+    );
+    check(&patch_files(d, "resumed"), "resumed");
+
+    // Shard 2 saved without the sums, the others with them: the merge names shard 2 only.
+    let mut parts = Vec::new();
+    for k in 1..=3 {
+        let part = file(&format!("mixed{k}.scx"));
+        let shard = format!("{k}/3");
+        let args = joined(
+            &base,
+            &["--lines", "6e5", "--shard", &shard, "--save", &part, "-q"],
+        );
+        if k == 2 {
+            run_json(&args);
+        } else {
+            run_with_files(&args, &patch_file_args(d, &format!("shard{k}")));
+        }
+        parts.push(part);
+    }
+    let mut args = vec!["merge", "--format", "json"];
+    args.extend(parts.iter().map(String::as_str));
+    let files = patch_file_args(d, "merged");
+    args.extend(files.iter().map(String::as_str));
+    let out = scx(&args);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    assert!(
+        err.contains("mixed2.scx") && err.contains("per-patch sums"),
+        "{err}"
+    );
+    assert!(
+        !err.contains("mixed1.scx") && !err.contains("mixed3.scx"),
+        "{err}"
+    );
+    check(&patch_files(d, "merged"), "merged");
+
+    // No pair counts at all: refused before any work, the file named, nothing written.
+    let bare = file("continuous.scx");
+    run_json(&joined(
+        &base,
+        &[
+            "--lines",
+            "3e5",
+            "--measures",
+            "continuous",
+            "--save",
+            &bare,
+            "-q",
+        ],
+    ));
+    let table = file("none.csv");
+    for args in [
+        vec![
+            "analyze",
+            "--resume",
+            &bare,
+            "--lines",
+            "6e5",
+            "--patches",
+            &table,
+        ],
+        vec!["merge", &bare, "--patches", &table],
+    ] {
+        let out = scx(&args);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+        assert!(
+            err.contains("continuous.scx") && err.contains("no patch pairs"),
+            "{err}"
+        );
+        assert!(out.stdout.is_empty() && !Path::new(&table).exists());
+    }
+}
