@@ -61,7 +61,7 @@ pub struct RunOptions {
     /// Worker threads; 0 or absent: all cores. Results do not depend on it.
     #[arg(long, value_parser = parse_threads, allow_negative_numbers = true)]
     pub threads: Option<usize>,
-    /// Tracing backend (default: embree when built in).
+    /// Tracing backend (default: rust, the faster; embree when a packet query is asked for).
     #[arg(long, value_enum)]
     pub tracer: Option<TracerArg>,
     /// Ray query: `single`, or `packet4`/`packet8`/`packet16` (Embree, native widths only).
@@ -102,9 +102,16 @@ pub enum TracerArg {
 impl TracerArg {
     /// The backend to use: the one named, or the default.
     pub fn backend(choice: Option<TracerArg>) -> Backend {
+        Self::backend_for(choice, Query::Single)
+    }
+
+    /// The backend to use for `query`: the one named, else Embree for packets (only Embree has them),
+    /// else the default.
+    pub fn backend_for(choice: Option<TracerArg>, query: Query) -> Backend {
         match choice {
             Some(TracerArg::Embree) => Backend::Embree,
             Some(TracerArg::Rust) => Backend::Rust,
+            None if query != Query::Single => Backend::Embree,
             None => Backend::default_available(),
         }
     }

@@ -26,7 +26,7 @@ impl Runner {
         Runner::with(
             spec,
             &opts.input.options(),
-            TracerArg::backend(opts.tracer),
+            TracerArg::backend_for(opts.tracer, opts.query),
             opts.query,
             opts.threads,
         )

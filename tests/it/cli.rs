@@ -319,3 +319,25 @@ fn bundled_runs_warn_that_the_corrections_assume_independent_lines() {
     assert!(!table(&[]).contains(note));
     assert!(!table(&["--bundle", "4", "--measures", "continuous"]).contains(note));
 }
+
+/// The default tracer is the pure-Rust one in every build (the faster end to end, with Embree's hits);
+/// a packet query, which only Embree has, selects Embree.
+#[test]
+fn the_default_tracer_is_rust_and_packets_select_embree() {
+    let tracer_of = |extra: &[&str]| {
+        let mut args = vec!["analyze", "@cube:3", "--lines", "2e3", "--format", "json"];
+        args.extend(extra);
+        let out = support::scx(&args);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        v["tracer"].as_str().unwrap_or_default().to_string()
+    };
+    assert!(tracer_of(&[]).starts_with("rust"), "{}", tracer_of(&[]));
+    if cfg!(feature = "embree") {
+        assert!(tracer_of(&["--query", "packet8"]).starts_with("embree"));
+    }
+}

@@ -1,0 +1,50 @@
+#!/usr/bin/env bash
+# The README's throughput table, from one window (the machine's speed drifts 10-20% over minutes, so every
+# figure of a ratio comes from the same run of this script): raw Embree all-hits (the shared yardstick,
+# ../shared/anchors/embree-bench), our kernels (cargo bench --bench throughput, "all-hits" column), and
+# `scx analyze` end to end through the CLI with its peak memory, on S1 = @cube:30, S3 = @cube:100 (3e7
+# lines) and @cube:130 (1e8 lines), both tracers, 2 threads.
+#
+#   bash benches/window.sh            # about 15 minutes; needs the yardstick's C file and libembree3
+#   ANCHOR=/path/to/embree-bench bash benches/window.sh
+set -euo pipefail
+cd "$(dirname "$0")/.."
+anchor_dir="${ANCHOR:-../shared/anchors/embree-bench}"
+cargo build --release --bin scx --quiet
+scx=target/release/scx
+bench=$(mktemp)
+trap 'rm -f "$bench"' EXIT
+gcc -O3 -march=native -o "$bench" "$anchor_dir/bench.c" -lembree3 -lpthread -lm
+
+echo "== raw Embree all-hits (yardstick), 2 threads: the Mlines/s median of V2r and V2or"
+for s in 1 3; do
+  "$bench" -s "$s" -v V2r,V2or -t 2 -r 3 -T 4 -W 0 -X 0 | grep -E '^\| S.*\| V2' | cut -d'|' -f2-6
+done
+
+echo "== scx analyze end to end (CLI), 2 threads, median of 3 runs: M lines/s, peak RSS, bytes per distinct pair"
+for run in "@cube:30 3e7" "@cube:100 3e7" "@cube:130 1e8"; do
+  set -- $run
+  for tracer in rust embree; do
+    out=$(mktemp)
+    for k in 1 2 3; do
+      /usr/bin/time -f "%M" -o "$out.rss$k" "$scx" analyze "$1" --lines "$2" --tracer "$tracer" \
+        --threads 2 --format json -q > "$out.$k"
+    done
+    python3 - "$out" "$1" "$tracer" <<'PY'
+import json, statistics, sys
+base = sys.argv[1]
+runs = [json.load(open(f"{base}.{k}")) for k in (1, 2, 3)]
+rates = sorted(a["lines"] / a["seconds"] / 1e6 for a in runs)
+rss = max(int(open(f"{base}.rss{k}").read().split()[-1]) * 1024 for k in (1, 2, 3))
+d = runs[0]["distinct_pairs"]
+print(f"{sys.argv[2]:<10} {sys.argv[3]:<7} {statistics.median(rates):6.2f} M lines/s "
+      f"({rates[0]:.2f}-{rates[-1]:.2f})  peak {rss / 2**30:5.2f} GiB  {d} distinct pairs  "
+      f"{rss / d:6.1f} B/pair")
+PY
+    rm -f "$out" "$out".*
+  done
+done
+
+echo "== kernels alone (cargo bench --bench throughput, all-hits column; 2-thread rows)"
+SCX_BENCH_TRACERS=rust,single cargo bench --quiet --bench throughput -- @cube:30 @cube:100 3e7 \
+  | grep -E '^(scene|@)'
