@@ -11,6 +11,7 @@ use crate::run::{all_batches, map_traced_batches, LineStream};
 use crate::sample::counts::{pair_key, PairCounts};
 use crate::sample::kernel::kernel_without_pi;
 use crate::sample::pairs::{segments, LineF64, Segment};
+use crate::sample::sparse::SparseCounts;
 use crate::scene::Scene;
 use crate::trace::{TraceError, Tracer};
 
@@ -100,7 +101,7 @@ pub fn sample_pairs(
         }
     }
     Ok(PairKernelSums {
-        counts: PairCounts::Sparse(list),
+        counts: PairCounts::Sparse(SparseCounts::from_entries(scene.patch_count(), list)),
         log_kernel_sums: sums,
         log_kernel_pairs: used,
         escapes,

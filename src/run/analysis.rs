@@ -16,7 +16,7 @@ use super::batches::LineStream;
 use super::control::{Budget, RunControl, StopReason, TargetMeasure};
 use super::errors::{ErrorMethod, Spread};
 use super::patches::{self as per_patch, PatchEstimate, PatchLight};
-use super::plan::{BatchPlan, BatchSet, MAX_ROUND_LINES};
+use super::plan::{BatchPlan, BatchSet, MAX_ROUND_KEYS, MAX_ROUND_LINES};
 use super::radiosity::{self, RadiosityOutcome, SolveFailure};
 use super::readings::VisibilityEstimates;
 use super::reliability::{self, SamplingReport, Verdict, VisibilityReliability, COVERAGE_OK};
@@ -483,12 +483,11 @@ pub fn cast(
     };
     let scope = options.scope.batches(plan.batches());
     // Rounds bound the memory held in pair keys and let a budget run check itself.
-    let max_round = (MAX_ROUND_LINES / plan.batch_size).max(1);
     let first_round = (4 * state.group_count()).max(64);
     let mut round = if cfg.budget.is_open_ended() || options.round_seconds.is_some() {
         first_round
     } else {
-        max_round
+        max_round_batches(plan, wanted, state)
     };
     let mut cast_batches = 0u64;
     // The next batch to look at, and the last round's batches when they are not counted yet: without a
@@ -553,9 +552,33 @@ pub fn cast(
             // Doubling: few rounds, and a time budget is checked before every batch anyway.
             round = state.batches_done().max(64);
         }
-        round = round.min(max_round);
+        round = round.min(max_round_batches(plan, wanted, state));
     };
     Ok(stop_reason)
+}
+
+/// The most batches a round may hold: [`MAX_ROUND_LINES`], and when pairs are counted no more than
+/// about [`MAX_ROUND_KEYS`] pair keys at the run's pairs per line so far (a first round assumes four).
+/// Rounds change no number, only the memory and the time between counts.
+fn max_round_batches(plan: BatchPlan, wanted: Wanted, state: &RunState) -> u64 {
+    let by_lines = MAX_ROUND_LINES;
+    let by_keys = if wanted.discrete {
+        let (lines, pairs) = state
+            .filled_groups()
+            .iter()
+            .fold((0u64, 0u64), |(l, p), t| {
+                (l + t.counters.lines, p + t.counters.pairs)
+            });
+        let pairs_per_line = if lines > 0 {
+            pairs as f64 / lines as f64
+        } else {
+            4.0
+        };
+        (MAX_ROUND_KEYS as f64 / pairs_per_line.max(0.25)) as u64
+    } else {
+        u64::MAX
+    };
+    (by_lines.min(by_keys) / plan.batch_size).max(1)
 }
 
 /// Up to `count` batches from `cursor` to `end` that are not `done`, and where to look next.

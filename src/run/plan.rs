@@ -5,6 +5,13 @@ use crate::sample::lines::LineSource;
 /// The most lines traced in one round of a run (their pair keys are held until the round is counted).
 pub const MAX_ROUND_LINES: u64 = 1 << 25;
 
+/// The most pair keys (8 bytes each) a round of a run that counts pairs should hold. A round's keys,
+/// their sorted copy, the round's new count lists and the next round's keys are alive at once, on top
+/// of the lists of the run so far: rounds sized by the keys they hold keep that extra memory under about
+/// 3 x 8 x this many bytes whatever the scene, where rounds sized by lines held ~30 bytes per line of a
+/// full round (about a gigabyte) on scenes whose lines cross many surfaces.
+pub const MAX_ROUND_KEYS: u64 = 1 << 24;
+
 /// How `lines` lines are cut into batches: a function of the line count only, never of the threads.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct BatchPlan {

@@ -67,43 +67,42 @@ impl TracedBatches {
         out
     }
 
-    /// Deals the batches into `groups` groups and tallies each (`None` for a group without batches).
-    /// With sparse counts also returns the counts of all the groups together, from the same sort
-    /// ([`count_by_group`]).
-    fn into_group_tallies(
-        self,
-        scene: &Scene,
-        wanted: Wanted,
-        groups: u64,
-    ) -> (Vec<Option<Tally>>, Option<PairCounts>) {
+    /// Deals the batches into `groups` groups and tallies each (`None` for a group without batches);
+    /// sparse counts come from one sort of every group's keys ([`count_by_group`]).
+    fn into_group_tallies(self, scene: &Scene, wanted: Wanted, groups: u64) -> Vec<Option<Tally>> {
         let patches = scene.patch_count();
         if !wanted.discrete || patches <= DENSE_MAX_PATCHES {
-            let tallies = self
+            return self
                 .split_into_groups(groups)
                 .into_par_iter()
                 .map(|piece| (!piece.is_empty()).then(|| Tally::from_batches(scene, wanted, piece)))
                 .collect();
-            return (tallies, None);
         }
-        let keyed: Vec<(usize, &[u64])> = self
-            .batches
-            .iter()
-            .map(|(b, t)| ((b % groups) as usize, t.pair_keys.as_slice()))
-            .collect();
-        let counted = count_by_group(patches, groups as usize, &keyed);
-        let tallies = self
+        // The counters (and per-patch sums) first, then the keys are counted: the sort frees them as it
+        // deals them.
+        type GroupKeys = Vec<(usize, Vec<u64>)>;
+        let (sums, keyed): (Vec<Option<Tally>>, Vec<GroupKeys>) = self
             .split_into_groups(groups)
             .into_par_iter()
-            .zip(counted.groups)
-            .map(|(piece, counts)| {
-                (!piece.is_empty()).then(|| {
-                    let (mut tally, _) = Tally::sum_batches(scene, wanted, piece);
+            .enumerate()
+            .map(|(g, piece)| {
+                if piece.is_empty() {
+                    return (None, Vec::new());
+                }
+                let (tally, keys) = Tally::sum_batches(scene, wanted, piece);
+                (Some(tally), keys.into_iter().map(|k| (g, k)).collect())
+            })
+            .unzip();
+        let counted = count_by_group(patches, groups as usize, keyed.concat());
+        sums.into_iter()
+            .zip(counted)
+            .map(|(tally, counts)| {
+                tally.map(|mut tally| {
                     tally.counts = Some(PairCounts::Sparse(counts));
                     tally
                 })
             })
-            .collect();
-        (tallies, Some(PairCounts::Sparse(counted.total)))
+            .collect()
     }
 }
 
@@ -112,13 +111,9 @@ impl TracedBatches {
 pub struct RunState {
     plan: BatchPlan,
     wanted: Wanted,
+    /// The groups' tallies. The run's total counts are not kept beside them: they are summed once,
+    /// when the run finishes, so that a long run on a large mesh holds only the groups' lists.
     groups: Vec<Option<Tally>>,
-    /// With sparse counts, those of all the groups together (counted with the groups', so that the
-    /// total needs no merging of the groups at the end); `None` when not kept (then summed at the end).
-    total_counts: Option<PairCounts>,
-    /// Whether `total_counts` follows every batch: only a state built batch by batch from empty (a
-    /// loaded or merged one sums its groups at the end instead).
-    keeps_total: bool,
     /// The batches added, the partial last batch among them.
     done: BatchSet,
     /// The tally of the plan's last batch when it is partial (fewer lines than the others), kept apart
@@ -153,8 +148,6 @@ impl RunState {
             plan,
             wanted,
             groups: vec![None; groups],
-            total_counts: None,
-            keeps_total: true,
             done: BatchSet::default(),
             tail: None,
         }
@@ -171,7 +164,7 @@ impl RunState {
         }
     }
 
-    /// A state from its saved parts (the total's counts are summed again when the run finishes).
+    /// A state from its saved parts.
     pub fn from_parts(
         plan: BatchPlan,
         wanted: Wanted,
@@ -183,8 +176,6 @@ impl RunState {
             plan,
             wanted,
             groups,
-            total_counts: None,
-            keeps_total: false,
             done,
             tail,
         }
@@ -235,25 +226,15 @@ impl RunState {
             let (b, t) = traced.batches.remove(k);
             self.tail = Some((b, Tally::from_batches(scene, self.wanted, vec![t])));
         }
-        let (tallies, total_counts) =
-            traced.into_group_tallies(scene, self.wanted, self.group_count());
-        let keeps_total = self.keeps_total;
-        let merge_total = || match (&mut self.total_counts, total_counts) {
-            _ if !keeps_total => {}
-            (Some(t), Some(new)) => t.merge(&new),
-            (slot, new) => *slot = slot.take().or(new),
-        };
-        let merge_groups = || {
-            self.groups
-                .par_iter_mut()
-                .zip(tallies)
-                .for_each(|(slot, tally)| match (slot.as_mut(), tally) {
-                    (Some(t), Some(new)) => t.merge(&new),
-                    (None, new) => *slot = new,
-                    (Some(_), None) => {}
-                });
-        };
-        rayon::join(merge_total, merge_groups);
+        let tallies = traced.into_group_tallies(scene, self.wanted, self.group_count());
+        self.groups
+            .par_iter_mut()
+            .zip(tallies)
+            .for_each(|(slot, tally)| match (slot.as_mut(), tally) {
+                (Some(t), Some(new)) => t.merge(&new),
+                (None, new) => *slot = new,
+                (Some(_), None) => {}
+            });
     }
 
     /// Adds the state of another part of the same run (a shard): the groups' tallies and the batches.
@@ -300,8 +281,6 @@ impl RunState {
         if !(self.wanted.per_patch && other.wanted.per_patch) {
             self.drop_per_patch();
         }
-        self.total_counts = None;
-        self.keeps_total = false;
         Ok(())
     }
 
@@ -338,16 +317,13 @@ impl RunState {
                 Some(g) => g.merge(&t),
                 None => *slot = Some(t.clone()),
             }
-            if let (Some(total), Some(c)) = (&mut self.total_counts, &t.counts) {
-                total.merge(c);
-            }
         }
         let groups: Vec<Tally> = self.groups.into_iter().flatten().collect();
-        // The counts are integers and the sums exact: added in any order. The sparse counts were counted
-        // with the groups'; the dense ones, or those of a loaded state, are added up here.
+        // The counts are integers and the sums exact: added in any order.
         let sums = groups.iter().map(Tally::without_counts).collect();
         let mut total = merge_tree(sums).unwrap_or_else(|| Tally::empty(scene, self.wanted));
-        total.counts = self.total_counts.or_else(|| counts_total(&groups));
+        let counts: Vec<&PairCounts> = groups.iter().filter_map(|t| t.counts.as_ref()).collect();
+        total.counts = PairCounts::sum_of(&counts);
         FinishedRun { total, groups }
     }
 }
@@ -365,14 +341,6 @@ pub struct StateParts<'a> {
     pub done: &'a BatchSet,
     /// The partial last batch's tally, kept apart.
     pub tail: Option<&'a (u64, Tally)>,
-}
-
-/// The sum of the groups' counts (`None` without counts).
-fn counts_total(groups: &[Tally]) -> Option<PairCounts> {
-    let mut counts = groups.iter().filter_map(|t| t.counts.as_ref());
-    let mut total = counts.next()?.clone();
-    counts.for_each(|c| total.merge(c));
-    Some(total)
 }
 
 /// Merges tallies pairwise in a balanced binary tree, the two halves in parallel; every count is merged

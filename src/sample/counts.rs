@@ -7,27 +7,19 @@
 use ndarray::Array2;
 use rayon::prelude::*;
 
+pub use super::sparse::{pair_key, split_key};
+use super::sparse::{Packing, SparseCounts};
+
 /// Scenes with at most this many patches keep their counts in a dense matrix (32 MiB at most).
 pub const DENSE_MAX_PATCHES: usize = 2048;
-
-/// The key of an unordered pair: `min << 32 | max`.
-pub fn pair_key(a: u32, b: u32) -> u64 {
-    let (lo, hi) = if a <= b { (a, b) } else { (b, a) };
-    (u64::from(lo) << 32) | u64::from(hi)
-}
-
-/// The two patches of a pair key, smaller first.
-pub fn split_key(key: u64) -> (u32, u32) {
-    ((key >> 32) as u32, key as u32)
-}
 
 /// Symmetric pair counts, dense or sparse.
 #[derive(Clone, Debug)]
 pub enum PairCounts {
     /// Upper triangle of an n_p x n_p matrix.
     Dense(Array2<u64>),
-    /// `(pair key, count)` sorted by key, no repeats, no zero counts.
-    Sparse(Vec<(u64, u64)>),
+    /// Sorted `(pair, count)` entries, eight bytes each ([`SparseCounts`]).
+    Sparse(SparseCounts),
 }
 
 impl PairCounts {
@@ -36,7 +28,7 @@ impl PairCounts {
         if patches <= DENSE_MAX_PATCHES {
             PairCounts::Dense(Array2::zeros((patches, patches)))
         } else {
-            PairCounts::Sparse(Vec::new())
+            PairCounts::Sparse(SparseCounts::new(patches))
         }
     }
 
@@ -52,7 +44,7 @@ impl PairCounts {
             }
             PairCounts::Sparse(list) => {
                 sort_keys(patches, keys);
-                *list = run_lengths(keys);
+                *list = SparseCounts::from_sorted_keys(patches, keys);
             }
         }
         counts
@@ -61,25 +53,22 @@ impl PairCounts {
     /// Counts for `patches` patches from the pair keys of several batches, in any order (integer sums do
     /// not depend on it). Sparse counts radix-sort all the keys at once.
     pub fn from_batches(patches: usize, batches: Vec<Vec<u64>>) -> Self {
-        let mut counts = PairCounts::new(patches);
-        match &mut counts {
-            PairCounts::Dense(m) => {
+        if patches <= DENSE_MAX_PATCHES {
+            let mut counts = PairCounts::new(patches);
+            if let PairCounts::Dense(m) = &mut counts {
                 for &k in batches.iter().flatten() {
                     let (i, j) = split_key(k);
                     m[[i as usize, j as usize]] += 1;
                 }
             }
-            PairCounts::Sparse(list) => {
-                let mut keys = batches.concat();
-                sort_keys(patches, &mut keys);
-                *list = run_lengths(&keys);
-            }
+            return counts;
         }
-        counts
+        let mut keys = batches.concat();
+        PairCounts::from_keys(patches, &mut keys)
     }
 
     /// Counts of `patches` patches from `(key, count)` entries, each key once, in any order.
-    pub fn from_entries(patches: usize, mut entries: Vec<(u64, u64)>) -> Self {
+    pub fn from_entries(patches: usize, entries: Vec<(u64, u64)>) -> Self {
         match PairCounts::new(patches) {
             PairCounts::Dense(mut m) => {
                 for (k, c) in entries {
@@ -89,8 +78,7 @@ impl PairCounts {
                 PairCounts::Dense(m)
             }
             PairCounts::Sparse(_) => {
-                entries.sort_unstable();
-                PairCounts::Sparse(entries)
+                PairCounts::Sparse(SparseCounts::from_entries(patches, entries))
             }
         }
     }
@@ -100,17 +88,7 @@ impl PairCounts {
         match (self, part) {
             (PairCounts::Dense(a), PairCounts::Dense(b)) => PairCounts::Dense(a - b),
             (PairCounts::Sparse(total), PairCounts::Sparse(part)) => {
-                // Both sorted by key, and every pair of the part is in the total.
-                let mut lowered = total.clone();
-                let mut k = 0;
-                for &(key, c) in part {
-                    while lowered[k].0 < key {
-                        k += 1;
-                    }
-                    lowered[k].1 -= c;
-                }
-                lowered.retain(|e| e.1 > 0);
-                PairCounts::Sparse(lowered)
+                PairCounts::Sparse(total.without(part))
             }
             _ => unreachable!("counts of one scene always share a layout"),
         }
@@ -120,7 +98,7 @@ impl PairCounts {
     pub fn merge(&mut self, other: &PairCounts) {
         match (self, other) {
             (PairCounts::Dense(a), PairCounts::Dense(b)) => *a += b,
-            (PairCounts::Sparse(a), PairCounts::Sparse(b)) => merge_into(a, b),
+            (PairCounts::Sparse(a), PairCounts::Sparse(b)) => a.merge(b),
             _ => unreachable!("counts of one scene always share a layout"),
         }
     }
@@ -135,12 +113,7 @@ impl PairCounts {
                     }
                 }
             }
-            PairCounts::Sparse(list) => {
-                for &(k, c) in list {
-                    let (i, j) = split_key(k);
-                    f(i, j, c);
-                }
-            }
+            PairCounts::Sparse(list) => list.for_each(f),
         }
     }
 
@@ -152,20 +125,27 @@ impl PairCounts {
             (PairCounts::Dense(_), PairCounts::Dense(t)) => {
                 self.for_each(|i, j, c| f(i, j, c, t[[i as usize, j as usize]]));
             }
-            (PairCounts::Sparse(list), PairCounts::Sparse(t)) => {
-                // Both sorted by key: one walk along the total.
-                let mut k = 0;
-                for &(key, c) in list {
-                    while t[k].0 < key {
-                        k += 1;
-                    }
-                    debug_assert_eq!(t[k].0, key, "a part's pair is in the total");
-                    let (i, j) = split_key(key);
-                    f(i, j, c, t[k].1);
-                }
-            }
+            (PairCounts::Sparse(list), PairCounts::Sparse(t)) => list.for_each_with_total(t, f),
             _ => unreachable!("counts of one scene always share a layout"),
         }
+    }
+
+    /// The sum of counts of one scene (all dense or all sparse); `None` without any.
+    pub fn sum_of(parts: &[&PairCounts]) -> Option<PairCounts> {
+        let first = *parts.first()?;
+        if first.is_dense() {
+            let mut total = first.clone();
+            parts[1..].iter().for_each(|p| total.merge(p));
+            return Some(total);
+        }
+        let lists: Vec<&SparseCounts> = parts
+            .iter()
+            .map(|p| match p {
+                PairCounts::Sparse(list) => list,
+                PairCounts::Dense(_) => unreachable!("counts of one scene always share a layout"),
+            })
+            .collect();
+        Some(PairCounts::Sparse(SparseCounts::sum_of(&lists)))
     }
 
     /// Number of distinct unordered pairs seen.
@@ -190,30 +170,26 @@ fn sort_keys(patches: usize, keys: &mut [u64]) {
     let mut packed: Vec<u64> = keys.iter().map(|&k| layout.tag(k, 0)).collect();
     radix_sort(&mut packed, layout.bits, &mut Vec::new());
     for (k, &p) in keys.iter_mut().zip(&packed) {
-        *k = layout.untag(p).0;
+        let (i, j) = layout.packing.unpack_pair(layout.untag(p).0);
+        *k = pair_key(i, j);
     }
 }
 
-/// Sparse pair counts of each standard-error group and of all the groups together.
-#[derive(Clone, Debug, Default)]
-pub struct GroupedCounts {
-    /// `(pair key, count)` sorted by key, one list per group.
-    pub groups: Vec<Vec<(u64, u64)>>,
-    /// The same over all groups.
-    pub total: Vec<(u64, u64)>,
-}
-
-/// Counts the pair keys of `batches` (each `(group, keys)`, groups below `groups`) per group and in
-/// all, for a scene of `patches` patches, in one sort.
+/// Counts the pair keys of `batches` (each `(group, keys)`, groups below `groups`) per group, for a
+/// scene of `patches` patches, in one sort. The batches' keys are freed as soon as they are
+/// dealt, so that they and the sorted copy are not both held through the sort.
 ///
 /// Each key is tagged with its group in its lowest bits, so that after sorting the entries of one patch
-/// pair lie together, group by group: one pass then yields every group's counts and their sum, where
-/// counting the groups apart and merging them would touch every count once per level of a merge tree.
+/// pair lie together, group by group: one pass then yields every group's counts.
 /// The sort is a radix sort in two stages that both run in parallel: the keys are first dealt by their
 /// top bits into buckets of a few thousand (one pass, per chunk of batches), then each bucket is sorted
 /// in cache on the remaining bits and writes its runs into its own stretch of every list. The result
 /// does not depend on the order of the batches nor on the threads (integer counts of sorted keys).
-pub fn count_by_group(patches: usize, groups: usize, batches: &[(usize, &[u64])]) -> GroupedCounts {
+pub fn count_by_group(
+    patches: usize,
+    groups: usize,
+    batches: Vec<(usize, Vec<u64>)>,
+) -> Vec<SparseCounts> {
     let layout = TagLayout::new(patches, groups);
     let keys: usize = batches.iter().map(|(_, k)| k.len()).sum();
     // Buckets of ~4096 keys on average.
@@ -224,14 +200,18 @@ pub fn count_by_group(patches: usize, groups: usize, batches: &[(usize, &[u64])]
     // thread) counts its keys per bucket, then writes them into its own stretch of every bucket.
     let buckets = 1usize << top_bits;
     let chunk = batches.len().div_ceil(rayon::current_num_threads()).max(1);
-    let chunks: Vec<&[(usize, &[u64])]> = batches.chunks(chunk).collect();
+    let mut chunks: Vec<Vec<(usize, Vec<u64>)>> = Vec::new();
+    let mut batches = batches.into_iter().peekable();
+    while batches.peek().is_some() {
+        chunks.push(batches.by_ref().take(chunk).collect());
+    }
     let per_chunk: Vec<Vec<usize>> = chunks
         .par_iter()
         .map(|chunk| {
             let mut counts = vec![0; buckets];
-            for &(group, keys) in chunk.iter() {
+            for (group, keys) in chunk {
                 for &k in keys {
-                    counts[(layout.tag(k, group) >> low_bits) as usize] += 1;
+                    counts[(layout.tag(k, *group) >> low_bits) as usize] += 1;
                 }
             }
             counts
@@ -248,12 +228,13 @@ pub fn count_by_group(patches: usize, groups: usize, batches: &[(usize, &[u64])]
         targets[k % chunks.len()].push(stretch);
     }
     chunks
-        .par_iter()
+        .into_par_iter()
         .zip(targets)
         .for_each(|(chunk, mut targets)| {
             let mut next = vec![0; buckets];
-            for &(group, keys) in chunk.iter() {
-                for &k in keys {
+            // Each batch's keys are dropped once dealt.
+            for (group, keys) in chunk {
+                for k in keys {
                     let t = layout.tag(k, group);
                     let b = (t >> low_bits) as usize;
                     targets[b][next[b]] = t;
@@ -262,7 +243,7 @@ pub fn count_by_group(patches: usize, groups: usize, batches: &[(usize, &[u64])]
             }
         });
 
-    // Stage 2: sort each bucket on its low bits, and count its runs per group and in all.
+    // Stage 2: sort each bucket on its low bits, and count its runs per group.
     let bucket_lengths = (0..buckets).map(|b| per_chunk.iter().map(|c| c[b]).sum());
     let mut sorted: Vec<(&mut [u64], Vec<usize>)> = split_by_lengths(&mut dealt, bucket_lengths)
         .into_iter()
@@ -276,33 +257,38 @@ pub fn count_by_group(patches: usize, groups: usize, batches: &[(usize, &[u64])]
         });
 
     // Stage 3: every bucket writes its runs into its own stretch of each list (buckets hold consecutive
-    // key ranges, so the lists come out sorted).
-    let mut out = GroupedCounts {
-        groups: (0..groups)
-            .map(|g| vec![(0, 0); sorted.iter().map(|(_, r)| r[g]).sum()])
-            .collect(),
-        total: vec![(0, 0); sorted.iter().map(|(_, r)| r[groups]).sum()],
-    };
-    let mut lists: Vec<Vec<&mut [(u64, u64)]>> = out
-        .groups
+    // key ranges, so the lists come out sorted), and its counts too large for their field apart.
+    let lists_len = |l: usize| sorted.iter().map(|(_, r)| r[l]).sum::<usize>();
+    let mut entries: Vec<Vec<u64>> = (0..groups).map(|l| vec![0; lists_len(l)]).collect();
+    let mut lists: Vec<Vec<&mut [u64]>> = entries
         .iter_mut()
-        .chain(std::iter::once(&mut out.total))
         .enumerate()
         .map(|(l, list)| split_by_lengths(list, sorted.iter().map(|(_, r)| r[l])))
         .collect();
     // Transposed: per bucket, its stretch of every list.
-    let mut per_bucket: Vec<Vec<&mut [(u64, u64)]>> =
-        (0..sorted.len()).map(|_| Vec::new()).collect();
+    let mut per_bucket: Vec<Vec<&mut [u64]>> = (0..sorted.len()).map(|_| Vec::new()).collect();
     for list in &mut lists {
         for (b, stretch) in list.drain(..).enumerate() {
             per_bucket[b].push(stretch);
         }
     }
-    sorted
+    let wide_per_bucket: Vec<Vec<Vec<(u64, u64)>>> = sorted
         .par_iter()
         .zip(per_bucket)
-        .for_each(|((values, _), mut lists)| layout.write_runs(values, &mut lists));
-    out
+        .map(|((values, _), mut lists)| layout.write_runs(values, &mut lists))
+        .collect();
+    drop(dealt);
+    entries
+        .into_iter()
+        .enumerate()
+        .map(|(l, entries)| {
+            let wide = wide_per_bucket
+                .iter()
+                .flat_map(|w| w[l].iter().copied())
+                .collect();
+            SparseCounts::from_parts(layout.packing, entries, wide)
+        })
+        .collect()
 }
 
 /// Cuts `slice` into consecutive pieces of the given lengths (which must not add up to more).
@@ -320,11 +306,11 @@ fn split_by_lengths<T>(
         .collect()
 }
 
-/// How pair keys are packed for sorting: `(lo << p | hi) << g | group`, with `p` bits for a patch index
-/// and `g` for a group (0 when there is one).
+/// How pair keys are tagged for sorting: `packed pair << g | group`, the pair packed as the sparse lists
+/// pack it ([`Packing`]), with `g` bits for a group (0 when there is one).
 #[derive(Clone, Copy, Debug)]
 struct TagLayout {
-    patch_bits: u32,
+    packing: Packing,
     group_bits: u32,
     /// Bits of a tagged key.
     bits: u32,
@@ -333,25 +319,23 @@ struct TagLayout {
 impl TagLayout {
     fn new(patches: usize, groups: usize) -> Self {
         let bits_for = |n: usize| usize::BITS - n.saturating_sub(1).leading_zeros();
-        let (patch_bits, group_bits) = (bits_for(patches).max(1), bits_for(groups));
+        let packing = Packing::for_patches(patches);
+        let group_bits = bits_for(groups);
         TagLayout {
-            patch_bits,
+            packing,
             group_bits,
-            bits: 2 * patch_bits + group_bits,
+            bits: 2 * packing.patch_bits() + group_bits,
         }
     }
 
     fn tag(&self, key: u64, group: usize) -> u64 {
-        let (lo, hi) = split_key(key);
-        (((u64::from(lo) << self.patch_bits) | u64::from(hi)) << self.group_bits) | group as u64
+        (self.packing.pack_key(key) << self.group_bits) | group as u64
     }
 
-    /// The pair key and the group of a tagged key.
+    /// The packed pair and the group of a tagged key.
     fn untag(&self, tagged: u64) -> (u64, usize) {
         let group = (tagged & ((1 << self.group_bits) - 1)) as usize;
-        let pair = tagged >> self.group_bits;
-        let hi = pair & ((1 << self.patch_bits) - 1);
-        (pair_key((pair >> self.patch_bits) as u32, hi as u32), group)
+        (tagged >> self.group_bits, group)
     }
 
     /// Calls `f(tagged key, count)` for each run of equal tagged keys in `sorted`.
@@ -365,38 +349,31 @@ impl TagLayout {
         }
     }
 
-    /// How many entries sorted tagged keys make in each group's list, and (last) in the total's.
+    /// How many entries sorted tagged keys make in each group's list.
     fn run_counts(&self, sorted: &[u64], groups: usize) -> Vec<usize> {
-        let mut runs = vec![0; groups + 1];
-        let mut last_pair = None;
+        let mut runs = vec![0; groups];
         Self::for_each_run(sorted, |tagged, _| {
-            runs[(tagged & ((1 << self.group_bits) - 1)) as usize] += 1;
-            let pair = tagged >> self.group_bits;
-            if last_pair != Some(pair) {
-                runs[groups] += 1;
-                last_pair = Some(pair);
-            }
+            runs[self.untag(tagged).1] += 1;
         });
         runs
     }
 
-    /// Writes the runs of sorted tagged keys into `lists` (one per group, then the total), each exactly
-    /// as long as [`TagLayout::run_counts`] said.
-    fn write_runs(&self, sorted: &[u64], lists: &mut [&mut [(u64, u64)]]) {
-        let total = lists.len() - 1;
+    /// Writes the runs of sorted tagged keys as packed entries into `lists` (one per group), each
+    /// exactly as long as [`TagLayout::run_counts`] said; returns, per list, the `(packed pair, count)`
+    /// of the counts too large for their field.
+    fn write_runs(&self, sorted: &[u64], lists: &mut [&mut [u64]]) -> Vec<Vec<(u64, u64)>> {
+        let mut wide: Vec<Vec<(u64, u64)>> = vec![Vec::new(); lists.len()];
         let mut next = vec![0usize; lists.len()];
         Self::for_each_run(sorted, |tagged, count| {
             let (pair, group) = self.untag(tagged);
-            lists[group][next[group]] = (pair, count);
+            let (entry, is_wide) = SparseCounts::entry_of(self.packing, pair, count);
+            lists[group][next[group]] = entry;
             next[group] += 1;
-            let t = next[total];
-            if t > 0 && lists[total][t - 1].0 == pair {
-                lists[total][t - 1].1 += count;
-            } else {
-                lists[total][t] = (pair, count);
-                next[total] += 1;
+            if is_wide {
+                wide[group].push((pair, count));
             }
         });
+        wide
     }
 }
 
@@ -479,47 +456,6 @@ fn radix_sort(values: &mut [u64], bits: u32, scratch: &mut Vec<u64>) {
     }
 }
 
-fn run_lengths(sorted: &[u64]) -> Vec<(u64, u64)> {
-    let mut out: Vec<(u64, u64)> = Vec::new();
-    for &k in sorted {
-        match out.last_mut() {
-            Some((last, c)) if *last == k => *c += 1,
-            _ => out.push((k, 1)),
-        }
-    }
-    out
-}
-
-/// Merges the sorted `(key, count)` list `b` into the sorted list `a`, adding the counts of equal keys.
-///
-/// In place, from the back: `a` only grows by `b`'s length (a long run's lists hold millions of entries,
-/// and a fresh list for every merge cost a page fault per 4 KiB on top of the copy), then the merged
-/// entries are written from the end down, which never overtakes the unread part of `a` (the gap between
-/// them is what is left of `b` plus the keys merged so far), and finally moved down over that gap.
-/// Branch-free in the loop body (which list advances is data, not control flow: the keys of two groups
-/// interleave at random, so a branch would be mispredicted half the time).
-fn merge_into(a: &mut Vec<(u64, u64)>, b: &[(u64, u64)]) {
-    let (n, m) = (a.len(), b.len());
-    a.resize(n + m, (0, 0));
-    let (mut i, mut j, mut w) = (n, m, n + m);
-    while i > 0 && j > 0 {
-        let ((ka, ca), (kb, cb)) = (a[i - 1], b[j - 1]);
-        let (take_a, take_b) = (ka >= kb, kb >= ka);
-        let key = if take_a { ka } else { kb };
-        w -= 1;
-        a[w] = (key, u64::from(take_a) * ca + u64::from(take_b) * cb);
-        i -= usize::from(take_a);
-        j -= usize::from(take_b);
-    }
-    // What is left of `b` goes before the merged tail; what is left of `a` already is in place.
-    a[w - j..w].copy_from_slice(&b[..j]);
-    w -= j;
-    if w > i {
-        a.copy_within(w.., i);
-        a.truncate(n + m - (w - i));
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -538,12 +474,9 @@ mod tests {
             .map(|&(a, b)| pair_key(a, b))
             .collect();
         let dense = PairCounts::from_keys(8, &mut keys.clone());
-        let mut sparse = PairCounts::Sparse(Vec::new());
-        if let PairCounts::Sparse(l) = &mut sparse {
-            let mut k = keys.clone();
-            k.sort_unstable();
-            *l = run_lengths(&k);
-        }
+        let mut sorted = keys.clone();
+        sorted.sort_unstable();
+        let sparse = PairCounts::Sparse(SparseCounts::from_sorted_keys(8, &sorted));
         assert!(dense.is_dense() && !sparse.is_dense());
         assert_eq!(entries(&dense), vec![(0, 0, 1), (1, 3, 2), (2, 5, 3)]);
         assert_eq!(entries(&dense), entries(&sparse));
@@ -612,49 +545,7 @@ mod tests {
         }
     }
 
-    /// The in-place merge equals a merge by a map, with either list longer, empty, or all equal keys.
-    #[test]
-    fn merging_in_place_adds_equal_keys() {
-        let mut rng = 7u64;
-        let mut next = |m: u64| {
-            rng = rng
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (rng >> 24) % m
-        };
-        let mut list = |len: usize, range: u64| {
-            let mut map = std::collections::BTreeMap::new();
-            for _ in 0..len {
-                *map.entry(next(range)).or_insert(0u64) += next(5) + 1;
-            }
-            map.into_iter().collect::<Vec<(u64, u64)>>()
-        };
-        let cases = [
-            (list(500, 800), list(300, 800)),
-            (list(10, 800), list(900, 800)),
-            (Vec::new(), list(50, 100)),
-            (list(50, 100), Vec::new()),
-            (list(40, 10), list(40, 10)),
-            (
-                list(100, 1000),
-                list(100, 1000)
-                    .into_iter()
-                    .map(|(k, c)| (k + 5000, c))
-                    .collect(),
-            ),
-        ];
-        for (a, b) in cases {
-            let mut expected = std::collections::BTreeMap::new();
-            for &(k, c) in a.iter().chain(&b) {
-                *expected.entry(k).or_insert(0) += c;
-            }
-            let mut merged = a.clone();
-            merge_into(&mut merged, &b);
-            assert_eq!(merged, expected.into_iter().collect::<Vec<_>>());
-        }
-    }
-
-    /// Counting tagged keys in one sort gives each group the counts it would have alone, and the total
+    /// Counting tagged keys in one sort gives each group the counts it would have alone, and their sum
     /// the counts of all keys; with many groups, buckets, self pairs, repeats, an empty group, and a
     /// scene size that is no power of two.
     #[test]
@@ -682,49 +573,54 @@ mod tests {
                 (group, keys)
             })
             .collect();
-        let refs: Vec<(usize, &[u64])> = batches.iter().map(|(g, k)| (*g, k.as_slice())).collect();
-        let counted = count_by_group(patches as usize, groups, &refs);
-        let sparse = |list: &Vec<(u64, u64)>| PairCounts::Sparse(list.clone());
-        for g in 0..groups {
+        let counted = count_by_group(patches as usize, groups, batches.clone());
+        let sparse = |list: &SparseCounts| PairCounts::Sparse(list.clone());
+        assert_eq!(counted.len(), groups);
+        for (g, counted_g) in counted.iter().enumerate() {
             let mut keys: Vec<u64> = batches
                 .iter()
                 .filter(|b| b.0 == g)
                 .flat_map(|b| b.1.iter().copied())
                 .collect();
             let alone = PairCounts::from_keys(patches as usize, &mut keys);
-            assert_eq!(
-                entries(&sparse(&counted.groups[g])),
-                entries(&alone),
-                "group {g}"
-            );
-            assert!(counted.groups[g].windows(2).all(|w| w[0].0 < w[1].0));
+            assert_eq!(entries(&sparse(counted_g)), entries(&alone), "group {g}");
+            let keys = counted_g.to_entries();
+            assert!(keys.windows(2).all(|w| w[0].0 < w[1].0));
         }
-        assert!(counted.groups[3].is_empty());
+        assert!(counted[3].is_empty());
         let mut all: Vec<u64> = batches.iter().flat_map(|b| b.1.iter().copied()).collect();
         let total = PairCounts::from_keys(patches as usize, &mut all);
-        assert_eq!(entries(&sparse(&counted.total)), entries(&total));
+        let parts: Vec<&SparseCounts> = counted.iter().collect();
+        assert_eq!(
+            entries(&sparse(&SparseCounts::sum_of(&parts))),
+            entries(&total)
+        );
 
         // A scene so small that the buckets are told apart by the group bits too.
         let keys: Vec<u64> = (0..9000u64)
             .map(|k| pair_key((k % 3) as u32, (k % 2) as u32))
             .collect();
-        let tiny: Vec<(usize, &[u64])> = keys
+        let tiny: Vec<(usize, Vec<u64>)> = keys
             .chunks(1000)
             .enumerate()
-            .map(|(b, k)| (b % 5, k))
+            .map(|(b, k)| (b % 5, k.to_vec()))
             .collect();
-        let counted = count_by_group(3, 5, &tiny);
-        let sum: u64 = counted.total.iter().map(|&(_, c)| c).sum();
+        let counted = count_by_group(3, 5, tiny.clone());
+        let sum: u64 = counted
+            .iter()
+            .flat_map(|g| g.to_entries())
+            .map(|(_, c)| c)
+            .sum();
         assert_eq!(sum, 9000);
-        for g in 0..5 {
+        for (g, counted_g) in counted.iter().enumerate() {
             let mut alone: Vec<u64> = tiny
                 .iter()
                 .filter(|b| b.0 == g)
-                .flat_map(|b| b.1.to_vec())
+                .flat_map(|b| b.1.clone())
                 .collect();
             let alone = PairCounts::from_keys(3, &mut alone);
             assert_eq!(
-                entries(&sparse(&counted.groups[g])),
+                entries(&sparse(counted_g)),
                 entries(&alone),
                 "tiny group {g}"
             );
