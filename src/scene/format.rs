@@ -93,10 +93,7 @@ fn looks_like_obj(text: &str) -> bool {
 /// Loads a scene file in any format scx reads, found from its content ([`detect`]).
 pub fn load_file(path: &Path, options: &SceneOptions) -> Result<Scene, SceneError> {
     let shown = path.display().to_string();
-    let file_error = |message: String| SceneError::File {
-        path: shown.clone(),
-        message,
-    };
+    let file_error = |message: String| SceneError::in_file(&shown, message);
     if !path.exists() {
         return Err(file_error("no such file".into()));
     }

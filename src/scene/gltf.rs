@@ -53,10 +53,7 @@ fn load_document(
     base: &Path,
     options: &SceneOptions,
 ) -> Result<Scene, SceneError> {
-    let file_error = |message: String| SceneError::File {
-        path: shown.to_string(),
-        message,
-    };
+    let file_error = |message: String| SceneError::in_file(shown, message);
     let gltf = ::gltf::Gltf::from_slice(bytes)
         .map_err(|e| file_error(format!("not a readable glTF 2.0 file: {e}")))?;
     let buffers = gltf

@@ -260,6 +260,16 @@ pub enum SceneError {
     Builtin(String),
 }
 
+impl SceneError {
+    /// A problem with the file shown to the user as `path`.
+    pub fn in_file(path: &str, message: String) -> Self {
+        SceneError::File {
+            path: path.to_string(),
+            message,
+        }
+    }
+}
+
 impl fmt::Display for Normalization {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         write!(

@@ -16,10 +16,7 @@ pub fn load(path: &Path) -> Result<Scene, SceneError> {
 /// [`load`] with options (planarity, flipped and two-sided objects).
 pub fn load_with(path: &Path, options: &SceneOptions) -> Result<Scene, SceneError> {
     let shown = path.display().to_string();
-    let file_error = |message: String| SceneError::File {
-        path: shown.clone(),
-        message,
-    };
+    let file_error = |message: String| SceneError::in_file(&shown, message);
     if !path.exists() {
         return Err(file_error("no such file".into()));
     }
@@ -97,10 +94,7 @@ pub fn load_text_with(
     options: &SceneOptions,
 ) -> Result<Scene, SceneError> {
     let shown = shown.to_string();
-    let file_error = |message: String| SceneError::File {
-        path: shown.clone(),
-        message,
-    };
+    let file_error = |message: String| SceneError::in_file(&shown, message);
     let prepared = super::obj_check::prepare(&shown, text)?;
     if prepared.faces.is_empty() {
         return Err(no_faces(&shown, &prepared));

@@ -20,10 +20,7 @@ pub(crate) fn load_bytes(
     path: &Path,
     options: &SceneOptions,
 ) -> Result<Scene, SceneError> {
-    let file_error = |message: String| SceneError::File {
-        path: shown.to_string(),
-        message,
-    };
+    let file_error = |message: String| SceneError::in_file(shown, message);
     let mut cursor = std::io::Cursor::new(bytes);
     let ply = Parser::<DefaultElement>::new()
         .read_ply(&mut cursor)

@@ -15,10 +15,7 @@ pub(crate) fn load_bytes(
     path: &Path,
     options: &SceneOptions,
 ) -> Result<Scene, SceneError> {
-    let file_error = |message: String| SceneError::File {
-        path: shown.to_string(),
-        message,
-    };
+    let file_error = |message: String| SceneError::in_file(shown, message);
     // A binary STL's 80-byte header is free text, and some exporters start it with `solid`, which
     // stl_io would take for the ASCII form: hide the word from it (the header carries no geometry).
     let binary_solid = is_binary_stl(bytes) && bytes.starts_with(b"solid");
