@@ -1,18 +1,23 @@
 //! The Embree backend (Embree 3 or 4, chosen at build time).
 //!
 //! Every intersection along a line comes from *one* traversal: the C shim (`ffi/scx_embree.c`) installs a
-//! filter callback that sees each candidate hit, records it if it is one, and rejects it, so Embree carries
-//! on to the next candidate instead of stopping at the nearest.
+//! filter callback that sees each candidate hit, records it, and rejects it, so Embree carries on to the
+//! next candidate instead of stopping at the nearest.
 //!
 //! Embree proposes, our watertight test decides. Embree's robust triangle test is watertight for a line
 //! that crosses an edge into the surface, but a line passing within rounding distance (~1e-7) of a vertex,
 //! or grazing a convex edge, can be rejected by every triangle there (measured on `@cube:N`: 1-2% of such
 //! lines lost a crossing). So Embree is given each triangle inflated by a margin far above its rounding
-//! error, which makes its candidates a superset of the true hits, and the filter decides each candidate,
+//! error, which makes its candidates a superset of the true hits, and the shim decides each candidate,
 //! and computes its distance, with the watertight test of Woop, Benthin and Wald on the original triangle,
 //! in the same operations as [`crate::trace::rust::watertight`]: the hits are bit-identical to the pure-Rust
 //! tracer's, at edges and vertices too. A crossing of a shared edge or vertex is reported by every
 //! triangle that owns it; [`HitRules`] merges those.
+//!
+//! For all hits the candidates are decided after the traversal of a batch, in one pass, not in the
+//! filter: there Embree waited, candidate after candidate, for the test and for the cache miss on the
+//! original triangle, while a pass over the batch overlaps them (README, "Exact hits only where they
+//! matter"). First-hit queries decide in the filter, because accepting a hit narrows Embree's search.
 //!
 //! Lines are traced one by one (`rtcIntersect1`, [`Query::Single`]) or in packets of 4, 8 or 16 adjacent
 //! lines (`rtcIntersectN`, [`Query::Packet`]), at the widths the machine traces natively; both give the
