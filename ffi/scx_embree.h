@@ -108,7 +108,7 @@ typedef struct scx_query {
   const scx_line* lines;     /* the batch, indexed by ray id */
   const scx_sheared* sheared; /* the batch prepared for the watertight test, indexed by ray id */
   uint32_t n_lines;          /* ray ids at or above this are not lines of the batch */
-  scx_hits* hits;            /* all-hits queries: where hits are appended */
+  scx_hits* hits;            /* all-hits queries: where candidates are appended, decided after the traversal */
   scx_first_hit* first;      /* first-hit queries: the nearest hit so far of each line */
   int bad_ray_id;            /* set by the filter on a foreign ray id or primitive */
 } scx_query;
@@ -170,7 +170,8 @@ int scx_scene_new(scx_device* device, const float* positions, uint32_t n_vertice
 void scx_scene_release(scx_scene* scene);
 
 /* Every intersection of n lines with the scene, appended to out as {t, prim, line}, in traversal order;
- * t and the hit decision come from the watertight test, identical for single lines and packets.
+ * t and the hit decision come from the watertight test, identical for single lines and packets (Embree's
+ * candidates are recorded during the traversal and decided after it, in one pass over the batch).
  * width 1 traces line by line (rtcIntersect1); 4, 8 or 16 traces packets of that many adjacent lines
  * (rtcIntersect4/8/16, native widths only), the last packet padded with inactive lanes. n must be below
  * SCX_NO_LINE. scratch is the caller's room for n prepared lines (its contents are overwritten): a caller

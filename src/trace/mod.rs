@@ -25,7 +25,10 @@ use std::fmt;
 /// A line in tracing space (the scene scaled to its unit bounding sphere), traced in f32.
 ///
 /// The segment `origin + t * dir`, `t` in `[0, t_max]`, covers the whole bounding sphere; `dir` is unit.
+/// `#[repr(C)]`: the Embree shim reads lines in place, as its `scx_line` (the same fields in the same
+/// order; the sizes are compared when an Embree tracer is made).
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[repr(C)]
 pub struct Line {
     /// A point outside the bounding sphere, on the line.
     pub origin: [f32; 3],

@@ -1,18 +1,23 @@
 //! The Embree backend (Embree 3 or 4, chosen at build time).
 //!
 //! Every intersection along a line comes from *one* traversal: the C shim (`ffi/scx_embree.c`) installs a
-//! filter callback that sees each candidate hit, records it if it is one, and rejects it, so Embree carries
-//! on to the next candidate instead of stopping at the nearest.
+//! filter callback that sees each candidate hit, records it, and rejects it, so Embree carries on to the
+//! next candidate instead of stopping at the nearest.
 //!
 //! Embree proposes, our watertight test decides. Embree's robust triangle test is watertight for a line
 //! that crosses an edge into the surface, but a line passing within rounding distance (~1e-7) of a vertex,
 //! or grazing a convex edge, can be rejected by every triangle there (measured on `@cube:N`: 1-2% of such
 //! lines lost a crossing). So Embree is given each triangle inflated by a margin far above its rounding
-//! error, which makes its candidates a superset of the true hits, and the filter decides each candidate,
+//! error, which makes its candidates a superset of the true hits, and the shim decides each candidate,
 //! and computes its distance, with the watertight test of Woop, Benthin and Wald on the original triangle,
 //! in the same operations as [`crate::trace::rust::watertight`]: the hits are bit-identical to the pure-Rust
 //! tracer's, at edges and vertices too. A crossing of a shared edge or vertex is reported by every
 //! triangle that owns it; [`HitRules`] merges those.
+//!
+//! For all hits the candidates are decided after the traversal of a batch, in one pass, not in the
+//! filter: there Embree waited, candidate after candidate, for the test and for the cache miss on the
+//! original triangle, while a pass over the batch overlaps them (README, "Exact hits only where they
+//! matter"). First-hit queries decide in the filter, because accepting a hit narrows Embree's search.
 //!
 //! Lines are traced one by one (`rtcIntersect1`, [`Query::Single`]) or in packets of 4, 8 or 16 adjacent
 //! lines (`rtcIntersectN`, [`Query::Packet`]), at the widths the machine traces natively; both give the
@@ -207,10 +212,10 @@ impl Drop for HitBuffer {
     }
 }
 
-/// Copies lines into the shim's layout (Rust's [`Line`] has no guaranteed layout), replacing `out`'s
-/// contents, checking that Embree can trace them: finite numbers, `t_max >= 0`, and fewer lines than the
-/// shim's padding id.
-fn fill_shim_lines(lines: &[Line], out: &mut Vec<ffi::scx_line>) -> Result<(), TraceError> {
+/// Checks that Embree can trace `lines`: finite numbers, `t_max >= 0`, and fewer lines than the shim's
+/// padding id. The shim reads them in place: [`Line`] is `#[repr(C)]` with the fields of `scx_line`
+/// (sizes compared in [`layout_checks`]).
+fn check_lines(lines: &[Line]) -> Result<(), TraceError> {
     if lines.len() >= NONE as usize {
         return Err(backend_error(format!(
             "{} lines in one batch; at most {} fit",
@@ -218,7 +223,6 @@ fn fill_shim_lines(lines: &[Line], out: &mut Vec<ffi::scx_line>) -> Result<(), T
             NONE - 1
         )));
     }
-    out.clear();
     for (k, l) in lines.iter().enumerate() {
         let finite = l.origin.iter().chain(&l.dir).all(|c| c.is_finite()) && l.t_max.is_finite();
         if !finite || l.t_max < 0.0 {
@@ -226,37 +230,47 @@ fn fill_shim_lines(lines: &[Line], out: &mut Vec<ffi::scx_line>) -> Result<(), T
                 "line {k} cannot be traced: {l:?} (needs finite values and t_max >= 0)"
             )));
         }
-        out.push(ffi::scx_line {
-            org: l.origin,
-            dir: l.dir,
-            t_max: l.t_max,
-        });
     }
     Ok(())
 }
 
-/// A thread's query buffers, kept from batch to batch: a batch of 4096 lines needs ~115 KB of lines in
-/// the shim's layout, ~150 KB of lines prepared for the watertight test and ~100 KB of hits, and
-/// allocating them afresh for every batch made the allocator map and the system clear fresh pages each
-/// time (perf: 4-5% of an analysis of `@cube:30` went to clearing pages for them).
+/// `lines` as the shim's `scx_line` array (the same layout; see [`check_lines`]).
+fn shim_lines(lines: &[Line]) -> *const ffi::scx_line {
+    lines.as_ptr().cast()
+}
+
+/// A thread's query buffers, kept from batch to batch: a batch of 4096 lines needs ~150 KB of lines
+/// prepared for the watertight test and ~100 KB of hits, and allocating them afresh for every batch made
+/// the allocator map and the system clear fresh pages each time (perf: 4-5% of an analysis of `@cube:30`
+/// went to clearing pages for them).
 #[derive(Default)]
 struct Scratch {
-    lines: Vec<ffi::scx_line>,
+    /// Room for the shim's prepared lines: only its capacity is used. The shim writes them and reads
+    /// them back; Rust never reads them, so they are neither initialised nor counted in the length
+    /// (clearing ~150 KB per batch, and copying the lines into the shim's layout, were 3-5% of an Embree
+    /// all-hits trace).
     sheared: Vec<ffi::scx_sheared>,
     hits: HitBuffer,
 }
 
 impl Scratch {
-    /// Prepares the buffers for `lines`: the lines copied and checked, room for as many prepared lines,
-    /// and an empty hit buffer.
+    /// Prepares the buffers for `lines`: the lines checked, room for as many prepared lines, and an empty
+    /// hit buffer.
     fn prepare(&mut self, lines: &[Line]) -> Result<(), TraceError> {
-        fill_shim_lines(lines, &mut self.lines)?;
+        check_lines(lines)?;
         self.sheared.clear();
-        self.sheared
-            .resize(lines.len(), ffi::scx_sheared::default());
+        self.sheared.reserve(lines.len());
         self.hits.0.len = 0;
         self.hits.0.overflow = 0;
         Ok(())
+    }
+
+    /// Where the shim writes the prepared lines: room for as many as [`Scratch::prepare`] was given.
+    fn sheared_room(&mut self) -> *mut ffi::scx_sheared {
+        self.sheared
+            .spare_capacity_mut()
+            .as_mut_ptr()
+            .cast::<ffi::scx_sheared>()
     }
 }
 
@@ -330,6 +344,7 @@ pub fn layout_checks() -> Vec<LayoutCheck> {
             size_of::<ffi::RTCFilterFunctionNArguments>(),
         ),
         LayoutCheck::new("scx_line", c.line, size_of::<ffi::scx_line>()),
+        LayoutCheck::new("scx_line as Line", c.line, size_of::<Line>()),
         LayoutCheck::new("scx_hit", c.hit_record, size_of::<ffi::scx_hit>()),
         LayoutCheck::new("scx_hit as RawHit", c.hit_record, size_of::<RawHit>()),
         LayoutCheck::new("scx_hits", c.hits, size_of::<ffi::scx_hits>()),
@@ -438,16 +453,19 @@ impl EmbreeTracer {
         let mut first = vec![ffi::scx_first_hit::default(); lines.len()];
         with_scratch(|scratch| {
             scratch.prepare(lines)?;
-            // SAFETY: the scene is live and committed; `scratch.lines`, `scratch.sheared` and `first`
-            // all hold `lines.len()` elements (checked to fit in u32); the width was checked against
-            // the device in `new` (and the shim checks it again).
+            let sheared = scratch.sheared_room();
+            // SAFETY: the scene is live and committed; `lines` (read in place: `Line` has the layout of
+            // `scx_line`, checked in `new`) and `first` hold `lines.len()` elements (checked to fit in
+            // u32), `sheared` has room for as many plain-data records, which the shim writes before it
+            // reads them; the width was checked against the device in `new` (and the shim checks it
+            // again).
             let code = unsafe {
                 ffi::scx_first_hits(
                     self.scene.raw.as_ptr(),
-                    scratch.lines.as_ptr(),
-                    scratch.lines.len() as u32,
+                    shim_lines(lines),
+                    lines.len() as u32,
                     self.width,
-                    scratch.sheared.as_mut_ptr(),
+                    sheared,
                     first.as_mut_ptr(),
                 )
             };
@@ -506,17 +524,20 @@ impl Tracer for EmbreeTracer {
     fn raw_hits(&self, lines: &[Line], out: &mut Vec<RawHit>) -> Result<(), TraceError> {
         with_scratch(|scratch| {
             scratch.prepare(lines)?;
-            // SAFETY: the scene is live and committed; `scratch.lines` and `scratch.sheared` hold
-            // `lines.len()` elements each (checked to fit in u32 below the padding id); `scratch.hits` is
-            // this thread's buffer, emptied above and grown by the shim with realloc; the width was
-            // checked against the device in `new` (and the shim checks it again).
+            let sheared = scratch.sheared_room();
+            // SAFETY: the scene is live and committed; `lines` (read in place: `Line` has the layout of
+            // `scx_line`, checked in `new`) holds `lines.len()` elements (checked to fit in u32 below
+            // the padding id), `sheared` has room for as many plain-data records, which the shim writes
+            // before it reads them; `scratch.hits` is this thread's buffer, emptied above and grown by
+            // the shim with realloc; the width was checked against the device in `new` (and the shim
+            // checks it again).
             let code = unsafe {
                 ffi::scx_all_hits(
                     self.scene.raw.as_ptr(),
-                    scratch.lines.as_ptr(),
-                    scratch.lines.len() as u32,
+                    shim_lines(lines),
+                    lines.len() as u32,
                     self.width,
-                    scratch.sheared.as_mut_ptr(),
+                    sheared,
                     &mut scratch.hits.0,
                 )
             };
