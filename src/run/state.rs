@@ -13,7 +13,7 @@ use rayon::prelude::*;
 use super::batches::{map_traced_batches, LineStream};
 use super::plan::{BatchPlan, BatchSet};
 use crate::sample::counts::{count_by_group, PairCounts, DENSE_MAX_PATCHES};
-use crate::sample::tally::{tally_lines, BatchTally, Tally, Wanted};
+use crate::sample::tally::{BatchTally, LineTally, Tally, Wanted};
 use crate::scene::Scene;
 use crate::trace::{TraceError, Tracer};
 
@@ -36,13 +36,14 @@ impl TracedBatches {
         wanted: Wanted,
         stop: &(dyn Fn(u64) -> bool + Sync),
     ) -> Result<(TracedBatches, bool), TraceError> {
+        let tally = LineTally::new(scene, wanted);
         let (batches, complete) = map_traced_batches(
             stream,
             tracer,
             scene.bounding_radius(),
             batches,
             stop,
-            |_: &mut (), batch, hits| tally_lines(scene, batch.lines, hits, wanted),
+            |_: &mut (), batch, hits| tally.batch(batch.lines, hits),
         )?;
         Ok((TracedBatches { batches }, complete))
     }

@@ -312,11 +312,12 @@ impl SparseCounts {
 
     /// The sum of several counts packed the same (a run's total from its groups' counts), each pair once.
     ///
-    /// The key range is cut into pieces of a few tens of thousands of entries that are merged in
-    /// parallel, in cache, twice: once to learn how many entries each piece makes, once to write them
-    /// into their own stretch of a list allocated at its exact size, so that no more than the result
-    /// and the parts is ever held (a list grown as it goes is copied when it outgrows its block, which
-    /// holds the old and the new one at once).
+    /// The key range is cut into pieces of a few thousand entries a part, merged in parallel a wave at a
+    /// time, in cache, straight from the parts (no copies of them), and appended in order to one list.
+    /// That list reserves the parts' total length, an upper bound of its own, but only the pages it
+    /// writes become resident, so no more than the result, the parts and one wave is ever held (a list
+    /// grown as it goes is copied when it outgrows its block, which holds the old and the new one at
+    /// once).
     pub fn sum_of(parts: &[&SparseCounts]) -> SparseCounts {
         let packing = match parts.first() {
             Some(p) => p.packing,
@@ -327,43 +328,38 @@ impl SparseCounts {
             "counts of one scene"
         );
         let pieces = key_pieces(parts);
-        let lengths: Vec<usize> = pieces
-            .par_iter()
-            .map(|piece| merge_piece(parts, piece).len())
-            .collect();
-        let mut entries = vec![0u64; lengths.iter().sum()];
-        let mut stretches = Vec::with_capacity(pieces.len());
-        let mut rest = entries.as_mut_slice();
-        for &n in &lengths {
-            let (head, tail) = std::mem::take(&mut rest).split_at_mut(n);
-            stretches.push(head);
-            rest = tail;
+        let bound = parts.iter().map(|p| p.len()).sum();
+        let mut out = SparseCounts::with_capacity(packing, bound);
+        let wave = 8 * rayon::current_num_threads();
+        for some in pieces.chunks(wave) {
+            let merged: Vec<SparseCounts> = some
+                .par_iter()
+                .map(|piece| merge_piece(parts, piece))
+                .collect();
+            for m in merged {
+                out.entries.extend_from_slice(&m.entries);
+                out.wide.extend_from_slice(&m.wide);
+            }
         }
-        let wide: Vec<Vec<(u64, u64)>> = pieces
-            .par_iter()
-            .zip(stretches)
-            .map(|(piece, out)| {
-                let merged = merge_piece(parts, piece);
-                out.copy_from_slice(&merged.entries);
-                merged.wide
-            })
-            .collect();
-        SparseCounts {
-            packing,
-            entries,
-            wide: wide.concat(),
-        }
+        out
     }
 
-    /// The entries (and side entries) whose packed pairs lie in `from..to`, as counts of their own.
-    fn piece(&self, from: u64, to: u64) -> SparseCounts {
+    /// The entries (and side entries) whose packed pairs lie in `from..to`.
+    fn slice(&self, from: u64, to: u64) -> Run<'_> {
         let packing = self.packing;
         let at = |k: u64| self.entries.partition_point(|&e| packing.packed_of(e) < k);
         let wide_at = |k: u64| self.wide.partition_point(|&(w, _)| w < k);
-        SparseCounts {
-            packing,
-            entries: self.entries[at(from)..at(to)].to_vec(),
-            wide: self.wide[wide_at(from)..wide_at(to)].to_vec(),
+        Run {
+            entries: &self.entries[at(from)..at(to)],
+            wide: &self.wide[wide_at(from)..wide_at(to)],
+        }
+    }
+
+    /// All of these counts as a [`Run`].
+    fn run(&self) -> Run<'_> {
+        Run {
+            entries: &self.entries,
+            wide: &self.wide,
         }
     }
 
@@ -382,10 +378,11 @@ impl SparseCounts {
     }
 }
 
-/// Cuts the packed pairs of `parts` into consecutive ranges `from..to` of about 32,768 entries of the
-/// longest part each (the last range open-ended).
+/// Cuts the packed pairs of `parts` into consecutive ranges `from..to` of about 8,192 entries of the
+/// longest part each (the last range open-ended): the parts' stretches of one range and their merges fit
+/// in a core's cache.
 fn key_pieces(parts: &[&SparseCounts]) -> Vec<(u64, u64)> {
-    const PIECE: usize = 1 << 15;
+    const PIECE: usize = 1 << 13;
     let longest = parts.iter().max_by_key(|p| p.len()).expect("some parts");
     let packing = longest.packing;
     let cuts: Vec<u64> = (1..longest.len().div_ceil(PIECE))
@@ -398,25 +395,101 @@ fn key_pieces(parts: &[&SparseCounts]) -> Vec<(u64, u64)> {
 
 /// The sum of the parts' entries in one range, merged pairwise as a balanced tree.
 fn merge_piece(parts: &[&SparseCounts], &(from, to): &(u64, u64)) -> SparseCounts {
-    let mut level: Vec<SparseCounts> = parts
+    let packing = parts[0].packing;
+    let runs: Vec<Run> = parts
         .iter()
-        .map(|p| p.piece(from, to))
-        .filter(|p| !p.is_empty())
+        .map(|p| p.slice(from, to))
+        .filter(|r| !r.entries.is_empty())
+        .collect();
+    // The first level merges the parts' stretches in place; later ones merge what it made.
+    let mut level: Vec<SparseCounts> = runs
+        .chunks(2)
+        .map(|pair| match pair {
+            [a, b] => merge_runs(packing, *a, *b),
+            [a] => a.to_counts(packing),
+            _ => unreachable!("chunks of one or two"),
+        })
         .collect();
     while level.len() > 1 {
-        let mut next = Vec::with_capacity(level.len().div_ceil(2));
-        let mut items = level.into_iter();
-        while let Some(mut a) = items.next() {
-            if let Some(b) = items.next() {
-                a.merge(&b);
-            }
-            next.push(a);
-        }
-        level = next;
+        level = level
+            .chunks(2)
+            .map(|pair| match pair {
+                [a, b] => merge_runs(packing, a.run(), b.run()),
+                [a] => a.clone(),
+                _ => unreachable!("chunks of one or two"),
+            })
+            .collect();
     }
     level
         .pop()
-        .unwrap_or_else(|| SparseCounts::with_packing(parts[0].packing))
+        .unwrap_or_else(|| SparseCounts::with_packing(packing))
+}
+
+/// A borrowed stretch of counts: sorted entries and the side entries of those whose field is full.
+#[derive(Clone, Copy, Debug)]
+struct Run<'a> {
+    entries: &'a [u64],
+    wide: &'a [(u64, u64)],
+}
+
+impl Run<'_> {
+    fn to_counts(self, packing: Packing) -> SparseCounts {
+        SparseCounts {
+            packing,
+            entries: self.entries.to_vec(),
+            wide: self.wide.to_vec(),
+        }
+    }
+}
+
+/// The sum of two runs, front to back. As in [`SparseCounts::merge`], which list advances is data, not
+/// control flow; only a sum that reaches the field's largest value takes the slow path, which reads
+/// whole counts from the side entries (every full field is met there in order, so `wa` and `wb` stay
+/// in step with the entries).
+fn merge_runs(packing: Packing, a: Run, b: Run) -> SparseCounts {
+    let max = packing.field_max();
+    let (ea, eb) = (a.entries, b.entries);
+    let mut entries = Vec::with_capacity(ea.len() + eb.len());
+    let mut wide = Vec::new();
+    let (mut i, mut j, mut wa, mut wb) = (0, 0, 0, 0);
+    while i < ea.len() && j < eb.len() {
+        let (x, y) = (ea[i], eb[j]);
+        let (kx, ky) = (packing.packed_of(x), packing.packed_of(y));
+        let (take_a, take_b) = (kx <= ky, ky <= kx);
+        let fx = packing.field_of(x) * u64::from(take_a);
+        let fy = packing.field_of(y) * u64::from(take_b);
+        let key = if take_a { kx } else { ky };
+        if fx == max || fy == max || fx + fy >= max {
+            let cx = if take_a && fx == max {
+                wa += 1;
+                a.wide[wa - 1].1
+            } else {
+                fx
+            };
+            let cy = if take_b && fy == max {
+                wb += 1;
+                b.wide[wb - 1].1
+            } else {
+                fy
+            };
+            wide.push((key, cx + cy));
+            entries.push(packing.entry(key, cx + cy));
+        } else {
+            // The key's bits and a field that does not overflow: the lower entry plus the other's count.
+            entries.push((if take_a { x } else { y }) + fy * u64::from(take_a));
+        }
+        i += usize::from(take_a);
+        j += usize::from(take_b);
+    }
+    entries.extend_from_slice(&ea[i..]);
+    entries.extend_from_slice(&eb[j..]);
+    wide.extend_from_slice(&a.wide[wa..]);
+    wide.extend_from_slice(&b.wide[wb..]);
+    SparseCounts {
+        packing,
+        entries,
+        wide,
+    }
 }
 
 /// A forward walk along sorted counts, looking up pairs in increasing order.

@@ -330,8 +330,45 @@ pub struct BatchTally {
 }
 
 /// Pairs the canonical hits of a batch of lines and tallies the segments (paper sec. 3.2.2): the hot
-/// loop of every analysis.
+/// loop of every analysis. A run tallies many batches with one [`LineTally`] instead.
 pub fn tally_lines(scene: &Scene, lines: &[Line], hits: &LineHits, wanted: Wanted) -> BatchTally {
+    LineTally::new(scene, wanted).batch(lines, hits)
+}
+
+/// The tally of batches of lines through one scene ([`tally_lines`]), with what depends only on the
+/// scene computed once: the eq. (27) offset log2(A_T / pi) is a sum over every patch, which would cost
+/// a pass over the whole patch list per batch.
+#[derive(Clone, Copy, Debug)]
+pub struct LineTally<'a> {
+    scene: &'a Scene,
+    wanted: Wanted,
+    log2_area_over_pi: f64,
+}
+
+impl<'a> LineTally<'a> {
+    /// Prepares the tally of lines through `scene`, gathering what `wanted` says.
+    pub fn new(scene: &'a Scene, wanted: Wanted) -> Self {
+        LineTally {
+            scene,
+            wanted,
+            log2_area_over_pi: (scene.total_area() / std::f64::consts::PI).log2(),
+        }
+    }
+
+    /// Pairs the canonical hits of one batch of lines and tallies the segments.
+    pub fn batch(&self, lines: &[Line], hits: &LineHits) -> BatchTally {
+        let (scene, wanted) = (self.scene, self.wanted);
+        tally_batch(scene, lines, hits, wanted, self.log2_area_over_pi)
+    }
+}
+
+fn tally_batch(
+    scene: &Scene,
+    lines: &[Line],
+    hits: &LineHits,
+    wanted: Wanted,
+    log2_area_over_pi: f64,
+) -> BatchTally {
     let count = lines.len();
     // About one pair per line in most scenes: one allocation instead of a dozen doublings.
     let mut keys = Vec::with_capacity(if wanted.discrete { count } else { 0 });
@@ -401,7 +438,6 @@ pub fn tally_lines(scene: &Scene, lines: &[Line], hits: &LineHits, wanted: Wante
         }
         c.coincident_crossings += ends.overlaps;
     }
-    let log2_area_over_pi = (scene.total_area() / std::f64::consts::PI).log2();
     let (cmi_sum, cmi_pairs) = log2_sum.finish(log2_area_over_pi);
     let (env_sum, env_pairs) = env_sum.finish(0.0);
     (c.cmi_sum, c.cmi_pairs) = (ExactSum::of(cmi_sum), cmi_pairs);

@@ -64,18 +64,37 @@ impl HitRules {
         new_start.push(0u32);
         for (k, line) in lines.iter().enumerate() {
             let (a, b) = (hits.start[k] as usize, hits.start[k + 1] as usize);
-            let row = &mut hits.hits[a..b];
-            row.sort_unstable_by(|x, y| x.t.total_cmp(&y.t).then(x.triangle.cmp(&y.triangle)));
-            kept.clear();
-            self.merge_row(line, row, &mut kept);
-            for h in &kept {
-                hits.hits[write] = *h;
-                write += 1;
-            }
+            let n = self.canonicalize_row(line, &mut hits.hits[a..b], &mut kept);
+            hits.hits.copy_within(a..a + n, write);
+            write += n;
             new_start.push(write as u32);
         }
         hits.hits.truncate(write);
         hits.start = new_start;
+    }
+
+    /// [`HitRules::canonicalize`] for the hits of one line: sorts `row` and moves the hits it keeps to
+    /// its front; returns how many. `kept` is scratch space.
+    ///
+    /// Most rows hold one or two crossings far apart, which need neither a sort call nor clustering.
+    pub fn canonicalize_row(&self, line: &Line, row: &mut [Hit], kept: &mut Vec<Hit>) -> usize {
+        let order = |x: &Hit, y: &Hit| x.t.total_cmp(&y.t).then(x.triangle.cmp(&y.triangle));
+        match row {
+            [] | [_] => return row.len(),
+            [a, b] => {
+                if order(a, b).is_gt() {
+                    std::mem::swap(a, b);
+                }
+                if b.t - a.t > tolerance(a.t) {
+                    return 2;
+                }
+            }
+            _ => row.sort_unstable_by(order),
+        }
+        kept.clear();
+        self.merge_row(line, row, kept);
+        row[..kept.len()].copy_from_slice(kept);
+        kept.len()
     }
 
     /// Merges a sorted row: clusters of hits closer than the tolerance; within a cluster, hits that face

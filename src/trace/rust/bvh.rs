@@ -47,7 +47,7 @@ use obvhs::BvhBuildParams;
 
 use super::watertight::ShearedRay;
 use crate::scene::Scene;
-use crate::trace::{Hit, HitRules, Line, RawHit, TraceError, Tracer};
+use crate::trace::{Hit, HitRules, Line, LineHits, RawHit, TraceError, Tracer};
 
 /// The name in reports and errors.
 const BACKEND: &str = "rust";
@@ -232,18 +232,33 @@ impl BvhTracer {
         }
     }
 
-    /// Calls `visit(t, triangle)` for every hit of one line, in traversal order.
+    /// Calls `visit(t, triangle)` for every hit of one line, in traversal order. `leaves` is scratch.
+    ///
+    /// The leaves are gathered first and their triangles tested after the traversal: the tests of
+    /// different leaves do not depend on each other, so their loads of the triangles (often cache misses)
+    /// overlap, where a test in the middle of the traversal waited for its load before the next box.
     #[inline(always)]
-    fn line_hits(&self, line: &Line, stack: &mut Vec<u32>, mut visit: impl FnMut(f32, u32)) {
-        let sheared = ShearedRay::new(line.origin, line.dir);
+    fn line_hits(
+        &self,
+        line: &Line,
+        stack: &mut Vec<u32>,
+        leaves: &mut Vec<(u32, u32)>,
+        mut visit: impl FnMut(f32, u32),
+    ) {
+        leaves.clear();
         self.traverse(line, stack, |first, count| {
+            leaves.push((first as u32, count as u32));
+            line.t_max
+        });
+        let sheared = ShearedRay::new(line.origin, line.dir);
+        for &(first, count) in leaves.iter() {
+            let (first, count) = (first as usize, count as usize);
             for (slot, [a, b, c]) in self.triangles[first..first + count].iter().enumerate() {
                 if let Some(t) = sheared.intersect(*a, *b, *c, 0.0, line.t_max) {
                     visit(t, self.ids[first + slot]);
                 }
             }
-            line.t_max
-        });
+        }
     }
 
     /// The nearest hit of one line: the least `t`, ties to the lower triangle index (the first hit of the
@@ -382,7 +397,7 @@ impl Tracer for BvhTracer {
     fn raw_hits(&self, lines: &[Line], out: &mut Vec<RawHit>) -> Result<(), TraceError> {
         check_batch(lines)?;
         out.clear();
-        let mut stack = Vec::new();
+        let (mut stack, mut leaves) = (Vec::new(), Vec::new());
         // Each line is checked as it is traced, rather than in a pass of its own: the lines are then
         // read from memory once.
         for (k, line) in lines.iter().enumerate() {
@@ -390,13 +405,45 @@ impl Tracer for BvhTracer {
                 out.clear();
                 return Err(bad_line(k, line));
             }
-            self.line_hits(line, &mut stack, |t, triangle| {
+            self.line_hits(line, &mut stack, &mut leaves, |t, triangle| {
                 out.push(RawHit {
                     t,
                     triangle,
                     line: k as u32,
                 })
             });
+        }
+        Ok(())
+    }
+
+    /// Each line's hits are canonicalised as soon as it is traced, while they are in cache, and written
+    /// straight into their row: no raw hits to regroup by line.
+    fn all_hits(
+        &self,
+        lines: &[Line],
+        _scratch: &mut Vec<RawHit>,
+        out: &mut LineHits,
+    ) -> Result<(), TraceError> {
+        check_batch(lines)?;
+        out.hits.clear();
+        out.start.clear();
+        out.start.push(0);
+        let (mut stack, mut leaves, mut kept) = (Vec::new(), Vec::new(), Vec::new());
+        for (k, line) in lines.iter().enumerate() {
+            if !traceable(line) {
+                out.hits.clear();
+                out.start.clear();
+                return Err(bad_line(k, line));
+            }
+            let from = out.hits.len();
+            self.line_hits(line, &mut stack, &mut leaves, |t, triangle| {
+                out.hits.push(Hit { t, triangle })
+            });
+            let kept_hits = self
+                .rules
+                .canonicalize_row(line, &mut out.hits[from..], &mut kept);
+            out.hits.truncate(from + kept_hits);
+            out.start.push(out.hits.len() as u32);
         }
         Ok(())
     }
