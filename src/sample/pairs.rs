@@ -13,7 +13,7 @@
 //! patch's plane faces neither side and makes its segments unpaired.
 
 use super::order::{self, Crossing};
-use crate::geom::{unit_vector, DVec3, Direction, Point};
+use crate::geom::{unit_vector, DVec3, Direction, Normal, Point};
 use crate::scene::Scene;
 use crate::trace::{Hit, Line};
 
@@ -105,13 +105,68 @@ pub fn segments_and_ends(
     scene: &Scene,
     line: &Line,
     hits: &[Hit],
+    visit: impl FnMut(Segment),
+) -> LineEnds {
+    let plane = |patch: u32| {
+        let p = &scene.patches[patch as usize];
+        (p.normal, p.offset)
+    };
+    ends_of(&scene.triangle_patch, plane, line, hits, visit)
+}
+
+/// The patch planes of a scene (normal and offset, `n . x = offset`) packed 32 bytes a patch, for the
+/// pairing of many lines: a crossing reads its patch's plane, and in a large mesh those reads miss the
+/// cache, so a dense table of just the planes (each within one cache line) misses less than the patch
+/// records. It copies the scene's numbers: pairing with it gives the same segments, to the bit.
+#[derive(Clone, Debug)]
+pub struct PatchPlanes {
+    planes: Vec<[f64; 4]>,
+}
+
+impl PatchPlanes {
+    /// The planes of `scene`'s patches.
+    pub fn of(scene: &Scene) -> Self {
+        PatchPlanes {
+            planes: scene
+                .patches
+                .iter()
+                .map(|p| [p.normal.x, p.normal.y, p.normal.z, p.offset])
+                .collect(),
+        }
+    }
+
+    /// [`segments_and_ends`] with the planes read from this table (made from `scene`).
+    pub fn segments_and_ends(
+        &self,
+        scene: &Scene,
+        line: &Line,
+        hits: &[Hit],
+        visit: impl FnMut(Segment),
+    ) -> LineEnds {
+        let plane = |patch: u32| {
+            let [x, y, z, offset] = self.planes[patch as usize];
+            (DVec3::new(x, y, z), offset)
+        };
+        ends_of(&scene.triangle_patch, plane, line, hits, visit)
+    }
+}
+
+/// [`segments_and_ends`], with each patch's plane from `plane`.
+fn ends_of(
+    triangle_patch: &[u32],
+    plane: impl Fn(u32) -> (Normal, f64),
+    line: &Line,
+    hits: &[Hit],
     mut visit: impl FnMut(Segment),
 ) -> LineEnds {
     if hits.is_empty() {
         return LineEnds::default();
     }
     let l = LineF64::from(line);
-    let crossing = |h: &Hit| crossing(scene, &l, h);
+    let crossing = |h: &Hit| {
+        let patch = triangle_patch[h.triangle as usize];
+        crossing(patch, plane(patch), &l, h)
+    };
     if !order::has_close_hits(hits) {
         return pair_crossings(hits.iter().map(crossing), &mut visit);
     }
@@ -123,14 +178,12 @@ pub fn segments_and_ends(
     }
 }
 
-/// A hit as a crossing: its patch, the facing and the f64 distance to the patch's plane.
-fn crossing(scene: &Scene, l: &LineF64, h: &Hit) -> Crossing {
-    let patch = scene.triangle_patch[h.triangle as usize];
-    let p = &scene.patches[patch as usize];
-    let n = p.normal;
+/// A hit on `patch`, whose plane is `(n, offset)`, as a crossing: its patch, the facing and the f64
+/// distance to the patch's plane.
+fn crossing(patch: u32, (n, offset): (Normal, f64), l: &LineF64, h: &Hit) -> Crossing {
     let cos = n.dot(l.dir);
     let t = if cos != 0.0 {
-        (p.offset - n.dot(l.origin)) / cos
+        (offset - n.dot(l.origin)) / cos
     } else {
         // In the plane: no plane distance; the traced one orders it.
         f64::from(h.t)

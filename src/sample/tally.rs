@@ -9,7 +9,7 @@ use super::counts::{pair_key, PairCounts};
 use super::environment;
 use super::exact::ExactSum;
 use super::kernel::Log2Sum;
-use super::pairs::{segments_and_ends, Segment};
+use super::pairs::{PatchPlanes, Segment};
 use super::patch_sums::PatchKernelSums;
 use crate::scene::Scene;
 use crate::trace::{Line, LineHits};
@@ -338,11 +338,12 @@ pub fn tally_lines(scene: &Scene, lines: &[Line], hits: &LineHits, wanted: Wante
 /// The tally of batches of lines through one scene ([`tally_lines`]), with what depends only on the
 /// scene computed once: the eq. (27) offset log2(A_T / pi) is a sum over every patch, which would cost
 /// a pass over the whole patch list per batch.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 pub struct LineTally<'a> {
     scene: &'a Scene,
     wanted: Wanted,
     log2_area_over_pi: f64,
+    planes: PatchPlanes,
 }
 
 impl<'a> LineTally<'a> {
@@ -352,23 +353,18 @@ impl<'a> LineTally<'a> {
             scene,
             wanted,
             log2_area_over_pi: (scene.total_area() / std::f64::consts::PI).log2(),
+            planes: PatchPlanes::of(scene),
         }
     }
 
     /// Pairs the canonical hits of one batch of lines and tallies the segments.
     pub fn batch(&self, lines: &[Line], hits: &LineHits) -> BatchTally {
-        let (scene, wanted) = (self.scene, self.wanted);
-        tally_batch(scene, lines, hits, wanted, self.log2_area_over_pi)
+        tally_batch(self, lines, hits)
     }
 }
 
-fn tally_batch(
-    scene: &Scene,
-    lines: &[Line],
-    hits: &LineHits,
-    wanted: Wanted,
-    log2_area_over_pi: f64,
-) -> BatchTally {
+fn tally_batch(prepared: &LineTally, lines: &[Line], hits: &LineHits) -> BatchTally {
+    let (scene, wanted) = (prepared.scene, prepared.wanted);
     let count = lines.len();
     // About one pair per line in most scenes: one allocation instead of a dozen doublings.
     let mut keys = Vec::with_capacity(if wanted.discrete { count } else { 0 });
@@ -396,40 +392,42 @@ fn tally_batch(
         }
         let events = &mut t.side_events;
         let pair_terms = &mut t.pair_terms;
-        let ends = segments_and_ends(scene, line, line_hits, |s| match s {
-            Segment::Pair {
-                from,
-                to,
-                distance,
-                cos_from,
-                cos_to,
-            } => {
-                c.pairs += 1;
-                if wanted.discrete {
-                    keys.push(pair_key(from, to));
+        let ends = prepared
+            .planes
+            .segments_and_ends(scene, line, line_hits, |s| match s {
+                Segment::Pair {
+                    from,
+                    to,
+                    distance,
+                    cos_from,
+                    cos_to,
+                } => {
+                    c.pairs += 1;
+                    if wanted.discrete {
+                        keys.push(pair_key(from, to));
+                    }
+                    if wanted.per_patch {
+                        pair_terms.push(PatchKernelSums::pair_term(cos_from * cos_to, distance));
+                    }
+                    if wanted.continuous && !log2_sum.add(cos_from * cos_to, distance) {
+                        c.degenerate_pairs += 1;
+                    }
                 }
-                if wanted.per_patch {
-                    pair_terms.push(PatchKernelSums::pair_term(cos_from * cos_to, distance));
+                Segment::Escape { patch, at_start } => {
+                    c.escapes += 1;
+                    if wanted.discrete {
+                        t.escape_patches.push(patch);
+                    }
+                    events.push(event(patch, 2));
+                    let (cos_product, distance) = environment::escape(scene, line, patch, at_start);
+                    env_sum.add(cos_product, distance);
                 }
-                if wanted.continuous && !log2_sum.add(cos_from * cos_to, distance) {
-                    c.degenerate_pairs += 1;
+                Segment::BackSeen { patch } => {
+                    c.unpaired += 1;
+                    events.push(event(patch, 3));
                 }
-            }
-            Segment::Escape { patch, at_start } => {
-                c.escapes += 1;
-                if wanted.discrete {
-                    t.escape_patches.push(patch);
-                }
-                events.push(event(patch, 2));
-                let (cos_product, distance) = environment::escape(scene, line, patch, at_start);
-                env_sum.add(cos_product, distance);
-            }
-            Segment::BackSeen { patch } => {
-                c.unpaired += 1;
-                events.push(event(patch, 3));
-            }
-            Segment::Unpaired => c.unpaired += 1,
-        });
+                Segment::Unpaired => c.unpaired += 1,
+            });
         if let Some(p) = ends.back_first {
             events.push(event(p, 0));
         }
@@ -438,7 +436,7 @@ fn tally_batch(
         }
         c.coincident_crossings += ends.overlaps;
     }
-    let (cmi_sum, cmi_pairs) = log2_sum.finish(log2_area_over_pi);
+    let (cmi_sum, cmi_pairs) = log2_sum.finish(prepared.log2_area_over_pi);
     let (env_sum, env_pairs) = env_sum.finish(0.0);
     (c.cmi_sum, c.cmi_pairs) = (ExactSum::of(cmi_sum), cmi_pairs);
     (c.env_log2_sum, c.env_pairs) = (ExactSum::of(env_sum), env_pairs);
