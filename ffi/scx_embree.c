@@ -18,12 +18,10 @@
 #define SCX_PREFETCH(p) __builtin_prefetch(p)
 #endif
 
-#if SCX_EMBREE_V4
-/* Without the scene flag, packet queries run kernels that never call the argument filter. */
-#define SCX_SCENE_FLAGS (RTC_SCENE_FLAG_ROBUST | RTC_SCENE_FLAG_FILTER_FUNCTION_IN_ARGUMENTS)
-#else
-#define SCX_SCENE_FLAGS (RTC_SCENE_FLAG_ROBUST | RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION)
-#endif
+/* Robust box tests: the margin would cover Embree's fast ones too, but robust mode costs nothing measurable
+ * on boxes, and keeps Embree's own rounding out of the argument. No filter flags: nothing is filtered,
+ * the user geometry's intersect callback sees every candidate. */
+#define SCX_SCENE_FLAGS (RTC_SCENE_FLAG_ROBUST)
 
 struct scx_device {
   RTCDevice rtc;
@@ -35,13 +33,17 @@ struct scx_scene {
   uint32_t widths;    /* copied from the device: checked on every query */
   float* triangles;   /* the original triangles, 9 floats each, for the watertight test */
   uint32_t n_triangles;
+  float margin;       /* how far each triangle's box reaches beyond it */
 };
 
-/* How far each triangle's edges are pushed out for Embree, relative to the scene's extent. Embree's
- * robust test errs by a few ulps of the distances involved (~1e-7 for a unit scene seen from a few units
- * away; measured: misses stop beyond ~1e-6): the margin must exceed that by far, and costs only
- * candidates the watertight test then rejects (about margin x perimeter / area more of them). */
-#define SCX_MARGIN (1.0 / 65536.0)
+/* Every triangle's box grows on each side by the scene's size (the largest side of its bounding box) over
+ * this, as in the pure-Rust tracer (margin() in src/trace/rust/bvh.rs, the same f32 operations): at least
+ * 1.7e-5 in tracing space, where the scene fills the unit sphere. A box holds every point within the
+ * margin of its triangle, in every direction. The watertight test sees the line through the triangle's
+ * corners relative to the line's origin, rounded to f32: ~1e-6 for origins a few units away, and Embree's
+ * box tests round as little. So a line the test says hits a triangle passes well inside the triangle's
+ * box, and Embree proposes it, whatever the angle between line and triangle. */
+#define SCX_MARGIN_DIVISOR 65536.0f
 
 /* ---------------------------------------------------------------------------------------------------- */
 /* Errors. Embree calls the error callback on the thread whose API call failed, so a thread-local record
@@ -116,7 +118,6 @@ void scx_get_layout(scx_layout* out) {
 #if SCX_EMBREE_V4
   out->arguments = sizeof(struct RTCIntersectArguments);
 #endif
-  out->filter_args = sizeof(struct RTCFilterFunctionNArguments);
   out->line = sizeof(scx_line);
   out->hit_record = sizeof(scx_hit);
   out->hits = sizeof(scx_hits);
@@ -186,62 +187,37 @@ static int check_indices(const uint32_t* indices, uint32_t n_triangles, uint32_t
   return SCX_OK;
 }
 
-/* The triangle pushed out by `margin` on every side: scaled about its incenter by 1 + margin / inradius,
- * which moves each edge outwards by exactly `margin`. Degenerate triangles are left as they are (the
- * watertight test never hits them). */
-static void inflate(const float* tri, double margin, float* out) {
-  double v[3][3], len[3], center[3] = {0.0, 0.0, 0.0};
-  for (int k = 0; k < 3; ++k)
-    for (int a = 0; a < 3; ++a) v[k][a] = tri[3 * k + a];
-  for (int k = 0; k < 3; ++k) {
-    /* len[k]: the side opposite vertex k */
-    const double* p = v[(k + 1) % 3];
-    const double* q = v[(k + 2) % 3];
-    len[k] = sqrt((p[0] - q[0]) * (p[0] - q[0]) + (p[1] - q[1]) * (p[1] - q[1]) + (p[2] - q[2]) * (p[2] - q[2]));
-  }
-  const double perimeter = len[0] + len[1] + len[2];
-  double e1[3], e2[3];
-  for (int a = 0; a < 3; ++a) {
-    e1[a] = v[1][a] - v[0][a];
-    e2[a] = v[2][a] - v[0][a];
-  }
-  const double cx = e1[1] * e2[2] - e1[2] * e2[1];
-  const double cy = e1[2] * e2[0] - e1[0] * e2[2];
-  const double cz = e1[0] * e2[1] - e1[1] * e2[0];
-  const double inradius = sqrt(cx * cx + cy * cy + cz * cz) / perimeter; /* 2 area / perimeter */
-  if (!(inradius > 0.0) || !isfinite(inradius)) {
-    memcpy(out, tri, 9 * sizeof(float));
-    return;
-  }
-  for (int k = 0; k < 3; ++k)
-    for (int a = 0; a < 3; ++a) center[a] += v[k][a] * len[k] / perimeter;
-  const double scale = 1.0 + margin / inradius;
-  for (int k = 0; k < 3; ++k)
-    for (int a = 0; a < 3; ++a) out[3 * k + a] = (float)(center[a] + (v[k][a] - center[a]) * scale);
+/* Embree's bounds callback: the box of triangle primID, grown by the margin. */
+static void triangle_bounds(const struct RTCBoundsFunctionArguments* args) {
+  const scx_scene* scene = (const scx_scene*)args->geometryUserPtr;
+  const float* v = scene->triangles + 9 * (size_t)args->primID;
+  const float m = scene->margin;
+  struct RTCBounds* b = args->bounds_o;
+  b->lower_x = fminf(fminf(v[0], v[3]), v[6]) - m;
+  b->lower_y = fminf(fminf(v[1], v[4]), v[7]) - m;
+  b->lower_z = fminf(fminf(v[2], v[5]), v[8]) - m;
+  b->upper_x = fmaxf(fmaxf(v[0], v[3]), v[6]) + m;
+  b->upper_y = fmaxf(fmaxf(v[1], v[4]), v[7]) + m;
+  b->upper_z = fmaxf(fmaxf(v[2], v[5]), v[8]) + m;
 }
 
-/* Attaches the scene's triangles, inflated, as geometry 0 (primID = triangle index). Inflation is per
- * triangle, so the vertex buffer holds three vertices per triangle. */
-static int attach_triangles(RTCDevice device, scx_scene* scene, double margin) {
-  const size_t n = scene->n_triangles;
-  RTCGeometry geometry = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
+static void propose(const struct RTCIntersectFunctionNArguments* args);
+
+/* Attaches the scene's triangles as geometry 0 (primID = triangle index): a user geometry whose bounds are
+ * the triangles' grown boxes and whose intersect callback, propose(), hands each candidate to the
+ * watertight test. Not Embree's own triangles, even inflated: inflating a triangle within its plane gives
+ * no margin across the plane, and a line at a small angle a to the plane sees every error across it
+ * (the f32 rounding of the inflated corners, which tilts the plane, and the rounding of Embree's and of
+ * the watertight test) magnified by 1 / sin a within the plane, past any in-plane margin near an edge.
+ * That lost crossings of ~4% of lines grazing tilted triangles at vertices and edges, and ~2e-3 of lines
+ * aimed at the vertices of @sphere:5 in random directions. */
+static int attach_triangles(RTCDevice device, scx_scene* scene) {
+  RTCGeometry geometry = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_USER);
   if (!geometry) return fail(RTC_ERROR_UNKNOWN, "rtcNewGeometry failed");
-  /* Embree reads the last vertex with a 16-byte load, so the buffer needs 4 bytes past the last float3.
-   * Some Embree 3 releases get the over-allocation of rtcSetNewGeometryBuffer wrong for a 12-byte stride,
-   * so ask for one spare (zeroed, never indexed) vertex instead of relying on it. */
-  float* vertices = rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
-                                            3 * sizeof(float), 3 * n + 1);
-  uint32_t* indices = rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
-                                              3 * sizeof(uint32_t), n);
-  if (!vertices || !indices) {
-    rtcReleaseGeometry(geometry);
-    return fail(RTC_ERROR_OUT_OF_MEMORY, "rtcSetNewGeometryBuffer failed");
-  }
-  for (size_t i = 0; i < n; ++i) {
-    inflate(scene->triangles + 9 * i, margin, vertices + 9 * i);
-    for (uint32_t k = 0; k < 3; ++k) indices[3 * i + k] = (uint32_t)(3 * i + k);
-  }
-  memset(vertices + 9 * n, 0, 3 * sizeof(float));
+  rtcSetGeometryUserPrimitiveCount(geometry, scene->n_triangles);
+  rtcSetGeometryUserData(geometry, scene);
+  rtcSetGeometryBoundsFunction(geometry, triangle_bounds, NULL);
+  rtcSetGeometryIntersectFunction(geometry, propose);
   rtcCommitGeometry(geometry);
   rtcAttachGeometry(scene->rtc, geometry);
   /* The scene holds its own reference now. */
@@ -249,17 +225,26 @@ static int attach_triangles(RTCDevice device, scx_scene* scene, double margin) {
   return last_code;
 }
 
-/* Copies the triangles' corners out of the indexed mesh; returns the largest coordinate magnitude. */
-static double gather_triangles(float* out, const float* positions, const uint32_t* indices, uint32_t n) {
-  double extent = 0.0;
+/* Copies the triangles' corners out of the indexed mesh. */
+static void gather_triangles(float* out, const float* positions, const uint32_t* indices, uint32_t n) {
   for (size_t i = 0; i < (size_t)n * 3; ++i) {
+    for (int a = 0; a < 3; ++a) out[3 * i + a] = positions[3 * (size_t)indices[i] + a];
+  }
+}
+
+/* The boxes' margin: the largest side of the vertices' bounding box over SCX_MARGIN_DIVISOR (1 over it for
+ * an empty or flat-as-a-point scene), in the pure-Rust tracer's f32 operations. */
+static float box_margin(const float* positions, uint32_t n_vertices) {
+  float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+  for (size_t i = 0; i < n_vertices; ++i) {
     for (int a = 0; a < 3; ++a) {
-      const float c = positions[3 * (size_t)indices[i] + a];
-      out[3 * i + a] = c;
-      if (fabs(c) > extent) extent = fabs(c);
+      lo[a] = fminf(lo[a], positions[3 * i + a]);
+      hi[a] = fmaxf(hi[a], positions[3 * i + a]);
     }
   }
-  return extent;
+  float size = 0.0f;
+  for (int a = 0; a < 3; ++a) size = fmaxf(size, hi[a] - lo[a]);
+  return (size > 0.0f ? size : 1.0f) / SCX_MARGIN_DIVISOR;
 }
 
 int scx_scene_new(scx_device* device, const float* positions, uint32_t n_vertices, const uint32_t* indices,
@@ -282,7 +267,8 @@ int scx_scene_new(scx_device* device, const float* positions, uint32_t n_vertice
     free(scene);
     return fail(RTC_ERROR_OUT_OF_MEMORY, "scx_scene_new: out of memory");
   }
-  const double extent = gather_triangles(scene->triangles, positions, indices, n_triangles);
+  gather_triangles(scene->triangles, positions, indices, n_triangles);
+  scene->margin = box_margin(positions, n_vertices);
   scene->rtc = rtcNewScene(device->rtc);
   if (!scene->rtc) {
     free(scene);
@@ -291,7 +277,7 @@ int scx_scene_new(scx_device* device, const float* positions, uint32_t n_vertice
   rtcSetSceneFlags(scene->rtc, (enum RTCSceneFlags)SCX_SCENE_FLAGS);
   /* An empty scene is valid: it has no geometry and every query misses. */
   if (n_triangles > 0) {
-    attach_triangles(device->rtc, scene, SCX_MARGIN * (extent > 0.0 ? extent : 1.0));
+    attach_triangles(device->rtc, scene);
   }
   if (last_code == SCX_OK) rtcCommitScene(scene->rtc);
   if (last_code != SCX_OK) {
@@ -399,47 +385,56 @@ static int watertight_hit(const scx_sheared* r, const float* tri, float t_min, f
   return 1;
 }
 
-/* The candidate in lane i: its line and triangle, 0 for a foreign ray or primitive (flagged, never
- * expected). */
-static int candidate(scx_query* q, const struct RTCFilterFunctionNArguments* args, unsigned int i,
-                     uint32_t* line, uint32_t* prim) {
-  const unsigned int n = args->N;
-  /* Lanes are found by ray id, never by position: Embree may repack rays. */
-  *line = ((const unsigned int*)args->ray)[10 * n + i];
-  *prim = ((const unsigned int*)args->hit)[5 * n + i];
-  if (*line >= q->n_lines || *prim >= q->n_triangles) {
-    q->bad_ray_id = 1;
-    return 0;
-  }
-  return 1;
-}
-
-/* The candidate in lane i, decided by the watertight test: 1 and *t for a hit. */
-static int decide(scx_query* q, const struct RTCFilterFunctionNArguments* args, unsigned int i,
-                  uint32_t* line, uint32_t* prim, float* t) {
-  if (!candidate(q, args, i, line, prim)) return 0;
-  return watertight_hit(&q->sheared[*line], q->triangles + 9 * (size_t)*prim, 0.0f, q->lines[*line].t_max, t);
-}
-
-/* All hits: record the candidate, to be decided after the traversal (decide_candidates), and reject it,
- * so that one traversal visits every candidate. Deciding here instead made Embree wait, candidate after
- * candidate, for the test and for the cache miss on the original triangle: 30-40% of an all-hits trace of
- * @cube:100 (120,000 triangles); decided afterwards, in one pass, the misses overlap. */
-static void collect_hits(const struct RTCFilterFunctionNArguments* args) {
+/* Embree's candidates: each triangle whose box a ray of the query crosses. All hits: record the candidate,
+ * to be decided after the traversal (decide_candidates), and report no hit, so that the traversal goes
+ * on through every box. Deciding here instead made Embree wait, candidate after candidate, for the test
+ * and for the cache miss on the original triangle: 30-40% of an all-hits trace of @cube:100 (120,000
+ * triangles); decided afterwards, in one pass, the misses overlap. First hit: decide at once and report
+ * true hits (shortening the ray, so Embree narrows its search to nearer boxes), keeping the nearest by the
+ * watertight t, ties to the lower triangle index. */
+static void propose(const struct RTCIntersectFunctionNArguments* args) {
   /* args->context points at q->rtc, the first member of q. */
   scx_query* q = (scx_query*)args->context;
-  for (unsigned int i = 0; i < args->N; ++i) {
+  const uint32_t prim = args->primID;
+  const unsigned int n = args->N;
+  float* ray = (float*)args->rayhit;
+  unsigned int* hit = (unsigned int*)args->rayhit + SCX_RAY_FIELDS * n;
+  if (prim >= q->n_triangles) {
+    q->bad_ray_id = 1;
+    return;
+  }
+  for (unsigned int i = 0; i < n; ++i) {
     if (args->valid[i] != -1) continue;
-    uint32_t line, prim;
-    if (candidate(q, args, i, &line, &prim)) hits_push(q->hits, 0.0f, prim, line);
-    args->valid[i] = 0;
+    /* Lanes are found by ray id, never by position: Embree may repack rays. */
+    const uint32_t line = ((const unsigned int*)ray)[10 * n + i];
+    if (line >= q->n_lines) {
+      q->bad_ray_id = 1;
+      continue;
+    }
+    if (q->hits) {
+      hits_push(q->hits, 0.0f, prim, line);
+      continue;
+    }
+    float t;
+    const float t_far = ray[8 * n + i];
+    if (!watertight_hit(&q->sheared[line], q->triangles + 9 * (size_t)prim, 0.0f, t_far, &t)) continue;
+    scx_first_hit* best = &q->first[line];
+    if (best->prim == SCX_NO_LINE || t < best->t || (t == best->t && prim < best->prim)) {
+      best->t = t;
+      best->prim = prim;
+    }
+    /* Boxes reach past their triangle by the margin, so another triangle through the same point, at the
+     * same t, is still proposed after tfar shrinks to t. */
+    ray[8 * n + i] = t;
+    hit[5 * n + i] = prim;
+    hit[6 * n + i] = args->geomID;
   }
 }
 
 /* How many candidates ahead decide_candidates prefetches the original triangle. */
 #define SCX_PREFETCH_AHEAD 8
 
-/* Decides the candidates hits[from..len) recorded by collect_hits with the watertight test: keeps the
+/* Decides the candidates hits[from..len) recorded by propose() with the watertight test: keeps the
  * hits, in order, with their distances, and drops the rest. */
 static void decide_candidates(const scx_query* q, size_t from) {
   scx_hit* data = q->hits->data;
@@ -464,26 +459,6 @@ static void decide_candidates(const scx_query* q, size_t from) {
   q->hits->len = kept;
 }
 
-/* First hit: accept true hits (so Embree narrows the search to nearer ones) and keep the nearest by the
- * watertight t, ties to the lower triangle index; reject false candidates of the inflated triangles. */
-static void nearest_hit(const struct RTCFilterFunctionNArguments* args) {
-  scx_query* q = (scx_query*)args->context;
-  for (unsigned int i = 0; i < args->N; ++i) {
-    if (args->valid[i] != -1) continue;
-    uint32_t line, prim;
-    float t;
-    if (!decide(q, args, i, &line, &prim, &t)) {
-      args->valid[i] = 0;
-      continue;
-    }
-    scx_first_hit* best = &q->first[line];
-    if (best->prim == SCX_NO_LINE || t < best->t || (t == best->t && prim < best->prim)) {
-      best->t = t;
-      best->prim = prim;
-    }
-  }
-}
-
 /* ---------------------------------------------------------------------------------------------------- */
 /* Queries, with the v3/v4 differences kept in these few functions. */
 
@@ -491,16 +466,12 @@ static void nearest_hit(const struct RTCFilterFunctionNArguments* args) {
 static void query_init(scx_query* q, const scx_scene* scene, const scx_line* lines, const scx_sheared* sheared,
                        uint32_t n_lines, scx_hits* hits, scx_first_hit* first) {
   memset(q, 0, sizeof *q);
-  RTCFilterFunctionN filter = hits ? collect_hits : nearest_hit;
 #if SCX_EMBREE_V4
   rtcInitRayQueryContext(&q->rtc);
   rtcInitIntersectArguments(&q->args);
   q->args.context = &q->rtc;
-  q->args.filter = filter;
-  q->args.flags = (enum RTCRayQueryFlags)(q->args.flags | RTC_RAY_QUERY_FLAG_INVOKE_ARGUMENT_FILTER);
 #else
   rtcInitIntersectContext(&q->rtc);
-  q->rtc.filter = filter;
 #endif
   q->triangles = scene->triangles;
   q->n_triangles = scene->n_triangles;
@@ -589,7 +560,7 @@ static void packet_fill(scx_packet* p, int* valid, uint32_t n, const scx_line* l
   }
 }
 
-/* Results arrive through the filter (in q), not in the ray structs. */
+/* Results arrive through propose() (in q), not in the ray structs. */
 static void trace_single(RTCScene scene, scx_query* q, const scx_line* lines, uint32_t n) {
   for (uint32_t k = 0; k < n; ++k) {
     struct RTCRayHit rh;
@@ -619,7 +590,7 @@ static int check_query(const scx_scene* scene, const scx_line* lines, uint32_t n
   return SCX_OK;
 }
 
-/* Prepares the batch for the watertight test (in the caller's scratch) and traces it; the filter delivers
+/* Prepares the batch for the watertight test (in the caller's scratch) and traces it; propose() delivers
  * the results into q (all hits: candidates, decided after the traversal). */
 static int trace(const scx_scene* scene, const scx_line* lines, uint32_t n, uint32_t width,
                  scx_sheared* sheared, scx_hits* hits, scx_first_hit* first) {

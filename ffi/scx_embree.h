@@ -29,7 +29,7 @@
 
 #if RTC_VERSION_MAJOR >= 4
 #define SCX_EMBREE_V4 1
-/* The per-query state Embree hands back to the filter callback. */
+/* The per-query state Embree hands back to the intersect callback. */
 #define SCX_RTC_CONTEXT struct RTCRayQueryContext
 #else
 #define SCX_EMBREE_V4 0
@@ -96,8 +96,8 @@ typedef struct scx_sheared {
 } scx_sheared;
 
 /* The per-query state. The Embree context must be the first member: Embree passes a pointer to it to the
- * filter callback, which casts it back to the whole struct. Internal; in the header only so the bindings'
- * size can be checked. */
+ * intersect callback, which casts it back to the whole struct. Internal; in the header only so the
+ * bindings' size can be checked. */
 typedef struct scx_query {
   SCX_RTC_CONTEXT rtc;
 #if SCX_EMBREE_V4
@@ -110,7 +110,7 @@ typedef struct scx_query {
   uint32_t n_lines;          /* ray ids at or above this are not lines of the batch */
   scx_hits* hits;            /* all-hits queries: where candidates are appended, decided after the traversal */
   scx_first_hit* first;      /* first-hit queries: the nearest hit so far of each line */
-  int bad_ray_id;            /* set by the filter on a foreign ray id or primitive */
+  int bad_ray_id;            /* set by the callback on a foreign ray id or primitive */
 } scx_query;
 
 /* sizeof/_Alignof of every struct shared with Rust, as this C compiler sees them, and RTC_VERSION. Rust
@@ -128,7 +128,6 @@ typedef struct scx_layout {
   size_t align_rayhit16;  /* _Alignof(struct RTCRayHit16) */
   size_t context;         /* RTCIntersectContext (v3) or RTCRayQueryContext (v4) */
   size_t arguments;       /* RTCIntersectArguments (v4); 0 with Embree 3 */
-  size_t filter_args;     /* struct RTCFilterFunctionNArguments */
   size_t line;            /* scx_line */
   size_t hit_record;      /* scx_hit */
   size_t hits;            /* scx_hits */
@@ -155,15 +154,16 @@ uint32_t scx_device_packet_widths(const scx_device* device);
 /* Embree's version as the running library reports it. */
 void scx_device_version(const scx_device* device, int* major, int* minor, int* patch);
 
-/* Builds and commits a robust scene with one triangle mesh: n_vertices float3 positions and n_triangles
+/* Builds and commits a robust scene of n_triangles triangles: n_vertices float3 positions and n_triangles
  * uint3 vertex indices (copied). Every index must be below n_vertices.
  *
- * Embree's own triangle test (robust mode) is watertight for lines that cross an edge into the surface,
- * but can miss every triangle around a vertex, or one face of a convex edge, when a line passes within
- * rounding distance of it. So Embree gets each triangle inflated by a small margin (every edge pushed out
- * by ~1.5e-5 of the scene's size), which makes its candidates a superset of the true hits, and every
- * candidate is then decided, and its distance computed, by the watertight test on the original triangle:
- * the hits are exactly those of that test, which is watertight at edges and vertices alike. */
+ * Embree never tests the triangles itself: its own test (robust mode) can miss every triangle around a
+ * vertex, or one face of a convex edge, when a line passes within rounding distance, and a triangle
+ * inflated within its plane gives no margin across it (lines at small angles to the plane got lost).
+ * So Embree gets each triangle's box, grown by 1/65536 of the scene's size on every side as in the
+ * pure-Rust tracer, as a user geometry: the triangles whose boxes a line crosses are a superset of the
+ * true hits at any angle, and each is decided, and its distance computed, by the watertight test on the
+ * original triangle. The hits are exactly that test's, which is watertight at edges and vertices alike. */
 int scx_scene_new(scx_device* device, const float* positions, uint32_t n_vertices, const uint32_t* indices,
                   uint32_t n_triangles, scx_scene** out);
 /* Releases a scene. */
