@@ -30,7 +30,7 @@
 //!
 //! A box test in f32 can miss a triangle that a line grazes (a wall is a box of zero thickness), so each
 //! triangle's box is inflated by [`margin`] on every side before the build, far beyond f32 rounding of the
-//! slab test, as the Embree backend inflates its triangles; a node's boxes are exact f32 unions of these
+//! slab test (the Embree backend proposes from the same grown boxes); a node's boxes are exact f32 unions of these
 //! (min and max round nothing): the candidates are then a superset of the true hits, and every hit (and
 //! its `t`) comes from the watertight test on the original triangle, in the same operations as the
 //! brute-force tracer and the Embree filter. No spatial splits are used, so a triangle is
@@ -53,8 +53,8 @@ use crate::trace::{Hit, HitRules, Line, LineHits, RawHit, TraceError, Tracer};
 const BACKEND: &str = "rust";
 
 /// Every triangle's box grows by this fraction of the scene's extent on each side (the Embree backend
-/// inflates its triangles by the same amount). In tracing space (unit bounding sphere) that is ~3e-5,
-/// a few hundred f32 ulps: the slab test can never round a crossed box into a missed one. Also, the slab
+/// grows its boxes by the same amount, in the same operations). In tracing space (unit bounding sphere)
+/// that is ~3e-5, a few hundred f32 ulps: the slab test can never round a crossed box into a missed one. Also, the slab
 /// test replaces a direction component below f32 epsilon by +-1/epsilon (as obvhs does); a line parallel
 /// to a wall then sees the wall's box only within `margin * 2^23 > 2 * t_max` of its origin when it passes
 /// inside the margin, so no true candidate is lost.
