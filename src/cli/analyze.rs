@@ -410,7 +410,11 @@ pub fn run(args: &AnalyzeArgs) -> Result<Exit, Failure> {
         persist::save(path, &identity, &state, seconds).map_err(persist_failure)?;
         output::wrote(path);
     }
-    let analysis = finish(&runner.scene, &cfg, state, stop_reason, seconds).map_err(Failure::of)?;
+    // In the run's pool: the measures use the threads asked for, like the tracing.
+    let analysis = runner
+        .pool
+        .install(|| finish(&runner.scene, &cfg, state, stop_reason, seconds))
+        .map_err(Failure::of)?;
     for w in &analysis.warnings {
         warn(&w.message);
     }

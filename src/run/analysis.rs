@@ -594,7 +594,9 @@ fn next_batches(done: &BatchSet, mut cursor: u64, end: u64, count: u64) -> (Vec<
 }
 
 /// The measures of a run's state: every reading with its standard error and verdict, the radiosity
-/// measures when the scene emits, and the warnings. `seconds` is the run's time, for the report.
+/// measures when the scene emits, and the warnings. `seconds` is the run's time before its measures;
+/// the report's [`Analysis::seconds`] adds the time they take here (summing the groups into the run's
+/// total and estimating from them is part of what a user waits for).
 pub fn finish(
     scene: &Scene,
     cfg: &AnalysisConfig,
@@ -602,6 +604,7 @@ pub fn finish(
     stop_reason: StopReason,
     seconds: f64,
 ) -> Result<Analysis, AnalysisError> {
+    let began = Instant::now();
     let materials = if cfg.measures.radiosity {
         Some(PatchMaterials::of_scene(scene)?)
     } else {
@@ -664,7 +667,7 @@ pub fn finish(
     Ok(Analysis {
         lines: total.counters.lines,
         seed: cfg.seed,
-        seconds,
+        seconds: seconds + began.elapsed().as_secs_f64(),
         stop_reason,
         plan,
         covered,

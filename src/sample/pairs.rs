@@ -114,28 +114,67 @@ pub fn segments_and_ends(
     ends_of(&scene.triangle_patch, plane, line, hits, visit)
 }
 
-/// The patch planes of a scene (normal and offset, `n . x = offset`) packed 32 bytes a patch, for the
-/// pairing of many lines: a crossing reads its patch's plane, and in a large mesh those reads miss the
-/// cache, so a dense table of just the planes (each within one cache line) misses less than the patch
-/// records. It copies the scene's numbers: pairing with it gives the same segments, to the bit.
+/// The patch planes of a scene (normal and offset, `n . x = offset`), for the pairing of many lines: a
+/// crossing reads its patch's plane, and in a large mesh those reads miss the cache. The planes are kept
+/// 32 bytes each (one cache line holds a plane), and when many patches share a plane bit for bit, as the
+/// patches of a wall meshed for radiosity do, each distinct plane is kept once with a 4-byte index per
+/// patch: the index table and the few planes stay in cache where the full table did not. Either way it
+/// holds the scene's own numbers: pairing with it gives the same segments, to the bit.
 #[derive(Clone, Debug)]
 pub struct PatchPlanes {
+    /// The distinct planes (or every patch's, when `index` is empty).
     planes: Vec<[f64; 4]>,
+    /// Each patch's plane in `planes`; empty when `planes` holds one plane per patch.
+    index: Vec<u32>,
 }
 
 impl PatchPlanes {
-    /// The planes of `scene`'s patches.
+    /// A table of planes this large is read from a core's second-level cache (256 KiB and more on
+    /// current x86 and ARM cores).
+    const CACHED_BYTES: usize = 256 << 10;
+
+    /// The planes of `scene`'s patches, shared when the full table would not fit in a core's cache
+    /// ([`PatchPlanes::CACHED_BYTES`]) and at most a quarter of them are distinct. Otherwise the index
+    /// would only add a dependent read to every crossing.
     pub fn of(scene: &Scene) -> Self {
-        PatchPlanes {
-            planes: scene
-                .patches
-                .iter()
-                .map(|p| [p.normal.x, p.normal.y, p.normal.z, p.offset])
-                .collect(),
+        let every: Vec<[f64; 4]> = scene
+            .patches
+            .iter()
+            .map(|p| [p.normal.x, p.normal.y, p.normal.z, p.offset])
+            .collect();
+        if std::mem::size_of_val(every.as_slice()) <= Self::CACHED_BYTES {
+            return PatchPlanes {
+                planes: every,
+                index: Vec::new(),
+            };
         }
+        let mut seen: std::collections::HashMap<[u64; 4], u32> = std::collections::HashMap::new();
+        let mut planes = Vec::new();
+        let mut index = Vec::with_capacity(every.len());
+        for plane in &every {
+            let next = planes.len() as u32;
+            let at = *seen.entry(plane.map(f64::to_bits)).or_insert(next);
+            if at == next {
+                planes.push(*plane);
+            }
+            index.push(at);
+            if planes.len() > every.len() / 4 {
+                return PatchPlanes {
+                    planes: every,
+                    index: Vec::new(),
+                };
+            }
+        }
+        PatchPlanes { planes, index }
     }
 
-    /// [`segments_and_ends`] with the planes read from this table (made from `scene`).
+    /// Whether patches share their planes behind an index (see [`PatchPlanes::of`]).
+    pub fn shares_planes(&self) -> bool {
+        !self.index.is_empty()
+    }
+
+    /// [`segments_and_ends`] with the planes read from this table (made from `scene`). The two layouts
+    /// get a pairing loop each, so the direct one pays nothing for the index.
     pub fn segments_and_ends(
         &self,
         scene: &Scene,
@@ -143,11 +182,15 @@ impl PatchPlanes {
         hits: &[Hit],
         visit: impl FnMut(Segment),
     ) -> LineEnds {
-        let plane = |patch: u32| {
-            let [x, y, z, offset] = self.planes[patch as usize];
-            (DVec3::new(x, y, z), offset)
-        };
-        ends_of(&scene.triangle_patch, plane, line, hits, visit)
+        let as_plane = |[x, y, z, offset]: [f64; 4]| (DVec3::new(x, y, z), offset);
+        let (planes, index) = (&self.planes, &self.index);
+        if index.is_empty() {
+            let plane = |patch: u32| as_plane(planes[patch as usize]);
+            ends_of(&scene.triangle_patch, plane, line, hits, visit)
+        } else {
+            let plane = |patch: u32| as_plane(planes[index[patch as usize] as usize]);
+            ends_of(&scene.triangle_patch, plane, line, hits, visit)
+        }
     }
 }
 

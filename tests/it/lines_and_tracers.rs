@@ -203,3 +203,36 @@ fn hits_per_patch_follow_crofton() {
         assert!(chi2 < 60.0, "{}: chi2 = {chi2}", tracer.name());
     }
 }
+
+/// Pairing from the run's plane table ([`PatchPlanes`], shared planes behind an index on a large mesh of
+/// walls, one plane per patch on a curved mesh) gives the segments of pairing from the patch records
+/// themselves, to the bit, line by line.
+#[test]
+fn the_plane_table_pairs_every_line_as_the_patch_records_do() {
+    use scene_complexity::sample::pairs::{segments_and_ends, PatchPlanes};
+    for name in ["@cube:60", "@sphere:5", "@cornell"] {
+        let scene = scenes::load(name).unwrap();
+        let planes = PatchPlanes::of(&scene);
+        // The walls of a fine cube share six planes; a sphere's patches have a plane each; the Cornell
+        // box is small enough for the full table.
+        assert_eq!(planes.shares_planes(), name == "@cube:60", "{name}");
+        let tracer = &all_tracers(&scene)[0];
+        let mut lines = Vec::new();
+        batch_lines(11, 0, 20_000, scene.bounding_radius(), &mut lines);
+        let hits = trace(tracer.as_ref(), &lines);
+        let mut pairs = 0;
+        for (k, line) in lines.iter().enumerate() {
+            let (mut direct, mut tabled) = (Vec::new(), Vec::new());
+            let ends = segments_and_ends(&scene, line, hits.of_line(k), |s| direct.push(s));
+            let ends_tabled =
+                planes.segments_and_ends(&scene, line, hits.of_line(k), |s| tabled.push(s));
+            assert_eq!(direct, tabled, "{name}, line {k}");
+            assert_eq!(ends, ends_tabled, "{name}, line {k}");
+            pairs += direct
+                .iter()
+                .filter(|s| matches!(s, Segment::Pair { .. }))
+                .count();
+        }
+        assert!(pairs > 1000, "{name}: {pairs} pairs");
+    }
+}
