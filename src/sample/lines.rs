@@ -9,6 +9,9 @@
 //! versions) with one *stream* per batch of lines, seeded from `(seed, batch index)`. A batch's lines are
 //! therefore the same whatever thread draws them, and results never depend on the number of threads.
 
+#[allow(dead_code)] // used by `batch_lines` from the next commit on
+mod pcg_lanes;
+
 use rand::RngCore;
 use rand_pcg::Pcg64;
 
