@@ -50,7 +50,14 @@ pub fn uniform_direction(u1: f64, u2: f64) -> Direction {
 /// A uniform double in [0, 1) from the top 53 bits of a 64-bit draw (fixed here, not left to a crate,
 /// so that random scenes and lines never change with a crate's version).
 pub fn uniform01(rng: &mut impl RngCore) -> f64 {
-    (rng.next_u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
+    unit_from_draw(rng.next_u64())
+}
+
+/// [`uniform01`] of a draw already made: for code that makes its draws in blocks
+/// ([`crate::sample::lines::batch_lines`]) and must turn them into the very same doubles.
+#[inline(always)]
+pub fn unit_from_draw(draw: u64) -> f64 {
+    (draw >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
 }
 
 /// The mean of some points (each coordinate summed in order, then divided).
