@@ -7,7 +7,7 @@ import sys, re, collections
 groups = collections.OrderedDict((k,0.0) for k in ["kernel","drawing","hit rules","pairing","counting","measures","other"])
 rules = [
  ("kernel", r"BvhTracer|embree|all_hits|rtc|scx_|propose|collect|trace_batch|libembree|watertight"),
- ("drawing", r"global_line|batch_lines|Pcg|pcg_lanes|DiscPoints|line_from_discs|uniform"),
+ ("drawing", r"global_line|batch_lines|lines_from_points|Pcg|pcg_lanes|DiscPoints|line_from_discs|uniform"),
  ("hit rules", r"canonicali|fill_from_raw|merge_row|insertion_sort|HitRules"),
  ("pairing", r"tally|ends_of|pairs::|segments|Log2Sum|environment|PatchKernel"),
  ("counting", r"sparse|counts::|radix|count_by_group|merge_runs|SparseCounts|PairCounts|sum_batches"),

@@ -50,13 +50,18 @@ pub fn batch_lines(seed: u64, batch: u64, count: usize, radius: f64, out: &mut V
     while left > 0 {
         let lines = left.min(CHUNK_LINES);
         points.top_up(2 * lines);
-        let kept = &points.kept[..2 * lines];
-        out.extend(
-            kept.chunks_exact(2)
-                .map(|pair| line_from_discs(pair[0], pair[1], radius)),
-        );
+        lines_from_points(&points.kept[..2 * lines], radius, out);
         points.drop_front(2 * lines);
         left -= lines;
+    }
+}
+
+/// Appends the lines of consecutive pairs of disc points ([`line_from_discs`]). A function of its own,
+/// called once per [`CHUNK_LINES`] lines, so that profiles name the drawing's arithmetic.
+#[inline(never)]
+fn lines_from_points(points: &[DiscPoint], radius: f64, out: &mut Vec<Line>) {
+    for pair in points.chunks_exact(2) {
+        out.push(line_from_discs(pair[0], pair[1], radius));
     }
 }
 
