@@ -5,7 +5,7 @@
 # `scx analyze` end to end through the CLI with its peak memory, on S1 = @cube:30, S3 = @cube:100 (3e7
 # lines) and @cube:130 (1e8 lines), both tracers, 2 threads.
 #
-#   bash benches/window.sh            # about 15 minutes; needs the yardstick's C file and libembree3
+#   bash benches/window.sh            # about 20 minutes; needs the yardstick's C file and libembree3
 #   ANCHOR=/path/to/embree-bench bash benches/window.sh
 set -euo pipefail
 cd "$(dirname "$0")/.."
