@@ -191,7 +191,7 @@ mod embree {
             .allowlist_type("scx_.*")
             .allowlist_type("RTCRay|RTCHit|RTCRayHit|RTCRayHit4|RTCRayHit8|RTCRayHit16")
             .allowlist_type("RTCIntersectContext|RTCRayQueryContext|RTCIntersectArguments")
-            .allowlist_type("RTCFilterFunctionNArguments|RTCError")
+            .allowlist_type("RTCError")
             .allowlist_var(
                 "RTC_VERSION|RTC_VERSION_MAJOR|RTC_VERSION_MINOR|RTC_VERSION_PATCH|SCX_.*",
             )

@@ -263,7 +263,6 @@ struct GroupValues {
 }
 
 impl GroupValues {
-    /// The values of a tally; of the enclosed scene when `enclose` ([`Tally::enclosed`]).
     /// The values of a tally; of the enclosed scene when `enclose` ([`Tally::enclosed`]); with the
     /// extrapolation of the rows' coverage when `extrapolate` (the whole run's).
     fn of(
