@@ -8,7 +8,7 @@
 //! Randomness: PCG-64 (`rand_pcg::Pcg64`, a fixed algorithm, so its output never changes with crate
 //! versions) with one *stream* per batch of lines, seeded from `(seed, batch index)`. A batch's lines are
 //! therefore the same whatever thread draws them, and results never depend on the number of threads.
-//! Independent lines ([`batch_lines`]) make that stream's draws in blocks ([`pcg_lanes`]), bit for bit the
+//! Independent lines ([`batch_lines`]) make that stream's draws in blocks (`pcg_lanes`), bit for bit the
 //! draws of `Pcg64`, and so the very lines [`global_line`] draws from [`batch_rng`], only faster.
 
 mod pcg_lanes;
@@ -41,7 +41,7 @@ fn batch_stream(seed: u64, batch: u64) -> (u128, u128) {
 /// Appends the `count` lines of batch `batch` to `out` (tracing space, bounding radius `radius`).
 ///
 /// The lines are those of [`global_line`] called `count` times on [`batch_rng`], bit for bit; only
-/// faster, drawing in blocks and without the rejection loops' branches (see [`DiscPoints`]).
+/// faster, drawing in blocks and without the rejection loops' branches (see `DiscPoints`).
 pub fn batch_lines(seed: u64, batch: u64, count: usize, radius: f64, out: &mut Vec<Line>) {
     let (state, stream) = batch_stream(seed, batch);
     let mut points = DiscPoints::new(PcgLanes::new(state, stream));

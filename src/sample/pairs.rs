@@ -134,7 +134,7 @@ impl PatchPlanes {
     const CACHED_BYTES: usize = 256 << 10;
 
     /// The planes of `scene`'s patches, shared when the full table would not fit in a core's cache
-    /// ([`PatchPlanes::CACHED_BYTES`]) and at most a quarter of them are distinct. Otherwise the index
+    /// (256 KiB, `CACHED_BYTES`) and at most a quarter of them are distinct. Otherwise the index
     /// would only add a dependent read to every crossing.
     pub fn of(scene: &Scene) -> Self {
         let every: Vec<[f64; 4]> = scene
