@@ -92,13 +92,74 @@ pub struct ObjectSides {
 }
 
 /// One piece of orientation evidence of a batch: which object, and which of its [`ObjectSides`]
-/// counters. A batch keeps a list of them (its memory follows its lines, not the scene's objects).
+/// counters. A batch of a scene of many objects keeps a list of them ([`BatchSides::Events`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct SideEvent {
     /// The object.
     pub object: u32,
     /// Which counter: 0 `back_from_open`, 1 `back_to_open`, 2 `front_open`, 3 `back_seen`.
     pub kind: u8,
+}
+
+/// A batch's orientation evidence ([`ObjectSides`]).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum BatchSides {
+    /// Counted per object, for scenes of at most [`DENSE_SIDE_OBJECTS`] objects: a room seen from inside
+    /// gives two pieces of evidence per line, and as a list they took three times the memory of the
+    /// batch's pair keys, all of it fresh pages to fault in as the rounds grow.
+    Dense(Vec<ObjectSides>),
+    /// Event by event, for scenes of more objects (a table per batch would outweigh its lines).
+    Events(Vec<SideEvent>),
+}
+
+/// Scenes with at most this many objects count their batches' orientation evidence in a table.
+pub const DENSE_SIDE_OBJECTS: usize = 256;
+
+impl Default for BatchSides {
+    fn default() -> Self {
+        BatchSides::Events(Vec::new())
+    }
+}
+
+impl BatchSides {
+    /// No evidence yet, for a scene of `objects` objects.
+    pub fn for_objects(objects: usize) -> Self {
+        if objects <= DENSE_SIDE_OBJECTS {
+            BatchSides::Dense(vec![ObjectSides::default(); objects])
+        } else {
+            BatchSides::Events(Vec::new())
+        }
+    }
+
+    /// Counts one piece of evidence.
+    fn count(&mut self, object: u32, kind: u8) {
+        match self {
+            BatchSides::Dense(table) => {
+                let o = object as usize;
+                if o >= table.len() {
+                    table.resize(o + 1, ObjectSides::default());
+                }
+                table[o].count(kind);
+            }
+            BatchSides::Events(events) => events.push(SideEvent { object, kind }),
+        }
+    }
+
+    /// Adds this evidence into per-object counters (integers: in any order).
+    fn add_to(&self, into: &mut Vec<ObjectSides>) {
+        match self {
+            BatchSides::Dense(table) => add_sides(into, table),
+            BatchSides::Events(events) => {
+                for e in events {
+                    let o = e.object as usize;
+                    if o >= into.len() {
+                        into.resize(o + 1, ObjectSides::default());
+                    }
+                    into[o].count(e.kind);
+                }
+            }
+        }
+    }
 }
 
 impl ObjectSides {
@@ -251,9 +312,7 @@ impl Tally {
         let mut batch_keys = Vec::with_capacity(batches.len());
         for b in batches {
             tally.counters.add(&b.counters);
-            for e in &b.side_events {
-                tally.orientation[e.object as usize].count(e.kind);
-            }
+            b.sides.add_to(&mut tally.orientation);
             if let Some(k) = &mut tally.kernel_by_patch {
                 k.add_pairs(&b.pair_keys, &b.pair_terms);
             }
@@ -322,8 +381,8 @@ pub struct BatchTally {
     pub pair_keys: Vec<u64>,
     /// The patch of every escape, when the discrete measures are wanted.
     pub escape_patches: Vec<u32>,
-    /// How the batch's lines met the objects' sides, event by event.
-    pub side_events: Vec<SideEvent>,
+    /// How the batch's lines met the objects' sides.
+    pub sides: BatchSides,
     /// Beside each pair key, its log kernel ([`PatchKernelSums::pair_term`]), when
     /// [`Wanted::per_patch`].
     pub pair_terms: Vec<f64>,
@@ -407,12 +466,10 @@ fn tally_batch(prepared: &LineTally, lines: &[Line], hits: &LineHits) -> BatchTa
             hits: hits.hits.len() as u64,
             ..Counters::default()
         },
+        sides: BatchSides::for_objects(scene.objects.len()),
         ..BatchTally::default()
     };
-    let event = |p: u32, kind: u8| SideEvent {
-        object: prepared.objects.object(p),
-        kind,
-    };
+    let objects = &prepared.objects;
     let c = &mut t.counters;
     for (k, line) in lines.iter().enumerate() {
         let line_hits = hits.of_line(k);
@@ -421,7 +478,7 @@ fn tally_batch(prepared: &LineTally, lines: &[Line], hits: &LineHits) -> BatchTa
             env_sum.add(1.0, 2.0);
             continue;
         }
-        let events = &mut t.side_events;
+        let sides = &mut t.sides;
         let pair_terms = &mut t.pair_terms;
         let ends = prepared
             .planes
@@ -449,21 +506,21 @@ fn tally_batch(prepared: &LineTally, lines: &[Line], hits: &LineHits) -> BatchTa
                     if wanted.discrete {
                         t.escape_patches.push(patch);
                     }
-                    events.push(event(patch, 2));
+                    sides.count(objects.object(patch), 2);
                     let (cos_product, distance) = environment::escape(scene, line, patch, at_start);
                     env_sum.add(cos_product, distance);
                 }
                 Segment::BackSeen { patch } => {
                     c.unpaired += 1;
-                    events.push(event(patch, 3));
+                    sides.count(objects.object(patch), 3);
                 }
                 Segment::Unpaired => c.unpaired += 1,
             });
         if let Some(p) = ends.back_first {
-            events.push(event(p, 0));
+            t.sides.count(objects.object(p), 0);
         }
         if let Some(p) = ends.back_last {
-            events.push(event(p, 1));
+            t.sides.count(objects.object(p), 1);
         }
         c.coincident_crossings += ends.overlaps;
     }
@@ -473,4 +530,48 @@ fn tally_batch(prepared: &LineTally, lines: &[Line], hits: &LineHits) -> BatchTa
     (c.env_log2_sum, c.env_pairs) = (ExactSum::of(env_sum), env_pairs);
     t.pair_keys = keys;
     t
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The per-object table and the event list count the same evidence: every event lands in its own
+    /// object's counter, whichever form a batch keeps, and objects beyond the table's length extend it.
+    #[test]
+    fn side_tables_and_event_lists_count_the_same() {
+        assert!(matches!(
+            BatchSides::for_objects(DENSE_SIDE_OBJECTS),
+            BatchSides::Dense(_)
+        ));
+        assert!(matches!(
+            BatchSides::for_objects(DENSE_SIDE_OBJECTS + 1),
+            BatchSides::Events(_)
+        ));
+        let events: Vec<(u32, u8)> = (0..1000u32)
+            .map(|k| ((k * 7) % 13, (k % 4) as u8))
+            .collect();
+        let mut expected = vec![ObjectSides::default(); 13];
+        for &(o, kind) in &events {
+            let s = &mut expected[o as usize];
+            match kind {
+                0 => s.back_from_open += 1,
+                1 => s.back_to_open += 1,
+                2 => s.front_open += 1,
+                _ => s.back_seen += 1,
+            }
+        }
+        for mut sides in [
+            BatchSides::for_objects(13),
+            BatchSides::for_objects(2),
+            BatchSides::Events(Vec::new()),
+        ] {
+            for &(o, kind) in &events {
+                sides.count(o, kind);
+            }
+            let mut into = Vec::new();
+            sides.add_to(&mut into);
+            assert_eq!(into, expected, "{sides:?}");
+        }
+    }
 }
