@@ -1,9 +1,9 @@
 #!/usr/bin/env bash
 # The README's throughput table, from one window (the machine's speed drifts 10-20% over minutes, so every
 # figure of a ratio comes from the same run of this script): raw Embree all-hits (the shared yardstick,
-# ../shared/anchors/embree-bench), our kernels (cargo bench --bench throughput, "all-hits" column), and
-# `scx analyze` end to end through the CLI with its peak memory, on S1 = @cube:30, S3 = @cube:100 (3e7
-# lines) and @cube:130 (1e8 lines), both tracers, 2 threads.
+# ../shared/anchors/embree-bench), our kernels (cargo bench --bench throughput, "all-hits" column),
+# `scx analyze` end to end through the CLI with its peak memory, and the same without the discrete
+# measures, on S1 = @cube:30, S3 = @cube:100 (3e7 lines) and @cube:130 (1e8 lines), 2 threads.
 #
 #   bash benches/window.sh            # about 20 minutes; needs the yardstick's C file and libembree3
 #   ANCHOR=/path/to/embree-bench bash benches/window.sh
@@ -47,6 +47,20 @@ print(f"{sys.argv[2]:<10} {sys.argv[3]:<7} {statistics.median(walls):6.2f} M lin
 PY
     rm -f "$out" "$out".*
   done
+done
+
+echo "== the same without the discrete measures (--measures continuous: no pair counts, groups' lists, total or"
+echo "   entropy estimates), rust tracer, median of 3: what tracing, drawing and pairing cost by themselves"
+for run in "@cube:30 3e7" "@cube:100 3e7"; do
+  set -- $run
+  walls=()
+  for k in 1 2 3; do
+    walls+=("$( { /usr/bin/time -f "%e" "$scx" analyze "$1" --lines "$2" --threads 2 --measures continuous \
+      -q > /dev/null; } 2>&1 | tail -1)")
+  done
+  python3 -c 'import statistics,sys; w=sorted(float(x) for x in sys.argv[3:]); n=float(sys.argv[2]);
+print(f"{sys.argv[1]:<10} rust    {n/statistics.median(w)/1e6:6.2f} M lines/s ({n/w[-1]/1e6:.2f}-{n/w[0]/1e6:.2f})")' \
+    "$1" "$2" "${walls[@]}"
 done
 
 echo "== kernels alone (cargo bench --bench throughput, all-hits column; 2-thread rows)"
