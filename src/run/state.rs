@@ -230,15 +230,11 @@ impl RunState {
             self.tail = Some((b, Tally::from_batches(scene, self.wanted, vec![t])));
         }
         let tallies = traced.into_group_tallies(scene, self.wanted, self.group_count());
-        let (plan, groups, patches) = (self.plan, self.group_count(), scene.patch_count());
         self.groups
             .par_iter_mut()
             .zip(tallies)
             .for_each(|(slot, tally)| match (slot.as_mut(), tally) {
-                (Some(t), Some(new)) => {
-                    reserve_group_counts(t, &new, plan, groups, patches);
-                    t.merge(&new)
-                }
+                (Some(t), Some(new)) => t.merge(&new),
                 (None, new) => *slot = new,
                 (Some(_), None) => {}
             });
@@ -348,38 +344,6 @@ pub struct StateParts<'a> {
     pub done: &'a BatchSet,
     /// The partial last batch's tally, kept apart.
     pub tail: Option<&'a (u64, Tally)>,
-}
-
-/// Makes room in a group's pair counts, before `new` is merged in, for as many distinct pairs as the
-/// group is likely to hold at the end of the plan: its pairs per line so far times its share of the
-/// plan's lines, at most every pair of the scene and at most eight times what it will hold after this
-/// merge (a run under a time budget plans more lines than it may ever trace). Reserved pages that are
-/// never written are never resident, so the peak does not grow; what is saved is the copy of the list
-/// at every doubling. Changes no count.
-fn reserve_group_counts(
-    group: &mut Tally,
-    new: &Tally,
-    plan: BatchPlan,
-    groups: u64,
-    patches: usize,
-) {
-    let (Some(counts), Some(more)) = (group.counts.as_mut(), new.counts.as_ref()) else {
-        return;
-    };
-    let after = counts.stored_len() + more.stored_len();
-    let lines = group.counters.lines + new.counters.lines;
-    if lines == 0 {
-        return;
-    }
-    let pairs_per_line = (group.counters.pairs + new.counters.pairs) as f64 / lines as f64;
-    let group_lines = (plan.lines / groups.max(1) + plan.batch_size) as f64;
-    let likely = (pairs_per_line * group_lines * 1.05) as usize;
-    let every_pair = patches.saturating_mul(patches + 1) / 2;
-    let hint = likely
-        .min(every_pair)
-        .min(after.saturating_mul(8))
-        .max(after);
-    counts.reserve_total(hint);
 }
 
 /// Merges tallies pairwise in a balanced binary tree, the two halves in parallel; every count is merged

@@ -103,22 +103,6 @@ impl PairCounts {
         }
     }
 
-    /// Distinct pairs stored (the dense layout's cells are all stored).
-    pub fn stored_len(&self) -> usize {
-        match self {
-            PairCounts::Dense(m) => m.len(),
-            PairCounts::Sparse(list) => list.len(),
-        }
-    }
-
-    /// Makes room for `entries` distinct pairs in all (sparse counts; dense ones have every cell), so
-    /// that merging up to that many never moves the list ([`SparseCounts::reserve_total`]).
-    pub fn reserve_total(&mut self, entries: usize) {
-        if let PairCounts::Sparse(list) = self {
-            list.reserve_total(entries);
-        }
-    }
-
     /// Visits every non-zero entry `(i, j, N_ij)` with `i <= j`.
     pub fn for_each(&self, mut f: impl FnMut(u32, u32, u64)) {
         match self {

@@ -138,15 +138,6 @@ impl SparseCounts {
         self.entries.is_empty()
     }
 
-    /// Makes room for `entries` entries in all, so that merges up to that length never move the list:
-    /// a list grown by doubling is copied to fresh memory at every doubling, and on a long run those
-    /// copies (and the page faults of their fresh pages) cost about as much as one more merge pass.
-    pub fn reserve_total(&mut self, entries: usize) {
-        if entries > self.entries.capacity() {
-            self.entries.reserve_exact(entries - self.entries.len());
-        }
-    }
-
     /// Appends the count of a packed pair above every pair so far (`count > 0`).
     pub fn push(&mut self, packed: u64, count: u64) {
         debug_assert!(count > 0, "no zero counts");
