@@ -6,10 +6,11 @@
 #[path = "../tests/it/support.rs"]
 mod support;
 
+use scene_complexity::analysis::analyze;
 use scene_complexity::measure::bias::corrected;
 use scene_complexity::measure::estimators::EntropyEstimator;
 use scene_complexity::run::Measures;
-use scene_complexity::run::{analyze, AnalysisConfig, RunControl};
+use scene_complexity::run::{AnalysisConfig, RunControl};
 use scene_complexity::scenes;
 use scene_complexity::trace::{make_tracer, Backend, Query};
 

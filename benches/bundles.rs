@@ -17,8 +17,9 @@ mod common;
 use scene_complexity::scenes;
 use std::time::Instant;
 
+use scene_complexity::analysis::{analyze, VisibilityEstimates};
 use scene_complexity::measure::Estimate;
-use scene_complexity::run::{analyze, AnalysisConfig, RunControl, VisibilityEstimates};
+use scene_complexity::run::{AnalysisConfig, RunControl};
 use scene_complexity::sample::lines::LineSource;
 use scene_complexity::scene::Scene;
 use scene_complexity::trace::{make_tracer, Backend, Query, Tracer};

@@ -15,7 +15,8 @@ use scene_complexity::scenes;
 use std::time::Instant;
 
 use rayon::prelude::*;
-use scene_complexity::run::{analyze, AnalysisConfig, RunControl, DEFAULT_GROUPS};
+use scene_complexity::analysis::analyze;
+use scene_complexity::run::{AnalysisConfig, RunControl, DEFAULT_GROUPS};
 use scene_complexity::run::{BatchPlan, Measures};
 use scene_complexity::sample::lines::batch_lines;
 use scene_complexity::trace::{make_tracer, Backend, Line, LineHits, Query, Tracer};

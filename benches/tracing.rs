@@ -7,8 +7,9 @@
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use rayon::prelude::*;
+use scene_complexity::analysis::analyze;
 use scene_complexity::run::Measures;
-use scene_complexity::run::{analyze, AnalysisConfig, RunControl};
+use scene_complexity::run::{AnalysisConfig, RunControl};
 use scene_complexity::sample::lines::LineSource;
 use scene_complexity::scene::Scene;
 use scene_complexity::scenes;

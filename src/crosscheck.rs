@@ -14,10 +14,10 @@
 
 use std::fmt;
 
+use crate::analysis::{analyze, Analysis, AnalysisError};
 use crate::measure::Estimate;
 use crate::run::{
-    all_batches, analyze, map_batches, Analysis, AnalysisConfig, AnalysisError, Batch, LineStream,
-    Measures, RunControl, TraceBuffers,
+    all_batches, map_batches, AnalysisConfig, Batch, LineStream, Measures, RunControl, TraceBuffers,
 };
 use crate::scene::Scene;
 use crate::trace::{Hit, Line, TraceError, Tracer};

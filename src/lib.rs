@@ -31,7 +31,9 @@
 //! * [`trace`]: every intersection along a batch of lines (Embree, or the pure-Rust tracer);
 //! * [`sample`]: global lines, pairing of hits into mutually visible points, tallies and pair counts;
 //! * [`measure`]: the paper's measures from counts and sums (sec. 3 and 4);
-//! * [`run`]: the run engine (batches, rounds, groups and standard errors, budgets) and [`analyze`];
+//! * [`run`]: the run engine (batches, rounds, groups and standard errors, budgets, saved states);
+//! * [`analysis`]: what is computed from a run: every measure with its standard error and verdict,
+//!   [`analyze`];
 //! * the applications: [`reproduce`] (the paper's tables), [`mod@refine`] (meshing strategies),
 //!   [`render`] (pictures of the per-patch results) and [`mod@crosscheck`] (the two tracers, hit for
 //!   hit).
@@ -40,6 +42,7 @@
 #![deny(unsafe_code)]
 #![forbid(unsafe_op_in_unsafe_fn)]
 
+pub mod analysis;
 pub mod crosscheck;
 pub mod geom;
 pub mod measure;
@@ -52,6 +55,10 @@ pub mod scene;
 pub mod scenes;
 pub mod trace;
 
+pub use analysis::{
+    analyze, Analysis, AnalysisError, RadiosityEstimates, RadiosityOutcome, RunWarning,
+    RunWarningKind, VisibilityEstimates,
+};
 pub use crosscheck::{crosscheck, CrossCheck, CrossCheckConfig, Tolerance};
 pub use geom::{Direction, Normal, Point, Vector};
 pub use measure::estimators::EntropyEstimator;
@@ -59,9 +66,7 @@ pub use measure::radiosity::SolveOptions;
 pub use measure::Estimate;
 pub use refine::{refine, RefineConfig, RefineError, Refinement, Strategy};
 pub use run::{
-    analyze, Analysis, AnalysisConfig, AnalysisError, Budget, ErrorMethod, Measures,
-    RadiosityEstimates, RadiosityOutcome, RunControl, RunWarning, RunWarningKind, StopReason,
-    Target, TargetMeasure, VisibilityEstimates,
+    AnalysisConfig, Budget, ErrorMethod, Measures, RunControl, StopReason, Target, TargetMeasure,
 };
 pub use sample::lines::LineSource;
 pub use scene::{

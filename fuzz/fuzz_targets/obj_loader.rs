@@ -7,7 +7,8 @@
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
-use scene_complexity::run::{analyze, AnalysisConfig, RunControl};
+use scene_complexity::run::{AnalysisConfig, RunControl};
+use scene_complexity::analysis::analyze;
 use scene_complexity::scene::{obj, Scene};
 use scene_complexity::scenes;
 use scene_complexity::trace::{make_tracer, Backend, Query};

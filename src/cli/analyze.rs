@@ -4,10 +4,11 @@ use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use clap::ValueEnum;
+use scene_complexity::analysis::{cast, finish};
 use scene_complexity::run::persist;
 use scene_complexity::run::{
-    cast, finish, plan_of, remaining_lines, start, AnalysisConfig, Budget, CastOptions, Measures,
-    PersistError, RunControl, RunIdentity, RunState, Scope, StopReason, Target, TargetMeasure,
+    plan_of, remaining_lines, start, AnalysisConfig, Budget, CastOptions, Measures, PersistError,
+    RunControl, RunIdentity, RunState, Scope, StopReason, Target, TargetMeasure,
 };
 use scene_complexity::sample::lines::LineSource;
 use scene_complexity::trace::{Backend, Query};
@@ -199,7 +200,7 @@ fn new_run(args: &AnalyzeArgs, spec: &str) -> Result<Prepared, Failure> {
              read it again): save the scene to a file",
         ));
     }
-    let state = start(&runner.scene, &cfg).map_err(Failure::of)?;
+    let state = start(&runner.scene, &cfg).map_err(Failure::bad_input)?;
     let identity = RunIdentity::of(
         spec,
         &args.run.input.options(),

@@ -5,8 +5,9 @@ use std::fmt::Write as _;
 use std::path::PathBuf;
 
 use clap::ValueEnum;
+use scene_complexity::analysis::Analysis;
 use scene_complexity::measure::Estimate;
-use scene_complexity::run::{Analysis, StopReason};
+use scene_complexity::run::StopReason;
 use serde_json::json;
 
 use super::args::{parse_count, ReportOutput, RunOptions};

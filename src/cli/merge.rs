@@ -3,8 +3,9 @@
 
 use std::path::PathBuf;
 
+use scene_complexity::analysis::finish;
 use scene_complexity::run::persist;
-use scene_complexity::run::{finish, AnalysisConfig, RunState, SavedRun, StopReason};
+use scene_complexity::run::{AnalysisConfig, RunState, SavedRun, StopReason};
 use scene_complexity::trace::{Backend, Query};
 
 use super::analyze::{check_same_scene, persist_failure};

@@ -161,7 +161,7 @@ macro_rules! input_errors {
 }
 
 input_errors!(
-    scene_complexity::run::AnalysisError,
+    scene_complexity::analysis::AnalysisError,
     scene_complexity::refine::RefineError,
     scene_complexity::reproduce::ReproduceError
 );

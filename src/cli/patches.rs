@@ -13,9 +13,10 @@ use std::path::{Path, PathBuf};
 
 use rayon::prelude::*;
 
+use scene_complexity::analysis::{Analysis, PatchEstimate};
 use scene_complexity::geom::Point;
 use scene_complexity::measure::Estimate;
-use scene_complexity::run::{Analysis, PatchEstimate, RunIdentity};
+use scene_complexity::run::RunIdentity;
 use scene_complexity::sample::counts::PairCounts;
 use scene_complexity::sample::tally::Wanted;
 use scene_complexity::scene::Scene;

@@ -6,11 +6,11 @@ use std::fmt::Write;
 
 use clap::ValueEnum;
 
-use scene_complexity::measure::Estimate;
-use scene_complexity::run::{
-    Analysis, ErrorMethod, RadiosityEstimates, RadiosityOutcome, Reliability, StopReason,
-    TargetOutcome, Verdict,
+use scene_complexity::analysis::{
+    Analysis, RadiosityEstimates, RadiosityOutcome, Reliability, TargetOutcome, Verdict,
 };
+use scene_complexity::measure::Estimate;
+use scene_complexity::run::{ErrorMethod, StopReason};
 use scene_complexity::scene::Scene;
 use serde_json::{json, Value};
 

@@ -2,7 +2,8 @@
 
 use std::sync::Arc;
 
-use scene_complexity::run::{analyze, Analysis, AnalysisConfig, Measures, RunControl};
+use scene_complexity::analysis::{analyze, Analysis};
+use scene_complexity::run::{AnalysisConfig, Measures, RunControl};
 use scene_complexity::scene::{Scene, SceneOptions};
 use scene_complexity::trace::{make_tracer, Backend, Query, Tracer};
 

@@ -20,9 +20,10 @@ pub mod oracle;
 use std::fmt;
 use std::time::Instant;
 
+use crate::analysis::SolveFailure;
 use crate::measure::patches;
 use crate::measure::radiosity::{self, FormFactors, MaterialError, PatchMaterials, SolveOptions};
-use crate::run::{RunControl, SolveFailure};
+use crate::run::RunControl;
 use crate::scene::{Scene, SceneError};
 use crate::trace::{TraceError, Tracer};
 use mesh::Mesh;

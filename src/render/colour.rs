@@ -1,7 +1,7 @@
 //! What a picture colours its patches by, and how: a per-patch quantity of the run mapped through
 //! viridis (perceptually uniform, readable with the common colour-vision deficiencies and in grey).
 
-use crate::run::PatchEstimate;
+use crate::analysis::PatchEstimate;
 
 /// A per-patch quantity a picture can show ([`PatchEstimate`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -17,12 +17,12 @@ use std::collections::HashMap;
 use std::fmt::Write as _;
 use std::time::Instant;
 
+use crate::analysis::{
+    analyze, AnalysisError, RadiosityEstimates, RadiosityOutcome, VisibilityEstimates,
+};
 use crate::measure::Estimate;
 use crate::refine::RefineError;
-use crate::run::{
-    analyze, AnalysisConfig, AnalysisError, Measures, RadiosityEstimates, RadiosityOutcome,
-    RunControl, VisibilityEstimates,
-};
+use crate::run::{AnalysisConfig, Measures, RunControl};
 use crate::scene::{Scene, SceneError};
 use crate::trace::{make_tracer, Backend, Query, TraceError};
 

@@ -4,10 +4,10 @@ use crate::scenes;
 use std::time::Instant;
 
 use super::{est, lines_text, published, Finding, ReproduceError, Run, Session, TableReport, Want};
+use crate::analysis::VisibilityEstimates;
 use crate::measure::radiosity::SolveOptions;
 use crate::measure::Estimate;
 use crate::refine::{refine, RefineConfig, Strategy};
-use crate::run::VisibilityEstimates;
 use crate::scene::Scene;
 use crate::trace::{make_tracer, Query};
 

@@ -20,10 +20,10 @@ use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
-use super::analysis::{AnalysisConfig, Measures};
 use super::control::{Budget, Target, TargetMeasure};
 use super::errors::ErrorMethod;
 use super::plan::{BatchPlan, BatchSet};
+use super::spec::{AnalysisConfig, Measures};
 use super::state::RunState;
 use crate::measure::estimators::EntropyEstimator;
 use crate::sample::counts::{pair_key, split_key, PairCounts};
@@ -601,8 +601,8 @@ pub fn load(path: &Path) -> Result<SavedRun, PersistError> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::run::analysis::{cast, start, CastOptions};
     use crate::run::control::RunControl;
+    use crate::run::{cast, start, CastHooks, CastOptions};
     use crate::trace::{make_tracer, Backend, Query};
 
     /// A state saved and read back reports the same numbers, bit for bit; a truncated file, a flipped
@@ -621,7 +621,10 @@ mod tests {
                 &mut state,
                 CastOptions::default(),
                 &RunControl::default(),
-                &mut |_| {},
+                CastHooks {
+                    target: None,
+                    after_round: &mut |_| {},
+                },
             )
             .unwrap();
             let identity = RunIdentity::of(
@@ -672,7 +675,10 @@ mod tests {
             &mut state,
             CastOptions::default(),
             &RunControl::default(),
-            &mut |_| {},
+            CastHooks {
+                target: None,
+                after_round: &mut |_| {},
+            },
         )
         .unwrap();
         (scene, state)

@@ -6,7 +6,8 @@
 use crate::support;
 use scene_complexity::scenes;
 
-use scene_complexity::run::{analyze, Analysis, AnalysisConfig, RunControl};
+use scene_complexity::analysis::{analyze, Analysis};
+use scene_complexity::run::{AnalysisConfig, RunControl};
 use scene_complexity::run::{BatchPlan, Measures};
 use scene_complexity::sample::lines::LineSource;
 use scene_complexity::scene::Scene;

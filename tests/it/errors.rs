@@ -4,8 +4,9 @@
 use crate::support;
 use scene_complexity::scenes;
 
+use scene_complexity::analysis::{analyze, Analysis};
 use scene_complexity::measure::Estimate;
-use scene_complexity::run::{analyze, Analysis, AnalysisConfig, RunControl};
+use scene_complexity::run::{AnalysisConfig, RunControl};
 use scene_complexity::scene::Scene;
 use scene_complexity::trace::Tracer;
 use support::{all_tracers, cube_exact_measures};

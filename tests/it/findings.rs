@@ -4,10 +4,9 @@
 //! figs. 5/6 are the best discretised (Tables 6, 7); constant radiosity leaves the measures unchanged
 //! (fig. 9, Table 8).
 
+use scene_complexity::analysis::{analyze, Analysis, RadiosityOutcome};
 use scene_complexity::geom::DVec3;
-use scene_complexity::run::{
-    analyze, Analysis, AnalysisConfig, Measures, RadiosityOutcome, RunControl,
-};
+use scene_complexity::run::{AnalysisConfig, Measures, RunControl};
 use scene_complexity::scene::Scene;
 use scene_complexity::scenes;
 use scene_complexity::scenes::cube_clusters::{fig2_corners, Fig2Placement};

@@ -1,9 +1,10 @@
 //! The per-patch results against invariants: the per-patch terms add up to the scene's measures, and
 //! the radiosity columns solve eq. (2). (`cli_patches` checks the files `scx analyze` writes.)
 
+use scene_complexity::analysis::{analyze, Analysis};
 use scene_complexity::measure::patches::information_loss;
 use scene_complexity::refine::oracle;
-use scene_complexity::run::{analyze, Analysis, AnalysisConfig, RunControl};
+use scene_complexity::run::{AnalysisConfig, RunControl};
 use scene_complexity::scenes;
 use scene_complexity::trace::{make_tracer, Backend, Query};
 use scene_complexity::EntropyEstimator;

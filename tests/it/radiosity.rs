@@ -5,12 +5,13 @@
 use crate::support;
 use scene_complexity::scenes;
 
+use scene_complexity::analysis::{analyze, RadiosityOutcome};
 use scene_complexity::measure::patches::information_loss;
 use scene_complexity::measure::radiosity::{
     for_each_transition, solve, transformed_areas, FormFactors, PatchMaterials, SolveOptions,
 };
 use scene_complexity::refine::{oracle, refine, RefineConfig, Strategy};
-use scene_complexity::run::{analyze, AnalysisConfig, RadiosityOutcome, RunControl};
+use scene_complexity::run::{AnalysisConfig, RunControl};
 use scene_complexity::scene::{self, Material, Scene};
 use scene_complexity::trace::{make_tracer, Backend, Query, Tracer};
 use support::*;

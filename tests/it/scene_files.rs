@@ -4,7 +4,7 @@
 
 use std::path::{Path, PathBuf};
 
-use scene_complexity::run::RunWarningKind;
+use scene_complexity::analysis::RunWarningKind;
 use scene_complexity::scene::{ObjectSet, Planarity, SceneOptions};
 use scene_complexity::scenes::load_with;
 use scene_complexity::{

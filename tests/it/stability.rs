@@ -12,8 +12,9 @@ use std::f64::consts::{LN_2, PI};
 
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
+use scene_complexity::analysis::{analyze, Analysis};
 use scene_complexity::measure::channel::row_totals;
-use scene_complexity::run::{analyze, Analysis, AnalysisConfig, RunControl};
+use scene_complexity::run::{AnalysisConfig, RunControl};
 use scene_complexity::sample::pairs::{segments, Segment};
 use scene_complexity::scene::{Material, Scene, SceneBuilder};
 use scene_complexity::trace::{make_tracer, Backend, Line, LineHits, Query, Tracer};

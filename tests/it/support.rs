@@ -4,7 +4,7 @@
 
 use std::f64::consts::PI;
 
-use scene_complexity::run::Analysis;
+use scene_complexity::analysis::Analysis;
 use scene_complexity::scene::Scene;
 
 use scene_complexity::trace::rust::BruteForceTracer;

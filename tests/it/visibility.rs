@@ -4,9 +4,10 @@
 use crate::support;
 use scene_complexity::scenes;
 
+use scene_complexity::analysis::{analyze, Analysis};
 use scene_complexity::measure::channel::{for_each_form_factor, row_totals};
 use scene_complexity::run::Measures;
-use scene_complexity::run::{analyze, Analysis, AnalysisConfig, RunControl};
+use scene_complexity::run::{AnalysisConfig, RunControl};
 use scene_complexity::scene::Scene;
 use scene_complexity::trace::Tracer;
 use support::*;

@@ -16,10 +16,10 @@
 //! below 0, I_s above I_s^c (Proposition 2), an accuracy outside [0, 1]) by more than twice its standard
 //! error is flagged, and is never `ok`.
 
-use super::control::TargetMeasure;
 use super::readings::VisibilityEstimates;
 use crate::measure::sampling::Sampling;
 use crate::measure::Estimate;
+use crate::run::TargetMeasure;
 
 /// Rows whose area-weighted sample coverage is at least this give `ok` bias-corrected readings.
 pub const COVERAGE_OK: f64 = 0.99;

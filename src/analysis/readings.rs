@@ -1,7 +1,7 @@
 //! The readings of a run: every visibility measure with its standard error.
 
-use super::control::TargetMeasure;
 use crate::measure::Estimate;
+use crate::run::TargetMeasure;
 
 /// The visibility measures of a run, each with its standard error; `None` when not computed.
 #[derive(Clone, Debug, Default)]

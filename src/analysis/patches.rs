@@ -2,16 +2,16 @@
 //!
 //! Every group of lines gets its own per-patch terms (and, when the scene emits, its own radiosity
 //! solution), and each full-run value gets the batch-means standard error of the group values, as the
-//! scene's measures do ([`super::errors`]); like theirs, the errors of the plug-in terms of undersampled
+//! scene's measures do ([`crate::run::errors`]); like theirs, the errors of the plug-in terms of undersampled
 //! rows measure the statistical error only, not the bias.
 
 use rayon::prelude::*;
 
-use super::state::FinishedRun;
 use crate::measure::estimators::EntropyEstimator;
 use crate::measure::patches::{patch_values, ContinuousSums, PatchValues};
 use crate::measure::radiosity::{self, FormFactors, PatchMaterials, SolveOptions};
 use crate::measure::Estimate;
+use crate::run::FinishedRun;
 use crate::sample::tally::Tally;
 use crate::scene::Scene;
 

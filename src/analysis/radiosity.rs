@@ -2,20 +2,20 @@
 //!
 //! The radiosity system is solved on the form factors estimated from the run's own pair counts, so the
 //! radiosity measures carry the statistical error of those counts. As for the visibility measures
-//! ([`super::errors`]), every group's counts give their own form factors, their own solution `B` and
+//! ([`crate::run::errors`]), every group's counts give their own form factors, their own solution `B` and
 //! their own eqs. (33)-(35), and so do the counts with each group left out for the jackknife.
 
 use rayon::prelude::*;
 
-use super::errors::Spread;
 use super::reliability::{coverage_verdict, plug_in, Reliability, SamplingReport};
-use super::state::FinishedRun;
 use crate::measure::bias::row_corrections;
 use crate::measure::estimators::EntropyEstimator;
 use crate::measure::radiosity::{
     self, FormFactors, PatchMaterials, RadiosityValues, SolveError, SolveOptions,
 };
 use crate::measure::Estimate;
+use crate::run::FinishedRun;
+use crate::run::Spread;
 use crate::sample::tally::Tally;
 use crate::scene::Scene;
 
