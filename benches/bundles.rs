@@ -14,10 +14,11 @@
 
 mod common;
 
+use scene_complexity::measure::Measure;
 use scene_complexity::scenes;
 use std::time::Instant;
 
-use scene_complexity::analysis::{analyze, VisibilityEstimates};
+use scene_complexity::analysis::analyze;
 use scene_complexity::measure::Estimate;
 use scene_complexity::run::{AnalysisConfig, RunControl};
 use scene_complexity::sample::lines::LineSource;
@@ -118,8 +119,8 @@ fn measure(scene: &Scene, tracer: &dyn Tracer, lines: u64, grid: u32) -> Row {
         let se = |e: Option<scene_complexity::measure::Estimate>| {
             e.and_then(|e| e.stderr).unwrap_or(f64::NAN)
         };
-        row.var_cmi += se(a.visibility.continuous_mutual_information).powi(2) / SEEDS as f64;
-        row.var_mi += se(a.visibility.mutual_information).powi(2) / SEEDS as f64;
+        row.var_cmi += se(a.estimate(Measure::ContinuousMutualInformation)).powi(2) / SEEDS as f64;
+        row.var_mi += se(a.estimate(Measure::MutualInformation)).powi(2) / SEEDS as f64;
     }
     row
 }
@@ -139,15 +140,12 @@ fn print_row(spec: &str, query: &str, grid: u32, r: &Row, base: &Row) {
     );
 }
 
-/// Where an analysis keeps one of its estimates.
-type Pick = fn(&VisibilityEstimates) -> Option<Estimate>;
-
-/// The measures the seed-spread mode follows: name, and where an analysis keeps it.
-const FOLLOWED: [(&str, Pick); 4] = [
-    ("I_s^c", |v| v.continuous_mutual_information),
-    ("I_s", |v| v.mutual_information),
-    ("I_s corr.", |v| v.mutual_information_corrected),
-    ("E(MSE)", |v| v.mse_per_line),
+/// The measures the seed-spread mode follows: name, and the measure.
+const FOLLOWED: [(&str, Measure); 4] = [
+    ("I_s^c", Measure::ContinuousMutualInformation),
+    ("I_s", Measure::MutualInformation),
+    ("I_s corr.", Measure::MutualInformationCorrected),
+    ("E(MSE)", Measure::MsePerLine),
 ];
 
 /// Independent lines against 4 x 4 and 8 x 8 bundles over `seeds` seeds each (seed outermost, so that
@@ -178,7 +176,7 @@ fn spread(specs: &[String], lines: u64, seeds: u64) -> anyhow::Result<()> {
                 let a = analyze(&scene, tracer.as_ref(), &cfg, &RunControl::default())?;
                 cpu[g] += common::cpu_seconds() - c0;
                 for (m, (_, of)) in FOLLOWED.iter().enumerate() {
-                    let e = of(&a.visibility).unwrap_or(Estimate {
+                    let e = a.estimate(*of).unwrap_or(Estimate {
                         value: f64::NAN,
                         stderr: None,
                     });

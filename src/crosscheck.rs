@@ -15,7 +15,7 @@
 use std::fmt;
 
 use crate::analysis::{analyze, Analysis, AnalysisError};
-use crate::measure::Estimate;
+use crate::measure::{Estimate, Measure};
 use crate::run::{
     all_batches, map_batches, AnalysisConfig, Batch, LineStream, Measures, RunControl, TraceBuffers,
 };
@@ -283,17 +283,31 @@ pub fn compare_measures(
 }
 
 fn measures(r: &Analysis) -> Vec<(&'static str, Option<Estimate>)> {
-    let v = &r.visibility;
     vec![
-        ("visibility entropy H_s (eq. 17)", v.entropy),
-        ("joint entropy H(X,Y) (eq. 7)", v.joint_entropy),
-        ("mutual information I_s (eq. 21)", v.mutual_information),
+        (
+            "visibility entropy H_s (eq. 17)",
+            r.estimate(Measure::Entropy),
+        ),
+        (
+            "joint entropy H(X,Y) (eq. 7)",
+            r.estimate(Measure::JointEntropy),
+        ),
+        (
+            "mutual information I_s (eq. 21)",
+            r.estimate(Measure::MutualInformation),
+        ),
         (
             "continuous mutual information I_s^c (eq. 27)",
-            v.continuous_mutual_information,
+            r.estimate(Measure::ContinuousMutualInformation),
         ),
-        ("accuracy I_s / I_s^c (sec. 3.3)", v.accuracy),
-        ("form-factor E(MSE) per line (eq. 22)", v.mse_per_line),
+        (
+            "accuracy I_s / I_s^c (sec. 3.3)",
+            r.estimate(Measure::Accuracy),
+        ),
+        (
+            "form-factor E(MSE) per line (eq. 22)",
+            r.estimate(Measure::MsePerLine),
+        ),
     ]
 }
 

@@ -56,18 +56,16 @@ pub mod scenes;
 pub mod trace;
 
 pub use analysis::{
-    analyze, Analysis, AnalysisError, RadiosityEstimates, RadiosityOutcome, RunWarning,
-    RunWarningKind, VisibilityEstimates,
+    analyze, Analysis, AnalysisError, RadiosityOutcome, RadiositySolve, Reliability, RunWarning,
+    RunWarningKind, Verdict,
 };
 pub use crosscheck::{crosscheck, CrossCheck, CrossCheckConfig, Tolerance};
 pub use geom::{Direction, Normal, Point, Vector};
 pub use measure::estimators::EntropyEstimator;
 pub use measure::radiosity::SolveOptions;
-pub use measure::Estimate;
+pub use measure::{ByMeasure, Estimate, Family, Measure, PatchMeasure, Unit};
 pub use refine::{refine, RefineConfig, RefineError, Refinement, Strategy};
-pub use run::{
-    AnalysisConfig, Budget, ErrorMethod, Measures, RunControl, StopReason, Target, TargetMeasure,
-};
+pub use run::{AnalysisConfig, Budget, ErrorMethod, Measures, RunControl, StopReason, Target};
 pub use sample::lines::LineSource;
 pub use scene::{
     Material, ObjectSet, Patch, Planarity, Scene, SceneBuilder, SceneError, SceneOptions,

@@ -7,6 +7,7 @@
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
+use scene_complexity::measure::Measure;
 use scene_complexity::run::{AnalysisConfig, RunControl};
 use scene_complexity::analysis::analyze;
 use scene_complexity::scene::{obj, Scene};
@@ -50,10 +51,10 @@ fn trace_a_little(scene: &Scene) {
         Err(e) => panic!("tracing a loaded scene failed: {e}"),
     };
     for e in [
-        a.visibility.positional_entropy,
-        a.visibility.entropy,
-        a.visibility.mutual_information,
-        a.visibility.continuous_mutual_information,
+        a.estimate(Measure::PositionalEntropy),
+        a.estimate(Measure::Entropy),
+        a.estimate(Measure::MutualInformation),
+        a.estimate(Measure::ContinuousMutualInformation),
     ]
     .into_iter()
     .flatten()

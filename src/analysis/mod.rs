@@ -9,7 +9,6 @@
 mod orientation;
 pub mod patches;
 pub mod radiosity;
-pub mod readings;
 pub mod reliability;
 mod values;
 pub mod warnings;
@@ -17,11 +16,8 @@ pub mod warnings;
 use std::time::Instant;
 
 pub use patches::{PatchEstimate, PatchLight};
-pub use radiosity::{
-    RadiosityEstimates, RadiosityOutcome, RadiosityReliability, SolveFailure, NOTHING_EMITS,
-};
-pub use readings::VisibilityEstimates;
-pub use reliability::{Reliability, SamplingReport, Verdict, VisibilityReliability};
+pub use radiosity::{RadiosityOutcome, RadiositySolve, SolveFailure, NOTHING_EMITS};
+pub use reliability::{Reliability, SamplingReport, Verdict};
 pub use warnings::{RunWarning, RunWarningKind};
 
 use patches as per_patch;
@@ -29,10 +25,10 @@ use values::visibility_estimates;
 
 use crate::measure::estimators::EntropyEstimator;
 use crate::measure::radiosity::{MaterialError, PatchMaterials};
-use crate::measure::Estimate;
+use crate::measure::{ByMeasure, Estimate, Measure};
 use crate::run::{
     AnalysisConfig, BatchPlan, BatchSet, CastHooks, CastOptions, ErrorMethod, FinishedRun,
-    RunControl, RunState, StopReason, TargetMeasure, TargetReading,
+    RunControl, RunState, StopReason, TargetReading,
 };
 use crate::sample::tally::{ObjectSides, Tally};
 use crate::scene::Scene;
@@ -98,15 +94,16 @@ pub struct Analysis {
     /// With `--enclose` when something escaped: the environment patch's area in scene units (see
     /// [`crate::sample::environment`]); `None` otherwise.
     pub environment_area: Option<Estimate>,
-    /// The visibility measures.
-    pub visibility: VisibilityEstimates,
+    /// Every reading with its standard error, by measure ([`Measure`]): the visibility measures and,
+    /// when computed, the radiosity measures; `None` for a measure not computed.
+    pub estimates: ByMeasure<Estimate>,
     /// How well the lines sampled the rows of F (when the discrete measures were counted).
     pub sampling: Option<SamplingReport>,
-    /// The verdict on every visibility reading.
-    pub reliability: VisibilityReliability,
+    /// The verdict on every reading that has one (all but the exact ones).
+    pub reliability: ByMeasure<Reliability>,
     /// The precision target, when there was one, and whether it was met.
     pub target: Option<TargetOutcome>,
-    /// The radiosity measures, or why there are none.
+    /// The radiosity solution's figures, or why there are no radiosity measures.
     pub radiosity: RadiosityOutcome,
     /// What the user must know about these numbers (an open scene, unsampled patches, ...).
     pub warnings: Vec<RunWarning>,
@@ -120,6 +117,16 @@ pub struct Analysis {
 }
 
 impl Analysis {
+    /// The reading of `measure` with its standard error (`None`: not computed).
+    pub fn estimate(&self, measure: Measure) -> Option<Estimate> {
+        self.estimates.get(measure).copied()
+    }
+
+    /// The verdict on the reading of `measure` (`None`: no reading, or an exact one).
+    pub fn verdict(&self, measure: Measure) -> Option<Verdict> {
+        self.reliability.get(measure).map(|r| r.verdict)
+    }
+
     /// Whether the report covers every batch of its plan.
     pub fn is_complete(&self) -> bool {
         self.covered.len() == self.plan.batches()
@@ -149,7 +156,7 @@ impl Analysis {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TargetOutcome {
     /// The measure watched.
-    pub measure: TargetMeasure,
+    pub measure: Measure,
     /// The standard error asked for.
     pub stderr_goal: f64,
     /// The standard error reached (`None`: none could be estimated).
@@ -262,12 +269,15 @@ pub fn finish(
     let target = cfg.budget.target.map(|t| TargetOutcome {
         measure: t.measure,
         stderr_goal: t.stderr,
-        stderr: visibility.estimates.of(t.measure).and_then(|e| e.stderr),
-        verdict: visibility.reliability.of(t.measure).map(|r| r.verdict),
+        stderr: visibility.estimates.get(t.measure).and_then(|e| e.stderr),
+        verdict: visibility.reliability.get(t.measure).map(|r| r.verdict),
     });
-    let radiosity = match &materials {
-        None => RadiosityOutcome::NotRequested,
-        Some(_) if !lit => RadiosityOutcome::Skipped(radiosity::NOTHING_EMITS.into()),
+    let (radiosity, radiosity_readings) = match &materials {
+        None => (RadiosityOutcome::NotRequested, None),
+        Some(_) if !lit => (
+            RadiosityOutcome::Skipped(radiosity::NOTHING_EMITS.into()),
+            None,
+        ),
         Some(m) => radiosity::estimates(
             scene,
             m,
@@ -300,7 +310,22 @@ pub fn finish(
     warnings.extend(orientation::warnings(scene, &total, enclose));
     let mut visibility = visibility;
     if total.counters.pairs == 0 && !enclose {
-        visibility.estimates = undefined_without_pairs(&visibility.estimates);
+        // No pair: only H_p (exact, from the areas) is defined; zeros would read as measurements.
+        let kept = visibility
+            .estimates
+            .get(Measure::PositionalEntropy)
+            .copied();
+        visibility.estimates = ByMeasure::default();
+        visibility.estimates.set(Measure::PositionalEntropy, kept);
+    }
+    let (mut estimates, mut reliability) = (visibility.estimates, visibility.reliability);
+    if let Some(r) = &radiosity_readings {
+        for (m, e) in r.estimates.iter() {
+            estimates.set(m, Some(*e));
+        }
+        for (m, v) in r.reliability.iter() {
+            reliability.set(m, Some(v.clone()));
+        }
     }
     Ok(Analysis {
         lines: total.counters.lines,
@@ -324,9 +349,9 @@ pub fn finish(
         environment_area: visibility.environment_area,
         distinct_pairs: total.counts.as_ref().map(|c| c.distinct_pairs()),
         unsampled: visibility.unsampled,
-        visibility: visibility.estimates,
+        estimates,
         sampling: visibility.sampling,
-        reliability: visibility.reliability,
+        reliability,
         target,
         radiosity,
         warnings,
@@ -336,16 +361,6 @@ pub fn finish(
     })
 }
 
-/// The estimates of a run in which no segment joined two patches: only the positional entropy (exact,
-/// from the areas) is defined; every visibility measure has no pair to be computed from, and zeros would
-/// read as measurements.
-fn undefined_without_pairs(estimates: &VisibilityEstimates) -> VisibilityEstimates {
-    VisibilityEstimates {
-        positional_entropy: estimates.positional_entropy,
-        ..VisibilityEstimates::default()
-    }
-}
-
 /// The standard error of `measure` and the verdict on its reading, from the run so far. Batch means:
 /// the jackknife needs the total's counts, which a dense run merges only at the end; batch means are
 /// larger where they differ, so a target is never met early.
@@ -353,14 +368,14 @@ fn current_reading(
     scene: &Scene,
     state: &RunState,
     cfg: &AnalysisConfig,
-    measure: TargetMeasure,
+    measure: Measure,
 ) -> TargetReading {
     let wanted = state.wanted();
     let run = state.snapshot(scene);
     let enclose = cfg.enclose && run.groups.iter().any(|t| t.counters.escapes > 0);
     let v = visibility_estimates(scene, &run, cfg.estimator, enclose, false, wanted);
     TargetReading {
-        stderr: v.estimates.of(measure).and_then(|e| e.stderr),
-        reliable: v.reliability.of(measure).map(|r| r.verdict) == Some(Verdict::Ok),
+        stderr: v.estimates.get(measure).and_then(|e| e.stderr),
+        reliable: v.reliability.get(measure).map(|r| r.verdict) == Some(Verdict::Ok),
     }
 }

@@ -16,10 +16,9 @@
 //! below 0, I_s above I_s^c (Proposition 2), an accuracy outside [0, 1]) by more than twice its standard
 //! error is flagged, and is never `ok`.
 
-use super::readings::VisibilityEstimates;
+use crate::measure::catalogue::{Bound, VerdictRule};
 use crate::measure::sampling::Sampling;
-use crate::measure::Estimate;
-use crate::run::TargetMeasure;
+use crate::measure::{ByMeasure, Estimate, Family, Measure};
 
 /// Rows whose area-weighted sample coverage is at least this give `ok` bias-corrected readings.
 pub const COVERAGE_OK: f64 = 0.99;
@@ -89,48 +88,6 @@ pub struct SamplingReport {
     pub lines_for_coverage: Option<u64>,
 }
 
-/// The verdicts on the visibility readings (each `None` when the reading is).
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct VisibilityReliability {
-    /// H_s, plug-in.
-    pub entropy: Option<Reliability>,
-    /// H_s, corrected.
-    pub entropy_corrected: Option<Reliability>,
-    /// H(X, Y).
-    pub joint_entropy: Option<Reliability>,
-    /// I_s, plug-in.
-    pub mutual_information: Option<Reliability>,
-    /// I_s, corrected.
-    pub mutual_information_corrected: Option<Reliability>,
-    /// I_s^c.
-    pub continuous_mutual_information: Option<Reliability>,
-    /// I_s / I_s^c, plug-in.
-    pub accuracy: Option<Reliability>,
-    /// I_s / I_s^c, corrected.
-    pub accuracy_corrected: Option<Reliability>,
-    /// (I_s^c - I_s) / I_s^c.
-    pub relative_error: Option<Reliability>,
-    /// E(MSE) per line.
-    pub mse_per_line: Option<Reliability>,
-}
-
-impl VisibilityReliability {
-    /// The verdict on the reading a precision target watches.
-    pub fn of(&self, measure: TargetMeasure) -> Option<&Reliability> {
-        match measure {
-            TargetMeasure::Entropy => self.entropy.as_ref(),
-            TargetMeasure::EntropyCorrected => self.entropy_corrected.as_ref(),
-            TargetMeasure::MutualInformation => self.mutual_information.as_ref(),
-            TargetMeasure::MutualInformationCorrected => self.mutual_information_corrected.as_ref(),
-            TargetMeasure::ContinuousMutualInformation => {
-                self.continuous_mutual_information.as_ref()
-            }
-            TargetMeasure::Accuracy => self.accuracy.as_ref(),
-            TargetMeasure::AccuracyCorrected => self.accuracy_corrected.as_ref(),
-        }
-    }
-}
-
 /// Whether `a` exceeds `b` by more than twice their combined standard error.
 fn clearly_above(a: Estimate, b: Estimate) -> bool {
     let se = (a.stderr.unwrap_or(0.0).powi(2) + b.stderr.unwrap_or(0.0).powi(2)).sqrt();
@@ -191,139 +148,140 @@ fn flag_unit_interval(r: &mut Reliability, e: Estimate, what: &str) {
     }
 }
 
-/// The verdicts on every visibility reading of a run of `lines` lines with `pairs` pairs; `sampling` is
-/// the rows' sampling when the discrete measures were counted. A reading without a standard error (too
-/// few groups with lines) is `unusable`: nothing tells how far off it is.
-pub fn visibility(
-    v: &VisibilityEstimates,
+/// Flags a mutual information above I_s^c (Proposition 2 says I_s <= I_s^c).
+fn flag_above_continuous(
+    r: &mut Reliability,
+    e: Estimate,
+    continuous: Option<Estimate>,
+    what: &str,
+) {
+    if let Some(c) = continuous.filter(|&c| clearly_above(e, c)) {
+        r.flag(format!(
+            "{what} {:.4} is above I_s^c {:.4}: Proposition 2 says I_s <= I_s^c; the rows are \
+             undersampled",
+            e.value, c.value
+        ));
+    }
+}
+
+/// What the verdicts of a family's readings are judged from.
+struct Evidence<'a> {
+    estimates: &'a ByMeasure<Estimate>,
+    /// The rows' sampling, when the pairs were counted.
+    sampling: Option<&'a SamplingReport>,
+    lines: u64,
+    pairs: u64,
+}
+
+impl Evidence<'_> {
+    fn estimate(&self, m: Measure) -> Option<Estimate> {
+        self.estimates.get(m).copied()
+    }
+
+    /// The rows' sampling and the estimated bias of the family's plug-in entropy, when both are known:
+    /// every verdict of a discrete reading needs them.
+    fn discrete(&self, family: Family) -> Option<(&SamplingReport, f64)> {
+        let (plain, corrected) = family.entropies();
+        let bias = self.estimate(plain)?.value - self.estimate(corrected)?.value;
+        Some((self.sampling?, bias))
+    }
+}
+
+/// The verdicts on every reading of a run of `lines` lines with `pairs` pairs ([`VerdictRule`] of each
+/// measure's catalogue entry); `sampling` is the rows' sampling when the pairs were counted. A reading
+/// without a standard error (too few groups with lines) is `unusable`: nothing tells how far off it is.
+pub fn verdicts(
+    estimates: &ByMeasure<Estimate>,
     sampling: Option<&SamplingReport>,
     lines: u64,
     pairs: u64,
-) -> VisibilityReliability {
-    let mut out = verdicts(v, sampling, lines, pairs);
-    let pairs_of = [
-        (v.entropy, &mut out.entropy),
-        (v.entropy_corrected, &mut out.entropy_corrected),
-        (v.joint_entropy, &mut out.joint_entropy),
-        (v.mutual_information, &mut out.mutual_information),
-        (
-            v.mutual_information_corrected,
-            &mut out.mutual_information_corrected,
-        ),
-        (
-            v.continuous_mutual_information,
-            &mut out.continuous_mutual_information,
-        ),
-        (v.accuracy, &mut out.accuracy),
-        (v.accuracy_corrected, &mut out.accuracy_corrected),
-        (v.relative_error, &mut out.relative_error),
-        (v.mse_per_line, &mut out.mse_per_line),
-    ];
-    for (e, r) in pairs_of {
-        if let (Some(e), Some(r)) = (e, r.as_mut()) {
-            if e.stderr.is_none() {
-                r.verdict = Verdict::Unusable;
-            }
+) -> ByMeasure<Reliability> {
+    let evidence = Evidence {
+        estimates,
+        sampling,
+        lines,
+        pairs,
+    };
+    let mut out = ByMeasure::default();
+    for (m, &e) in estimates.iter() {
+        let r = verdict(&evidence, &out, m, e);
+        out.set(m, r);
+    }
+    for (m, e) in estimates.iter() {
+        if let (Some(r), None) = (out.get_mut(m), e.stderr) {
+            r.verdict = Verdict::Unusable;
         }
     }
     out
 }
 
-fn verdicts(
-    v: &VisibilityEstimates,
-    sampling: Option<&SamplingReport>,
-    lines: u64,
-    pairs: u64,
-) -> VisibilityReliability {
-    let mut out = VisibilityReliability::default();
-    let isc = v.continuous_mutual_information;
-    if let Some(e) = isc {
-        let mut r = Reliability::new(if pairs >= MIN_PAIRS && e.stderr.is_some() {
-            Verdict::Ok
-        } else {
-            Verdict::Unusable
-        });
-        flag_negative(&mut r, e, "I_s^c");
-        out.continuous_mutual_information = Some(r);
-    }
-    let (Some(report), Some(h), Some(hc)) = (sampling, v.entropy, v.entropy_corrected) else {
-        return out;
-    };
-    // The plug-in H_s reads low by about the correction; I_s = X - H_s high by as much.
-    let bias = h.value - hc.value;
-    let isc_zero = isc.is_some_and(|c| c.value.abs() <= 3.0 * stderr(c));
-
-    let mut entropy = plug_in(h, bias, report, lines);
-    flag_negative(&mut entropy, h, "H_s");
-    out.entropy = Some(entropy);
-    let mut entropy_corrected = coverage_verdict(report);
-    flag_negative(&mut entropy_corrected, hc, "the corrected H_s");
-    out.entropy_corrected = Some(entropy_corrected);
-    out.joint_entropy = v.joint_entropy.map(|j| plug_in(j, bias, report, lines));
-
-    let mi_with = |e: Estimate, bias: Option<f64>, what: &str| {
-        let mut r = match bias {
-            Some(b) => plug_in(e, b, report, lines),
-            None => coverage_verdict(report),
-        };
-        flag_negative(&mut r, e, what);
-        if let Some(c) = isc.filter(|&c| clearly_above(e, c)) {
-            r.flag(format!(
-                "{what} {:.4} is above I_s^c {:.4}: Proposition 2 says I_s <= I_s^c; the rows are \
-                 undersampled",
-                e.value, c.value
-            ));
+/// The verdict on reading `e` of measure `m`, given the verdicts `so_far` of the measures before it.
+fn verdict(
+    evidence: &Evidence,
+    so_far: &ByMeasure<Reliability>,
+    m: Measure,
+    e: Estimate,
+) -> Option<Reliability> {
+    let info = m.info();
+    let continuous = evidence.estimate(Measure::ContinuousMutualInformation);
+    let mut r = match info.verdict {
+        VerdictRule::Exact => return None,
+        VerdictRule::Mean => {
+            Reliability::new(if evidence.pairs >= MIN_PAIRS && e.stderr.is_some() {
+                Verdict::Ok
+            } else {
+                Verdict::Unusable
+            })
         }
-        r
-    };
-    if let Some(mi) = v.mutual_information {
-        out.mutual_information = Some(mi_with(mi, Some(-bias), "I_s"));
-    }
-    if let Some(mi) = v.mutual_information_corrected {
-        out.mutual_information_corrected = Some(mi_with(mi, None, "the corrected I_s"));
-    }
-    let ratio = |e: Estimate, base: &Option<Reliability>, what: &str| {
-        // The ratio inherits the verdict of its I_s, not its flags (they are I_s's).
-        let mut r = base
-            .clone()
-            .unwrap_or_else(|| Reliability::new(Verdict::Unusable));
-        r.flags.clear();
-        r.estimated_bias = r.estimated_bias.zip(isc).map(|(b, c)| b / c.value);
-        flag_unit_interval(&mut r, e, what);
-        if isc_zero {
-            r.verdict = Verdict::Unusable;
-            r.flags
-                .push("I_s^c is not distinguishable from 0, so the ratio means nothing".into());
+        VerdictRule::PlugIn { sign } => {
+            let (report, bias) = evidence.discrete(info.family)?;
+            plug_in(e, sign * bias, report, evidence.lines)
         }
-        r
+        VerdictRule::Corrected => coverage_verdict(evidence.discrete(info.family)?.0),
+        VerdictRule::RatioOf { of, sign } => {
+            evidence.discrete(info.family)?;
+            // The ratio inherits the verdict of its I_s, not its flags (they are I_s's).
+            let mut r = so_far
+                .get(of)
+                .cloned()
+                .unwrap_or_else(|| Reliability::new(Verdict::Unusable));
+            r.flags.clear();
+            r.estimated_bias = r
+                .estimated_bias
+                .zip(continuous)
+                .map(|(b, c)| sign * b / c.value);
+            r
+        }
+        VerdictRule::Unbiased => {
+            let (report, _) = evidence.discrete(info.family)?;
+            let bias = report.sampling.mse_bias;
+            let mut r = Reliability::new(if bias.abs() <= stderr(e) {
+                Verdict::Ok
+            } else {
+                Verdict::Undersampled
+            });
+            r.estimated_bias = Some(bias);
+            r.lines_needed = lines_for_bias(evidence.lines, bias, stderr(e));
+            r
+        }
     };
-    out.accuracy = v
-        .accuracy
-        .map(|e| ratio(e, &out.mutual_information, "the accuracy"));
-    out.accuracy_corrected = v.accuracy_corrected.map(|e| {
-        ratio(
-            e,
-            &out.mutual_information_corrected,
-            "the corrected accuracy",
-        )
-    });
-    out.relative_error = v.relative_error.map(|e| {
-        let mut r = ratio(e, &out.mutual_information, "the relative error");
-        r.estimated_bias = r.estimated_bias.map(|b| -b);
-        r
-    });
-    out.mse_per_line = v.mse_per_line.map(|e| {
-        let bias = report.sampling.mse_bias;
-        let mut r = Reliability::new(if bias.abs() <= stderr(e) {
-            Verdict::Ok
-        } else {
-            Verdict::Undersampled
-        });
-        r.estimated_bias = Some(bias);
-        r.lines_needed = lines_for_bias(lines, bias, stderr(e));
-        r
-    });
-    out
+    match info.bound {
+        Bound::None => {}
+        Bound::NonNegative => flag_negative(&mut r, e, info.flag_name),
+        Bound::NonNegativeBelowContinuous => {
+            flag_negative(&mut r, e, info.flag_name);
+            flag_above_continuous(&mut r, e, continuous, info.flag_name);
+        }
+        Bound::UnitInterval => {
+            flag_unit_interval(&mut r, e, info.flag_name);
+            if continuous.is_some_and(|c| c.value.abs() <= 3.0 * stderr(c)) {
+                r.verdict = Verdict::Unusable;
+                r.flags
+                    .push("I_s^c is not distinguishable from 0, so the ratio means nothing".into());
+            }
+        }
+    }
+    Some(r)
 }
 
 #[cfg(test)]
@@ -351,92 +309,105 @@ mod tests {
         }
     }
 
-    fn readings(h: f64, hc: f64, isc: f64) -> VisibilityEstimates {
-        VisibilityEstimates {
-            positional_entropy: est(9.0, 0.0),
-            entropy: est(h, 0.001),
-            entropy_corrected: est(hc, 0.001),
-            joint_entropy: est(9.0 + h, 0.001),
-            mutual_information: est(9.0 - h, 0.001),
-            mutual_information_corrected: est(9.0 - hc, 0.001),
-            continuous_mutual_information: est(isc, 0.001),
-            accuracy: est((9.0 - h) / isc, 0.001),
-            accuracy_corrected: est((9.0 - hc) / isc, 0.001),
-            relative_error: est(1.0 - (9.0 - h) / isc, 0.001),
-            mse_per_line: est(500.0, 0.01),
-        }
+    fn readings(h: f64, hc: f64, isc: f64) -> ByMeasure<Estimate> {
+        ByMeasure::from_fn(|m| match m {
+            Measure::PositionalEntropy => est(9.0, 0.0),
+            Measure::Entropy => est(h, 0.001),
+            Measure::EntropyCorrected => est(hc, 0.001),
+            Measure::JointEntropy => est(9.0 + h, 0.001),
+            Measure::MutualInformation => est(9.0 - h, 0.001),
+            Measure::MutualInformationCorrected => est(9.0 - hc, 0.001),
+            Measure::ContinuousMutualInformation => est(isc, 0.001),
+            Measure::Accuracy => est((9.0 - h) / isc, 0.001),
+            Measure::AccuracyCorrected => est((9.0 - hc) / isc, 0.001),
+            Measure::RelativeError => est(1.0 - (9.0 - h) / isc, 0.001),
+            Measure::MsePerLine => est(500.0, 0.01),
+            _ => None,
+        })
+    }
+
+    fn of(r: &ByMeasure<Reliability>, m: Measure) -> Reliability {
+        r.get(m).cloned().expect("a verdict")
     }
 
     /// Well sampled rows: every reading ok; a plug-in far from its correction: undersampled, with the
     /// lines to fix it; low coverage: unusable.
     #[test]
     fn verdicts_follow_coverage_and_the_plug_in_bias() {
-        let r = visibility(
+        let r = verdicts(
             &readings(7.8, 7.8005, 1.6),
             Some(&report(0.999)),
             1_000_000,
             1_000_000,
         );
-        assert_eq!(r.mutual_information.as_ref().unwrap().verdict, Verdict::Ok);
-        assert_eq!(r.mutual_information_corrected.unwrap().verdict, Verdict::Ok);
+        assert_eq!(of(&r, Measure::MutualInformation).verdict, Verdict::Ok);
         assert_eq!(
-            r.continuous_mutual_information.unwrap().verdict,
+            of(&r, Measure::MutualInformationCorrected).verdict,
+            Verdict::Ok
+        );
+        assert_eq!(
+            of(&r, Measure::ContinuousMutualInformation).verdict,
             Verdict::Ok
         );
 
-        let r = visibility(
+        let r = verdicts(
             &readings(7.6, 7.8, 1.6),
             Some(&report(0.999)),
             1_000_000,
             1_000_000,
         );
-        let mi = r.mutual_information.unwrap();
+        let mi = of(&r, Measure::MutualInformation);
         assert_eq!(mi.verdict, Verdict::Undersampled);
         assert!((mi.estimated_bias.unwrap() - 0.2).abs() < 1e-12);
         // (0.2 / 0.001)^2 times the lines.
         let needed = mi.lines_needed.unwrap() as f64;
         assert!((needed / 4e10 - 1.0).abs() < 1e-9, "{needed}");
-        assert_eq!(r.mutual_information_corrected.unwrap().verdict, Verdict::Ok);
+        assert_eq!(
+            of(&r, Measure::MutualInformationCorrected).verdict,
+            Verdict::Ok
+        );
 
-        let r = visibility(
+        let r = verdicts(
             &readings(5.0, 7.5, 1.6),
             Some(&report(0.3)),
             100_000,
             100_000,
         );
         assert_eq!(
-            r.mutual_information_corrected.unwrap().verdict,
+            of(&r, Measure::MutualInformationCorrected).verdict,
             Verdict::Unusable
         );
         // E(MSE) has an unbiased estimate whatever the coverage: its bias (0.001) is within 0.01.
-        assert_eq!(r.mse_per_line.unwrap().verdict, Verdict::Ok);
+        assert_eq!(of(&r, Measure::MsePerLine).verdict, Verdict::Ok);
     }
 
     /// Readings beyond the theory's bounds are flagged and never ok.
     #[test]
     fn impossible_readings_are_flagged() {
         // I_s = 3 > I_s^c = 1.6: Proposition 2 broken, accuracy 1.9 > 1.
-        let r = visibility(
+        let r = verdicts(
             &readings(6.0, 6.0, 1.6),
             Some(&report(0.999)),
             1_000_000,
             1_000_000,
         );
-        let mi = r.mutual_information.unwrap();
+        let mi = of(&r, Measure::MutualInformation);
         assert!(
             mi.flags.iter().any(|f| f.contains("Proposition 2")),
             "{mi:?}"
         );
         assert_ne!(mi.verdict, Verdict::Ok);
-        assert!(!r.accuracy.unwrap().flags.is_empty());
+        assert!(!of(&r, Measure::Accuracy).flags.is_empty());
         // A negative I_s^c, and a ratio over an I_s^c indistinguishable from 0.
         let mut v = readings(7.8, 7.8, -0.5);
-        v.continuous_mutual_information = est(-0.5, 0.01);
-        let r = visibility(&v, Some(&report(0.999)), 100, 16);
-        assert!(!r.continuous_mutual_information.unwrap().flags.is_empty());
+        v.set(Measure::ContinuousMutualInformation, est(-0.5, 0.01));
+        let r = verdicts(&v, Some(&report(0.999)), 100, 16);
+        assert!(!of(&r, Measure::ContinuousMutualInformation)
+            .flags
+            .is_empty());
         let mut v = readings(7.8, 7.8, 0.0005);
-        v.continuous_mutual_information = est(0.0005, 0.001);
-        let r = visibility(&v, Some(&report(0.999)), 1_000_000, 1_000_000);
-        assert_eq!(r.accuracy.unwrap().verdict, Verdict::Unusable);
+        v.set(Measure::ContinuousMutualInformation, est(0.0005, 0.001));
+        let r = verdicts(&v, Some(&report(0.999)), 1_000_000, 1_000_000);
+        assert_eq!(of(&r, Measure::Accuracy).verdict, Verdict::Unusable);
     }
 }

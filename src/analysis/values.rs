@@ -3,16 +3,16 @@
 
 use rayon::prelude::*;
 
-use super::readings::VisibilityEstimates;
-use super::reliability::{self, SamplingReport, VisibilityReliability, COVERAGE_OK};
+use super::reliability::{self, Reliability, SamplingReport, COVERAGE_OK};
 use crate::measure::bias::{self, CorrectedValues};
+use crate::measure::catalogue::VerdictRule;
 use crate::measure::channel;
 use crate::measure::entropy::xlog2x;
 use crate::measure::estimators::EntropyEstimator;
 use crate::measure::rows::Rows;
 use crate::measure::sampling::{lines_factor_for_coverage, Sampling};
 use crate::measure::visibility::{self, ContinuousValues, DiscreteValues};
-use crate::measure::Estimate;
+use crate::measure::{ByMeasure, Estimate, Family, Measure};
 use crate::run::{FinishedRun, Spread};
 use crate::sample::tally::{Tally, Wanted};
 use crate::scene::Scene;
@@ -94,7 +94,7 @@ fn areas(scene: &Scene) -> Vec<f64> {
 
 /// The visibility side of a finished run.
 pub(super) struct VisibilityOfRun {
-    pub(super) estimates: VisibilityEstimates,
+    pub(super) estimates: ByMeasure<Estimate>,
     /// The groups with lines.
     pub(super) groups: usize,
     /// Patches no segment left, and their area fraction (when counted).
@@ -106,7 +106,7 @@ pub(super) struct VisibilityOfRun {
     /// How the rows were sampled (when counted).
     pub(super) sampling: Option<SamplingReport>,
     /// The verdict on every reading.
-    pub(super) reliability: VisibilityReliability,
+    pub(super) reliability: ByMeasure<Reliability>,
 }
 
 /// Every visibility measure of a finished run with its standard error (by the jackknife when asked and
@@ -134,17 +134,17 @@ pub(super) fn visibility_estimates(
         replicates: replicates.as_deref(),
     };
     let mut estimates = if run.total.counters.lines == 0 {
-        VisibilityEstimates {
-            positional_entropy: Some(Estimate::exact(positional_entropy(&areas))),
-            ..VisibilityEstimates::default()
-        }
+        exact_only(&areas)
     } else {
         estimates(&areas, &spread, wanted)
     };
     let mut environment_area = None;
     if enclose {
         // The environment's area is counted, so H_p has a spread over the groups too.
-        estimates.positional_entropy = spread.batch_means(|g| Some(g.discrete?.positional_entropy));
+        estimates.set(
+            Measure::PositionalEntropy,
+            spread.batch_means(|g| Some(g.discrete?.positional_entropy)),
+        );
         let scale2 = scene.normalization.scale.powi(2);
         environment_area = spread.batch_means(|g| Some(g.environment_area? * scale2));
     }
@@ -153,7 +153,7 @@ pub(super) fn visibility_estimates(
         sampling,
         lines_for_coverage: all.lines_factor.map(|k| (k * lines as f64).ceil() as u64),
     });
-    let reliability = reliability::visibility(
+    let reliability = reliability::verdicts(
         &estimates,
         sampling.as_ref(),
         lines,
@@ -216,6 +216,18 @@ fn jackknife_replicates(
         .collect()
 }
 
+/// The estimates of a run in which no segment joined two patches: only the positional entropy (exact,
+/// from the areas) is defined; every visibility measure has no pair to be computed from, and zeros would
+/// read as measurements.
+pub(super) fn exact_only(areas: &[f64]) -> ByMeasure<Estimate> {
+    let mut out = ByMeasure::default();
+    out.set(
+        Measure::PositionalEntropy,
+        Some(Estimate::exact(positional_entropy(areas))),
+    );
+    out
+}
+
 /// Eq. (19), exact from the areas.
 fn positional_entropy(areas: &[f64]) -> f64 {
     -channel::area_distribution(areas)
@@ -224,32 +236,44 @@ fn positional_entropy(areas: &[f64]) -> f64 {
         .sum::<f64>()
 }
 
-/// Every measure with its standard error: by the delete-a-group jackknife when the spread has
-/// replicates, except I_s^c, a mean, whose batch-means error is exact; else, and for I_s^c, by batch
-/// means.
-fn estimates(areas: &[f64], spread: &Spread<GroupValues>, wanted: Wanted) -> VisibilityEstimates {
-    let both = wanted.discrete && wanted.continuous;
-    let est = |f: &dyn Fn(&GroupValues) -> Option<f64>| spread.estimate(f);
-    VisibilityEstimates {
-        positional_entropy: Some(Estimate::exact(positional_entropy(areas))),
-        entropy: est(&|g| Some(g.discrete?.entropy)),
-        entropy_corrected: est(&|g| Some(g.corrected?.entropy)),
-        joint_entropy: est(&|g| Some(g.discrete?.joint_entropy)),
-        mutual_information: est(&|g| Some(g.discrete?.mutual_information)),
-        mutual_information_corrected: est(&|g| Some(g.corrected?.mutual_information)),
-        continuous_mutual_information: spread
-            .batch_means(|g| Some(g.continuous?.mutual_information)),
-        accuracy: if both { est(&|g| g.accuracy()) } else { None },
-        accuracy_corrected: if both {
-            est(&|g| g.accuracy_corrected())
-        } else {
-            None
-        },
-        relative_error: if both {
-            est(&|g| Some(1.0 - g.accuracy()?))
-        } else {
-            None
-        },
-        mse_per_line: est(&|g| Some(g.discrete?.mse_per_line)),
+/// The value of the visibility measure `m` in a group's (or the run's) values: the estimator behind each
+/// entry of the catalogue ([`crate::measure::catalogue`]). `None` when the values do not have it.
+fn value_of(m: Measure, g: &GroupValues) -> Option<f64> {
+    match m {
+        Measure::Entropy => Some(g.discrete?.entropy),
+        Measure::EntropyCorrected => Some(g.corrected?.entropy),
+        Measure::JointEntropy => Some(g.discrete?.joint_entropy),
+        Measure::MutualInformation => Some(g.discrete?.mutual_information),
+        Measure::MutualInformationCorrected => Some(g.corrected?.mutual_information),
+        Measure::ContinuousMutualInformation => Some(g.continuous?.mutual_information),
+        Measure::Accuracy => g.accuracy(),
+        Measure::AccuracyCorrected => g.accuracy_corrected(),
+        Measure::RelativeError => Some(1.0 - g.accuracy()?),
+        Measure::MsePerLine => Some(g.discrete?.mse_per_line),
+        Measure::PositionalEntropy
+        | Measure::RadiosityPositionalEntropy
+        | Measure::RadiosityEntropy
+        | Measure::RadiosityEntropyCorrected
+        | Measure::RadiosityMutualInformation
+        | Measure::RadiosityMutualInformationCorrected => None,
     }
+}
+
+/// Every visibility measure the run gathered what it needs for, with its standard error: exact for
+/// H_p (from the areas); by batch means for a mean (I_s^c), whose batch-means error is exact; else by
+/// the delete-a-group jackknife when the spread has replicates, or batch means.
+fn estimates(areas: &[f64], spread: &Spread<GroupValues>, wanted: Wanted) -> ByMeasure<Estimate> {
+    ByMeasure::from_fn(|m| {
+        let info = m.info();
+        if info.family != Family::Visibility
+            || !info.needs.met_by(wanted.discrete, wanted.continuous)
+        {
+            return None;
+        }
+        match info.verdict {
+            VerdictRule::Exact => Some(Estimate::exact(positional_entropy(areas))),
+            VerdictRule::Mean => spread.batch_means(|g| value_of(m, g)),
+            _ => spread.estimate(|g| value_of(m, g)),
+        }
+    })
 }

@@ -8,12 +8,14 @@ use scene_complexity::analysis::{cast, finish};
 use scene_complexity::run::persist;
 use scene_complexity::run::{
     plan_of, remaining_lines, start, AnalysisConfig, Budget, CastOptions, Measures, PersistError,
-    RunControl, RunIdentity, RunState, Scope, StopReason, Target, TargetMeasure,
+    RunControl, RunIdentity, RunState, Scope, StopReason, Target,
 };
 use scene_complexity::sample::lines::LineSource;
 use scene_complexity::trace::{Backend, Query};
 
-use super::args::{parse_count, parse_positive, parse_target_measure, ReportOutput, RunOptions};
+use scene_complexity::measure::Measure;
+
+use super::args::{parse_count, parse_positive, target_measure_parser, ReportOutput, RunOptions};
 use super::output::{self, warn};
 use super::patches::PatchFiles;
 use super::report::{self, Format};
@@ -43,10 +45,9 @@ pub struct AnalyzeArgs {
     /// (verdict `ok`); then --lines (and --seconds) only cap the run.
     #[arg(long, value_parser = parse_positive, allow_negative_numbers = true)]
     target_stderr: Option<f64>,
-    /// The measure --target-stderr watches: mutual_information_corrected (default), mutual_information,
-    /// entropy, entropy_corrected, continuous_mutual_information, accuracy, accuracy_corrected.
-    #[arg(long, default_value = "mutual_information_corrected", value_parser = parse_target_measure)]
-    target_measure: TargetMeasure,
+    /// The measure --target-stderr watches.
+    #[arg(long, default_value = Measure::DEFAULT_TARGET.key(), value_parser = target_measure_parser())]
+    target_measure: Measure,
     /// Cast the lines in bundles of G x G parallel lines (jittered grid over the disc, traced as adjacent
     /// packets); 0 casts independent lines. The standard errors include the correlation within a bundle.
     #[arg(long, default_value_t = 0, value_parser = parse_bundle)]

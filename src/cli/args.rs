@@ -5,7 +5,8 @@ use std::path::PathBuf;
 
 use clap::ValueEnum;
 use scene_complexity::measure::estimators::EntropyEstimator;
-use scene_complexity::run::{ErrorMethod, TargetMeasure, DEFAULT_ESTIMATOR, DEFAULT_GROUPS};
+use scene_complexity::measure::Measure;
+use scene_complexity::run::{ErrorMethod, DEFAULT_ESTIMATOR, DEFAULT_GROUPS};
 use scene_complexity::scene::{ObjectSet, Planarity, SceneOptions, DEFAULT_PLANARITY};
 use scene_complexity::trace::{Backend, Query};
 
@@ -187,11 +188,12 @@ fn parse_errors(s: &str) -> Result<ErrorMethod, String> {
     })
 }
 
-/// A measure a precision target can watch.
-pub fn parse_target_measure(s: &str) -> Result<TargetMeasure, String> {
-    TargetMeasure::from_name(s).ok_or_else(|| {
-        let names: Vec<&str> = TargetMeasure::NAMES.iter().map(|(n, _)| *n).collect();
-        format!("`{s}`: expected one of {}", names.join(", "))
+/// The measures a precision target can watch (`--target-measure`), each with its label in `--help`.
+pub fn target_measure_parser() -> impl clap::builder::TypedValueParser<Value = Measure> {
+    let values =
+        Measure::targets().map(|m| clap::builder::PossibleValue::new(m.key()).help(m.info().label));
+    clap::builder::TypedValueParser::map(clap::builder::PossibleValuesParser::new(values), |key| {
+        Measure::target_named(&key).expect("a possible value names a target")
     })
 }
 

@@ -15,7 +15,7 @@ use rayon::prelude::*;
 
 use scene_complexity::analysis::{Analysis, PatchEstimate};
 use scene_complexity::geom::Point;
-use scene_complexity::measure::Estimate;
+use scene_complexity::measure::PatchMeasure;
 use scene_complexity::run::RunIdentity;
 use scene_complexity::sample::counts::PairCounts;
 use scene_complexity::sample::tally::Wanted;
@@ -92,10 +92,11 @@ impl PatchFiles {
         if !self.patches.is_empty() && wanted.continuous && !without_sums.is_empty() {
             warn(&format!(
                 "{}: saved without the per-patch sums of eq. (27) (the run was not asked for \
-                 --patches), so the continuous_mutual_information_term and lost_information columns \
-                 of --patches stay empty; give --patches to the first run (to every shard) to have \
-                 them",
-                without_sums.join(", ")
+                 --patches), so the {} and {} columns of --patches stay empty; give --patches to the \
+                 first run (to every shard) to have them",
+                without_sums.join(", "),
+                PatchMeasure::ContinuousTerm.info().column,
+                PatchMeasure::LostInformation.info().column
             ));
         }
         Ok(())
@@ -337,33 +338,6 @@ fn centroid(scene: &Scene, patch: usize) -> Point {
     }
 }
 
-/// The columns of the per-patch file after the geometry: each estimate as value and standard error.
-const ESTIMATE_COLUMNS: [&str; 9] = [
-    "row_entropy",
-    "row_entropy_corrected",
-    "mutual_information_term",
-    "mutual_information_term_corrected",
-    "continuous_mutual_information_term",
-    "lost_information",
-    "lost_information_corrected",
-    "radiosity",
-    "incoming_radiosity",
-];
-
-fn estimates_of(p: &PatchEstimate) -> [Option<Estimate>; 9] {
-    [
-        Some(p.row_entropy),
-        Some(p.row_entropy_corrected),
-        Some(p.mutual_information_term),
-        Some(p.mutual_information_term_corrected),
-        p.continuous_term,
-        p.lost_information,
-        p.lost_information_corrected,
-        p.radiosity,
-        p.incoming_radiosity,
-    ]
-}
-
 fn patches_csv(w: &mut dyn Write, scene: &Scene, patches: &[PatchEstimate]) -> std::io::Result<()> {
     let mut out = csv::Writer::from_writer(w);
     let mut header: Vec<String> = [
@@ -384,7 +358,8 @@ fn patches_csv(w: &mut dyn Write, scene: &Scene, patches: &[PatchEstimate]) -> s
     ]
     .map(String::from)
     .to_vec();
-    for name in ESTIMATE_COLUMNS {
+    for q in PatchMeasure::ALL {
+        let name = q.info().column;
         header.push(name.to_string());
         header.push(format!("{name}_stderr"));
     }
@@ -412,7 +387,7 @@ fn patches_csv(w: &mut dyn Write, scene: &Scene, patches: &[PatchEstimate]) -> s
             p.escapes.to_string(),
             p.sampled().to_string(),
         ];
-        for e in estimates_of(p) {
+        for e in PatchMeasure::ALL.map(|q| p.get(q)) {
             row.push(num(e.map(|e| e.value)));
             row.push(num(e.and_then(|e| e.stderr)));
         }

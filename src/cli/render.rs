@@ -25,10 +25,8 @@ use super::{Exit, Failure};
 pub struct RenderArgs {
     /// A scene file (OBJ), a built-in scene such as `@cornell`, or `-` for an OBJ on standard input.
     scene: String,
-    /// What colours the patches: row-entropy, row-entropy-corrected, mutual-information (term of I_s),
-    /// continuous-mutual-information (share of I_s^c), lost-information (I_i^c - I_i),
-    /// lost-information-corrected, segments (N_i), radiosity (B_i), incoming-radiosity (B_i^in).
-    #[arg(long, value_parser = parse_quantity)]
+    /// What colours the patches: a per-patch result of the run.
+    #[arg(long, value_parser = quantity_parser())]
     color: Quantity,
     /// The picture to write (.png).
     #[arg(short, long, value_name = "FILE.png")]
@@ -71,10 +69,12 @@ enum ScaleArg {
     Log,
 }
 
-fn parse_quantity(s: &str) -> Result<Quantity, String> {
-    Quantity::from_name(s).ok_or_else(|| {
-        let names: Vec<&str> = Quantity::NAMES.iter().map(|(n, _)| *n).collect();
-        format!("`{s}`: expected one of {}", names.join(", "))
+/// The per-patch quantities `--color` takes, each with its label in `--help`.
+fn quantity_parser() -> impl clap::builder::TypedValueParser<Value = Quantity> {
+    let values =
+        Quantity::all().map(|q| clap::builder::PossibleValue::new(q.name()).help(q.label()));
+    clap::builder::TypedValueParser::map(clap::builder::PossibleValuesParser::new(values), |name| {
+        Quantity::from_name(&name).expect("a possible value names a quantity")
     })
 }
 

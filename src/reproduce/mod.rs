@@ -17,10 +17,8 @@ use std::collections::HashMap;
 use std::fmt::Write as _;
 use std::time::Instant;
 
-use crate::analysis::{
-    analyze, AnalysisError, RadiosityEstimates, RadiosityOutcome, VisibilityEstimates,
-};
-use crate::measure::Estimate;
+use crate::analysis::{analyze, AnalysisError, RadiosityOutcome};
+use crate::measure::{ByMeasure, Estimate};
 use crate::refine::RefineError;
 use crate::run::{AnalysisConfig, Measures, RunControl};
 use crate::scene::{Scene, SceneError};
@@ -256,8 +254,10 @@ struct Run {
     patches: usize,
     lines: u64,
     seconds: f64,
-    v: VisibilityEstimates,
-    radiosity: Option<RadiosityEstimates>,
+    /// The visibility readings.
+    v: ByMeasure<Estimate>,
+    /// The radiosity readings, when computed.
+    radiosity: Option<ByMeasure<Estimate>>,
     /// Segments leaving a front side out of the scene (0 in a closed scene but for grazing hits).
     escapes: u64,
     /// Segments joining two patches.
@@ -310,7 +310,7 @@ impl Session<'_> {
         };
         let a = analyze(scene, tracer.as_ref(), &cfg, &RunControl::default())?;
         let radiosity = match &a.radiosity {
-            RadiosityOutcome::Computed(r) => Some((**r).clone()),
+            RadiosityOutcome::Computed(_) => Some(a.estimates.clone()),
             _ => None,
         };
         let seconds = start.elapsed().as_secs_f64();
@@ -324,7 +324,7 @@ impl Session<'_> {
             patches: scene.patch_count(),
             lines: a.lines,
             seconds,
-            v: a.visibility,
+            v: a.estimates,
             radiosity,
             escapes: a.escapes,
             pairs: a.pairs,

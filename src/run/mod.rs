@@ -28,7 +28,7 @@ pub use cast::{
     cast, plan_of, remaining_lines, start, CastHooks, CastOptions, Scope, TargetReading,
     TargetWatch,
 };
-pub use control::{Budget, RunControl, StopReason, Target, TargetMeasure};
+pub use control::{Budget, RunControl, StopReason, Target};
 pub use errors::{ErrorMethod, Spread};
 pub use persist::{PersistError, RunIdentity, SavedRun};
 pub use plan::{BatchPlan, BatchSet};

@@ -20,12 +20,13 @@ use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
-use super::control::{Budget, Target, TargetMeasure};
+use super::control::{Budget, Target};
 use super::errors::ErrorMethod;
 use super::plan::{BatchPlan, BatchSet};
 use super::spec::{AnalysisConfig, Measures};
 use super::state::RunState;
 use crate::measure::estimators::EntropyEstimator;
+use crate::measure::Measure;
 use crate::sample::counts::{pair_key, split_key, PairCounts};
 use crate::sample::exact::ExactSum;
 use crate::sample::lines::LineSource;
@@ -122,7 +123,7 @@ impl RunIdentity {
             target: cfg
                 .budget
                 .target
-                .map(|t| (t.measure.name().to_string(), t.stderr)),
+                .map(|t| (t.measure.key().to_string(), t.stderr)),
             shard,
         }
     }
@@ -131,7 +132,7 @@ impl RunIdentity {
     pub fn config(&self) -> Result<AnalysisConfig, String> {
         let target = match &self.target {
             Some((name, stderr)) => Some(Target {
-                measure: TargetMeasure::from_name(name)
+                measure: Measure::target_named(name)
                     .ok_or_else(|| format!("unknown target measure `{name}`"))?,
                 stderr: *stderr,
             }),

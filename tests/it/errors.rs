@@ -2,6 +2,7 @@
 //! the bias-corrected I_s is closer to the exact value than the plug-in.
 
 use crate::support;
+use scene_complexity::measure::Measure;
 use scene_complexity::scenes;
 
 use scene_complexity::analysis::{analyze, Analysis};
@@ -26,7 +27,7 @@ fn run(scene: &Scene, tracer: &dyn Tracer, lines: u64, seed: u64) -> Analysis {
 }
 
 fn cmi(a: &Analysis) -> Estimate {
-    a.visibility.continuous_mutual_information.unwrap()
+    a.estimate(Measure::ContinuousMutualInformation).unwrap()
 }
 
 #[test]
@@ -88,8 +89,11 @@ fn corrected_mutual_information_beats_the_plug_in_on_a_small_cube() {
     let scene = scenes::load("@cube:4").unwrap();
     let tracer = fastest_tracer(&scene);
     let a = run(&scene, tracer.as_ref(), 100_000, 7);
-    let plug = a.visibility.mutual_information.unwrap().value;
-    let corrected = a.visibility.mutual_information_corrected.unwrap().value;
+    let plug = a.estimate(Measure::MutualInformation).unwrap().value;
+    let corrected = a
+        .estimate(Measure::MutualInformationCorrected)
+        .unwrap()
+        .value;
     assert!(
         (corrected - exact).abs() < (plug - exact).abs(),
         "exact {exact}: corrected {corrected} vs plug-in {plug}"

@@ -2,6 +2,7 @@
 //! `w`, objects flipped or two-sided, the orientation diagnosis, glTF with node transforms, PLY and STL
 //! in ASCII and binary, materials in RGB, and I_s^c the same whatever the format and the triangulation.
 
+use scene_complexity::measure::Measure;
 use std::path::{Path, PathBuf};
 
 use scene_complexity::analysis::RunWarningKind;
@@ -219,10 +220,16 @@ fn inside_out_objects_are_diagnosed_and_flipped() {
     );
     assert_eq!(a.pairs, 0);
     assert!(kinds(&a).contains(&RunWarningKind::NoPairs));
-    let v = &a.visibility;
-    assert!(v.positional_entropy.is_some());
-    assert!(v.entropy.is_none() && v.mutual_information.is_none() && v.mse_per_line.is_none());
-    assert!(v.continuous_mutual_information.is_none() && v.accuracy.is_none());
+    assert!(a.estimate(Measure::PositionalEntropy).is_some());
+    assert!(
+        a.estimate(Measure::Entropy).is_none()
+            && a.estimate(Measure::MutualInformation).is_none()
+            && a.estimate(Measure::MsePerLine).is_none()
+    );
+    assert!(
+        a.estimate(Measure::ContinuousMutualInformation).is_none()
+            && a.estimate(Measure::Accuracy).is_none()
+    );
     let all = SceneOptions {
         flip_normals: ObjectSet::All,
         ..SceneOptions::default()
@@ -242,7 +249,7 @@ fn inside_out_objects_are_diagnosed_and_flipped() {
 }
 
 fn v_entropy(a: &Analysis) -> (f64, f64) {
-    let e = a.visibility.entropy.unwrap();
+    let e = a.estimate(Measure::Entropy).unwrap();
     (e.value, e.stderr.unwrap())
 }
 
@@ -515,7 +522,7 @@ fn continuous_mutual_information_is_the_same_in_every_format() {
         let scene = load(path.to_str().unwrap()).unwrap();
         assert_eq!(scene.patch_count(), patches, "{}", path.display());
         let a = run(&scene, 300_000, seed as u64 + 1, continuous);
-        let e = a.visibility.continuous_mutual_information.unwrap();
+        let e = a.estimate(Measure::ContinuousMutualInformation).unwrap();
         results.push((path, e.value, e.stderr.unwrap()));
     }
     for a in &results {
@@ -676,6 +683,6 @@ fn two_sided_walls_one_after_another_pair_as_thin_panels() {
         b.unpaired
     );
     assert_eq!(b.degenerate_pairs, 0);
-    let e = b.visibility.continuous_mutual_information.unwrap();
+    let e = b.estimate(Measure::ContinuousMutualInformation).unwrap();
     assert!(e.value.is_finite());
 }

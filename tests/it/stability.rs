@@ -6,6 +6,7 @@
 //! reference computed here (never against scx's own earlier output).
 
 use crate::support;
+use scene_complexity::measure::Measure;
 use scene_complexity::scenes;
 
 use std::f64::consts::{LN_2, PI};
@@ -46,17 +47,19 @@ fn trace(tracer: &dyn Tracer, lines: &[Line]) -> LineHits {
 
 /// Every reported measure is a finite number (or absent), never NaN or infinite.
 fn assert_all_finite(a: &Analysis, what: &str) {
-    let v = &a.visibility;
     for (name, e) in [
-        ("H_p", v.positional_entropy),
-        ("H_s", v.entropy),
-        ("H_s corrected", v.entropy_corrected),
-        ("H(X,Y)", v.joint_entropy),
-        ("I_s", v.mutual_information),
-        ("I_s corrected", v.mutual_information_corrected),
-        ("I_s^c", v.continuous_mutual_information),
-        ("accuracy", v.accuracy),
-        ("mse", v.mse_per_line),
+        ("H_p", a.estimate(Measure::PositionalEntropy)),
+        ("H_s", a.estimate(Measure::Entropy)),
+        ("H_s corrected", a.estimate(Measure::EntropyCorrected)),
+        ("H(X,Y)", a.estimate(Measure::JointEntropy)),
+        ("I_s", a.estimate(Measure::MutualInformation)),
+        (
+            "I_s corrected",
+            a.estimate(Measure::MutualInformationCorrected),
+        ),
+        ("I_s^c", a.estimate(Measure::ContinuousMutualInformation)),
+        ("accuracy", a.estimate(Measure::Accuracy)),
+        ("mse", a.estimate(Measure::MsePerLine)),
     ] {
         if let Some(e) = e {
             assert!(e.value.is_finite(), "{what}: {name} = {}", e.value);
@@ -420,7 +423,7 @@ fn nearly_concentric_spheres_close_to_touching() {
         );
 
         let (reference, se_ref) = nested_reference(&inner, &outer, 300_000, 77 + k as u64);
-        let cmi = a.visibility.continuous_mutual_information.unwrap();
+        let cmi = a.estimate(Measure::ContinuousMutualInformation).unwrap();
         let se = cmi.stderr.unwrap();
         assert!(
             (cmi.value - reference).abs() < 4.5 * (se * se + se_ref * se_ref).sqrt() + 3e-3,
@@ -509,7 +512,7 @@ fn cube_almost_touching_and_touching_the_floor() {
         cmi.push((
             gap,
             exact,
-            a.visibility.continuous_mutual_information.unwrap(),
+            a.estimate(Measure::ContinuousMutualInformation).unwrap(),
         ));
     }
     let a_t = 6.0 + 6.0 * SIDE * SIDE;
@@ -929,14 +932,13 @@ fn tiny_and_huge_scenes_give_the_same_results() {
         scenes::load(path.to_str().unwrap()).unwrap()
     };
     let measures = |a: &Analysis| {
-        let v = &a.visibility;
         [
-            v.positional_entropy,
-            v.entropy,
-            v.entropy_corrected,
-            v.mutual_information,
-            v.continuous_mutual_information,
-            v.mse_per_line,
+            a.estimate(Measure::PositionalEntropy),
+            a.estimate(Measure::Entropy),
+            a.estimate(Measure::EntropyCorrected),
+            a.estimate(Measure::MutualInformation),
+            a.estimate(Measure::ContinuousMutualInformation),
+            a.estimate(Measure::MsePerLine),
         ]
         .map(|e| e.unwrap().value)
     };
@@ -1133,7 +1135,7 @@ fn enclose_closes_open_scenes_consistently() {
         (to_cube - exact).abs() < 4.5 * sigma,
         "F(env -> cube) = {to_cube}, A_cube / 4 pi R^2 = {exact}"
     );
-    let hp = a.visibility.positional_entropy.unwrap();
+    let hp = a.estimate(Measure::PositionalEntropy).unwrap();
     let total = 6.0 + sphere;
     let exact_hp =
         -(6.0 * (1.0 / total) * (1.0 / total).log2() + (sphere / total) * (sphere / total).log2());
