@@ -10,7 +10,7 @@ use scene_complexity::analysis::analyze;
 use scene_complexity::measure::bias::corrected;
 use scene_complexity::measure::estimators::EntropyEstimator;
 use scene_complexity::run::Measures;
-use scene_complexity::run::{AnalysisConfig, RunControl};
+use scene_complexity::run::{RunControl, RunSpec};
 use scene_complexity::scenes;
 use scene_complexity::trace::{make_tracer, Backend, Query};
 
@@ -41,13 +41,13 @@ fn main() {
         let tracer = make_tracer(Backend::default_available(), &scene, Query::Single).unwrap();
         for &lines in &line_counts {
             for seed in 1..=seeds {
-                let cfg = AnalysisConfig {
+                let cfg = RunSpec {
                     measures: Measures {
                         discrete: true,
                         continuous: false,
                         radiosity: false,
                     },
-                    ..AnalysisConfig::new(lines as u64, seed)
+                    ..RunSpec::new(lines as u64, seed)
                 };
                 let a = analyze(&scene, tracer.as_ref(), &cfg, &RunControl::default()).unwrap();
                 let counts = a.tally.counts.as_ref().unwrap();

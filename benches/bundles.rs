@@ -20,7 +20,7 @@ use std::time::Instant;
 
 use scene_complexity::analysis::analyze;
 use scene_complexity::measure::Estimate;
-use scene_complexity::run::{AnalysisConfig, RunControl};
+use scene_complexity::run::{RunControl, RunSpec};
 use scene_complexity::sample::lines::LineSource;
 use scene_complexity::scene::Scene;
 use scene_complexity::trace::{make_tracer, Backend, Query, Tracer};
@@ -98,10 +98,10 @@ impl Row {
 
 fn measure(scene: &Scene, tracer: &dyn Tracer, lines: u64, grid: u32) -> Row {
     let source = LineSource::bundles(grid).expect("grids from the list are valid");
-    let cfg = |seed| AnalysisConfig {
+    let cfg = |seed| RunSpec {
         groups: GROUPS,
         source,
-        ..AnalysisConfig::new(lines, seed)
+        ..RunSpec::new(lines, seed)
     };
     let mut row = Row {
         lines: 0.0,
@@ -168,9 +168,9 @@ fn spread(specs: &[String], lines: u64, seeds: u64) -> anyhow::Result<()> {
         let mut cpu = [0.0; GRIDS.len()];
         for seed in 1..=seeds {
             for (g, &grid) in GRIDS.iter().enumerate() {
-                let cfg = AnalysisConfig {
+                let cfg = RunSpec {
                     source: LineSource::bundles(grid).expect("grids from the list are valid"),
-                    ..AnalysisConfig::new(lines, seed)
+                    ..RunSpec::new(lines, seed)
                 };
                 let c0 = common::cpu_seconds();
                 let a = analyze(&scene, tracer.as_ref(), &cfg, &RunControl::default())?;

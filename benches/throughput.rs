@@ -16,8 +16,8 @@ use std::time::Instant;
 
 use rayon::prelude::*;
 use scene_complexity::analysis::analyze;
-use scene_complexity::run::{AnalysisConfig, RunControl, DEFAULT_GROUPS};
 use scene_complexity::run::{BatchPlan, Measures};
+use scene_complexity::run::{RunControl, RunSpec, DEFAULT_GROUPS};
 use scene_complexity::sample::lines::batch_lines;
 use scene_complexity::trace::{make_tracer, Backend, Line, LineHits, Query, Tracer};
 
@@ -70,12 +70,12 @@ fn bench_scene(spec: &str, count: u64, pools: &[rayon::ThreadPool]) -> anyhow::R
             &mut lines,
         );
     }
-    let cfg = AnalysisConfig {
+    let cfg = RunSpec {
         groups: DEFAULT_GROUPS,
-        ..AnalysisConfig::new(count, 1)
+        ..RunSpec::new(count, 1)
     };
     // `--measures continuous`: I_s^c alone, no pair counts (what a run needs when it wants only eq. 27).
-    let continuous = AnalysisConfig {
+    let continuous = RunSpec {
         measures: Measures {
             discrete: false,
             continuous: true,

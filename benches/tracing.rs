@@ -9,7 +9,7 @@ use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Through
 use rayon::prelude::*;
 use scene_complexity::analysis::analyze;
 use scene_complexity::run::Measures;
-use scene_complexity::run::{AnalysisConfig, RunControl};
+use scene_complexity::run::{RunControl, RunSpec};
 use scene_complexity::sample::lines::LineSource;
 use scene_complexity::scene::Scene;
 use scene_complexity::scenes;
@@ -117,13 +117,13 @@ fn bench_analysis(c: &mut Criterion) {
         let mut g = c.benchmark_group(format!("analyze/{spec}"));
         g.throughput(Throughput::Elements(LINES as u64));
         g.sample_size(10);
-        let cfg = AnalysisConfig {
+        let cfg = RunSpec {
             measures: Measures {
                 discrete: true,
                 continuous: true,
                 radiosity: false,
             },
-            ..AnalysisConfig::new(LINES as u64, 1)
+            ..RunSpec::new(LINES as u64, 1)
         };
         for (name, t) in tracers(&scene) {
             g.bench_function(BenchmarkId::from_parameter(&name), |b| {

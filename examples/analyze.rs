@@ -6,9 +6,7 @@
 
 use std::error::Error;
 
-use scene_complexity::{
-    analyze, load, make_tracer, AnalysisConfig, Backend, Measure, Query, RunControl,
-};
+use scene_complexity::{analyze, load, make_tracer, Backend, Measure, Query, RunControl, RunSpec};
 
 fn main() -> Result<(), Box<dyn Error>> {
     let mut args = std::env::args().skip(1);
@@ -27,7 +25,7 @@ fn main() -> Result<(), Box<dyn Error>> {
     let analysis = analyze(
         &scene,
         tracer.as_ref(),
-        &AnalysisConfig::new(lines, 1),
+        &RunSpec::new(lines, 1),
         &RunControl::default(),
     )?;
     for warning in &analysis.warnings {

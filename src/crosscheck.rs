@@ -17,7 +17,7 @@ use std::fmt;
 use crate::analysis::{analyze, Analysis, AnalysisError};
 use crate::measure::{Estimate, Measure};
 use crate::run::{
-    all_batches, map_batches, AnalysisConfig, Batch, LineStream, Measures, RunControl, TraceBuffers,
+    all_batches, map_batches, Batch, LineStream, Measures, RunControl, RunSpec, TraceBuffers,
 };
 use crate::scene::Scene;
 use crate::trace::{Hit, Line, TraceError, Tracer};
@@ -270,7 +270,7 @@ pub fn compare_measures(
     scene: &Scene,
     a: &dyn Tracer,
     b: &dyn Tracer,
-    cfg: &AnalysisConfig,
+    cfg: &RunSpec,
 ) -> Result<Vec<MeasureComparison>, AnalysisError> {
     let control = RunControl::default();
     let ra = analyze(scene, a, cfg, &control)?;
@@ -334,10 +334,10 @@ pub fn crosscheck(
     groups: usize,
 ) -> Result<CrossCheck, AnalysisError> {
     let hits = compare_hits(scene, a, b, cfg)?;
-    let analysis = AnalysisConfig {
+    let analysis = RunSpec {
         groups,
         measures: Measures::VISIBILITY,
-        ..AnalysisConfig::new(cfg.lines, cfg.seed)
+        ..RunSpec::new(cfg.lines, cfg.seed)
     };
     let measures = compare_measures(scene, a, b, &analysis)?;
     Ok(CrossCheck {

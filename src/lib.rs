@@ -8,12 +8,12 @@
 //! light, the radiosity measures of sec. 4, each with its standard error.
 //!
 //! ```
-//! use scene_complexity::{analyze, load, make_tracer, AnalysisConfig, Backend, Query, RunControl};
+//! use scene_complexity::{analyze, load, make_tracer, RunSpec, Backend, Query, RunControl};
 //!
 //! // The unit cube cut into 4 x 4 patches per face, whose exact I_s is 1.12257 bits.
 //! let scene = load("@cube:4")?;
 //! let tracer = make_tracer(Backend::Rust, &scene, Query::Single)?;
-//! let config = AnalysisConfig::new(200_000, 1);
+//! let config = RunSpec::new(200_000, 1);
 //! let a = analyze(&scene, tracer.as_ref(), &config, &RunControl::default())?;
 //! let is = a.visibility.mutual_information_corrected.expect("counted");
 //! let isc = a.visibility.continuous_mutual_information.expect("summed");
@@ -65,7 +65,7 @@ pub use measure::estimators::EntropyEstimator;
 pub use measure::radiosity::SolveOptions;
 pub use measure::{ByMeasure, Estimate, Family, Measure, PatchMeasure, Unit};
 pub use refine::{refine, RefineConfig, RefineError, Refinement, Strategy};
-pub use run::{AnalysisConfig, Budget, ErrorMethod, Measures, RunControl, StopReason, Target};
+pub use run::{Budget, ErrorMethod, Measures, RunControl, RunSpec, StopReason, Target};
 pub use sample::lines::LineSource;
 pub use scene::{
     Material, ObjectSet, Patch, Planarity, Scene, SceneBuilder, SceneError, SceneOptions,

@@ -8,7 +8,7 @@
 
 use libfuzzer_sys::fuzz_target;
 use scene_complexity::measure::Measure;
-use scene_complexity::run::{AnalysisConfig, RunControl};
+use scene_complexity::run::{RunSpec, RunControl};
 use scene_complexity::analysis::analyze;
 use scene_complexity::scene::{obj, Scene};
 use scene_complexity::scenes;
@@ -39,10 +39,10 @@ fn trace_a_little(scene: &Scene) {
         return;
     }
     let tracer = make_tracer(Backend::Rust, scene, Query::Single).expect("the Rust tracer builds");
-    let cfg = AnalysisConfig {
+    let cfg = RunSpec {
         groups: 2,
         enclose: scene.triangles.len() % 2 == 0,
-        ..AnalysisConfig::new(256, 1)
+        ..RunSpec::new(256, 1)
     };
     let a = match analyze(scene, tracer.as_ref(), &cfg, &RunControl::default()) {
         Ok(a) => a,

@@ -27,8 +27,8 @@ use crate::measure::estimators::EntropyEstimator;
 use crate::measure::radiosity::{MaterialError, PatchMaterials};
 use crate::measure::{ByMeasure, Estimate, Measure};
 use crate::run::{
-    AnalysisConfig, BatchPlan, BatchSet, CastHooks, CastOptions, ErrorMethod, FinishedRun,
-    RunControl, RunState, StopReason, TargetReading,
+    BatchPlan, BatchSet, CastHooks, CastOptions, ErrorMethod, FinishedRun, RunControl, RunSpec,
+    RunState, StopReason, TargetReading,
 };
 use crate::sample::tally::{ObjectSides, Tally};
 use crate::scene::Scene;
@@ -58,10 +58,10 @@ impl AnalysisError {
 /// Everything a run found.
 #[derive(Clone, Debug)]
 pub struct Analysis {
+    /// What the run was asked to be (its seed, measures, estimator, ...).
+    pub spec: RunSpec,
     /// Lines cast.
     pub lines: u64,
-    /// Seed.
-    pub seed: u64,
     /// Wall-clock seconds of tracing, counting and measuring.
     pub seconds: f64,
     /// Why the run ended.
@@ -72,8 +72,6 @@ pub struct Analysis {
     pub covered: BatchSet,
     /// Groups behind the standard errors.
     pub groups: usize,
-    /// The estimator of the corrected measures.
-    pub estimator: EntropyEstimator,
     /// How the standard errors of the count-based measures were estimated (batch means when the
     /// jackknife was asked for but does not apply).
     pub errors: ErrorMethod,
@@ -111,7 +109,7 @@ pub struct Analysis {
     pub orientation: Vec<ObjectSides>,
     /// The full-run counts, for form factors (when counted).
     pub tally: Tally,
-    /// Each patch's results, with standard errors, when [`AnalysisConfig::per_patch`] asked for them
+    /// Each patch's results, with standard errors, when [`RunSpec::per_patch`] asked for them
     /// (`None` as well for an enclosed open scene).
     pub patches: Option<Vec<PatchEstimate>>,
 }
@@ -182,7 +180,7 @@ impl TargetOutcome {
 pub fn analyze(
     scene: &Scene,
     tracer: &dyn Tracer,
-    cfg: &AnalysisConfig,
+    cfg: &RunSpec,
     control: &RunControl,
 ) -> Result<Analysis, AnalysisError> {
     let started = Instant::now();
@@ -211,7 +209,7 @@ pub fn analyze(
 pub fn cast(
     scene: &Scene,
     tracer: &dyn Tracer,
-    cfg: &AnalysisConfig,
+    cfg: &RunSpec,
     state: &mut RunState,
     options: CastOptions,
     control: &RunControl,
@@ -244,7 +242,7 @@ pub fn cast(
 /// total and estimating from them is part of what a user waits for).
 pub fn finish(
     scene: &Scene,
-    cfg: &AnalysisConfig,
+    cfg: &RunSpec,
     state: RunState,
     stop_reason: StopReason,
     seconds: f64,
@@ -328,14 +326,13 @@ pub fn finish(
         }
     }
     Ok(Analysis {
+        spec: cfg.clone(),
         lines: total.counters.lines,
-        seed: cfg.seed,
         seconds: seconds + began.elapsed().as_secs_f64(),
         stop_reason,
         plan,
         covered,
         groups: visibility.groups,
-        estimator: cfg.estimator,
         errors: if visibility.jackknifed {
             ErrorMethod::Jackknife
         } else {
@@ -367,7 +364,7 @@ pub fn finish(
 fn current_reading(
     scene: &Scene,
     state: &RunState,
-    cfg: &AnalysisConfig,
+    cfg: &RunSpec,
     measure: Measure,
 ) -> TargetReading {
     let wanted = state.wanted();

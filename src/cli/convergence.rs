@@ -124,13 +124,12 @@ pub fn run(args: &ConvergenceArgs) -> Result<Exit, Failure> {
     'counts: for (k, &lines) in counts.iter().enumerate() {
         let mut runs = Vec::new();
         for r in 0..args.repeats {
-            let seed = args.run.seed + u64::from(r);
+            let seed = args.run.seed.value + u64::from(r);
             let label = format!(
                 "run {} of {total_runs}: {lines:.0e} lines, seed {seed}",
                 k as u32 * args.repeats + r + 1
             );
-            let mut a =
-                runner.analyze(&runner.config(&args.run, lines, seed), Some(lines), &label)?;
+            let mut a = runner.analyze(&args.run.spec(lines, seed), Some(lines), &label)?;
             // The counts are not needed any more; keep the measures only.
             a.tally.counts = None;
             let stopped = a.stop_reason != StopReason::Lines;
@@ -213,7 +212,7 @@ fn json_report(info: &report::RunInfo, levels: &[Level], repeats: u32) -> String
             }
             json!({
                 "lines": a.lines,
-                "seed": a.seed,
+                "seed": a.spec.seed,
                 "seconds": a.seconds,
                 "stop_reason": a.stop_reason.name(),
                 "measures": measures,
@@ -226,7 +225,7 @@ fn json_report(info: &report::RunInfo, levels: &[Level], repeats: u32) -> String
         "unit": "bit",
         "scene": info.scene.name,
         "patches": info.scene.patch_count(),
-        "tracer": info.tracer,
+        "tracer": info.tracing.backend.name(),
         "threads": info.threads,
         "repeats": repeats,
         "runs": runs,
@@ -288,7 +287,7 @@ fn table(info: &report::RunInfo, levels: &[Level], repeats: u32) -> String {
          measures in bits\n",
         info.scene.name,
         info.scene.patch_count(),
-        info.tracer,
+        info.tracing.backend.name(),
         info.threads
     );
     let mut header = vec!["lines", "seconds"];

@@ -5,7 +5,7 @@ use scene_complexity::run::DEFAULT_GROUPS;
 use scene_complexity::trace::{make_tracer, Backend, Query};
 
 use super::args::SceneArgs;
-use super::args::{parse_count, parse_seed, parse_threads, ReportOutput};
+use super::args::{parse_count, ReportOutput, Seed, Threads};
 use super::input::load_scene;
 use super::output::{self, check_all};
 use super::runner::thread_pool;
@@ -22,12 +22,10 @@ pub struct CrosscheckArgs {
     /// Number of global lines (accepts `1e6`).
     #[arg(long, default_value = "1e6", value_parser = parse_count, allow_negative_numbers = true)]
     lines: u64,
-    /// Seed of the random line streams (the lines of `scx analyze` with the same seed).
-    #[arg(long, default_value = "1", value_parser = parse_seed, allow_negative_numbers = true)]
-    seed: u64,
-    /// Worker threads; 0 or absent: all cores. Results do not depend on it.
-    #[arg(long, value_parser = parse_threads, allow_negative_numbers = true)]
-    threads: Option<usize>,
+    #[command(flatten)]
+    seed: Seed,
+    #[command(flatten)]
+    threads: Threads,
     /// Distances agree within this many f32 ulps at max(t, 1).
     #[arg(long, default_value_t = Tolerance::default().ulps, allow_negative_numbers = true)]
     ulps: f32,
@@ -50,10 +48,10 @@ pub fn run(args: &CrosscheckArgs) -> Result<Exit, Failure> {
     let scene = load_scene(&args.scene, &args.input.options())?;
     let embree = make_tracer(Backend::Embree, &scene, Query::Single).map_err(Failure::bad_input)?;
     let rust = make_tracer(Backend::Rust, &scene, Query::Single).map_err(Failure::bad_input)?;
-    let (_, pool) = thread_pool(args.threads)?;
+    let (_, pool) = thread_pool(args.threads.value)?;
     let cfg = CrossCheckConfig {
         lines: args.lines,
-        seed: args.seed,
+        seed: args.seed.value,
         tolerance: Tolerance { ulps: args.ulps },
         examples: args.show,
     };

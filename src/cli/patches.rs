@@ -77,7 +77,7 @@ impl PatchFiles {
         if self.is_empty() {
             return Ok(());
         }
-        if identity.enclose {
+        if identity.spec.enclose {
             return Err(Failure::bad_input(format!(
                 "{file}: the run closed the scene with --enclose; --patches and --form-factors \
                  describe the scene's own patches"
@@ -305,7 +305,7 @@ fn matrix_market(
         "% form factors F_ij = N_ij / N_i of {} from {} global lines (seed {}), written by scx {}",
         scene.name.replace('\n', " "),
         a.lines,
-        a.seed,
+        a.spec.seed,
         env!("CARGO_PKG_VERSION")
     )?;
     writeln!(w, "% row i, column j (1-based: patch index + 1)")?;

@@ -11,7 +11,7 @@ use scene_complexity::render::{
     default_camera, trace_view, write_ply, Camera, ColourScale, Quantity, Sample, BACK_SIDE,
     NO_DATA,
 };
-use scene_complexity::run::{AnalysisConfig, Measures, StopReason};
+use scene_complexity::run::{Measures, RunSpec, StopReason};
 use scene_complexity::scene::Scene;
 
 use super::args::{parse_count, RunOptions};
@@ -156,10 +156,10 @@ pub fn run(args: &RenderArgs) -> Result<Exit, Failure> {
             args.color.name()
         )));
     }
-    let cfg = AnalysisConfig {
+    let cfg = RunSpec {
         measures: Measures::ALL,
         per_patch: true,
-        ..runner.config(&args.run, args.lines, args.run.seed)
+        ..args.run.spec(args.lines, args.run.seed.value)
     };
     let analysis = runner.analyze(&cfg, Some(args.lines), "")?;
     for w in &analysis.warnings {

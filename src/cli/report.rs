@@ -9,7 +9,8 @@ use clap::ValueEnum;
 use scene_complexity::analysis::{Analysis, RadiosityOutcome, Reliability, TargetOutcome, Verdict};
 use scene_complexity::measure::catalogue::VerdictRule;
 use scene_complexity::measure::{Estimate, Family, Measure, Unit};
-use scene_complexity::run::{ErrorMethod, StopReason};
+use scene_complexity::run::{ErrorMethod, Shard, StopReason, Tracing};
+use scene_complexity::sample::lines::LineSource;
 use scene_complexity::scene::Scene;
 use serde_json::{json, Value};
 
@@ -39,16 +40,21 @@ pub fn render(format: Format, run: &RunInfo, a: &Analysis) -> String {
 /// line, CPU).
 pub const SCHEMA_VERSION: u32 = 2;
 
-/// Facts about the run that the analysis itself does not hold.
+/// Facts about the run that the analysis itself does not hold: the scene, how it ran.
 pub struct RunInfo<'a> {
     pub scene: &'a Scene,
-    pub tracer: &'a str,
-    pub query: String,
+    pub tracing: Tracing,
     pub threads: usize,
-    /// Lines per side of a bundle, 0 for independent lines.
-    pub bundle: u32,
-    /// The shard (index from 1, count) when the run was one.
-    pub shard: Option<(u32, u32)>,
+    /// The shard, when the run was one.
+    pub shard: Option<Shard>,
+}
+
+/// Lines per side of a bundle, 0 for independent lines.
+fn bundle(a: &Analysis) -> u32 {
+    match a.spec.source {
+        LineSource::Independent => 0,
+        LineSource::Bundles { grid } => grid,
+    }
 }
 
 /// One row of the report: JSON key, table label, unit, paper reference, plug-in and bias-corrected
@@ -192,11 +198,11 @@ pub fn json(run: &RunInfo, a: &Analysis) -> String {
         "patches": run.scene.patch_count(),
         "triangles": run.scene.triangles.len(),
         "area": run.scene.total_area_scene_units(),
-        "tracer": run.tracer,
-        "query": run.query,
-        "bundle": run.bundle,
+        "tracer": run.tracing.backend.name(),
+        "query": run.tracing.query.to_string(),
+        "bundle": bundle(a),
         "lines": a.lines,
-        "seed": a.seed,
+        "seed": a.spec.seed,
         "threads": run.threads,
         "groups": a.groups,
         "seconds": a.seconds,
@@ -204,9 +210,9 @@ pub fn json(run: &RunInfo, a: &Analysis) -> String {
         "interrupted": a.stop_reason == StopReason::Interrupted,
         "complete": a.is_complete(),
         "covered_lines": a.covered_lines().iter().map(|r| [r.start, r.end]).collect::<Vec<_>>(),
-        "shard": run.shard.map(|(k, m)| json!({"index": k, "count": m})),
+        "shard": run.shard.map(|s| json!({"index": s.index, "count": s.count})),
         "target": target_json(&a.target),
-        "estimator": a.estimator.name(),
+        "estimator": a.spec.estimator.name(),
         "errors": a.errors.name(),
         "hits": a.hits,
         "pairs": a.pairs,
@@ -294,8 +300,8 @@ pub fn csv(run: &RunInfo, a: &Analysis) -> String {
         w.write_record([
             run.scene.name.clone(),
             a.lines.to_string(),
-            a.seed.to_string(),
-            run.tracer.to_string(),
+            a.spec.seed.to_string(),
+            run.tracing.backend.name().to_string(),
             family.to_string(),
             r.key.to_string(),
             r.unit.name().to_string(),
@@ -383,14 +389,14 @@ pub fn table(run: &RunInfo, a: &Analysis) -> String {
         s,
         "lines    {}{}  seed {}  tracer {} ({})  threads {}  {:.3} s  ({:.2} M lines/s)",
         a.lines,
-        if run.bundle > 0 {
-            format!(" in bundles of {0} x {0}", run.bundle)
+        if bundle(a) > 0 {
+            format!(" in bundles of {0} x {0}", bundle(a))
         } else {
             String::new()
         },
-        a.seed,
-        run.tracer,
-        run.query,
+        a.spec.seed,
+        run.tracing.backend.name(),
+        run.tracing.query,
         run.threads,
         a.seconds,
         a.lines as f64 / a.seconds.max(1e-12) / 1e6
@@ -439,7 +445,7 @@ pub fn table(run: &RunInfo, a: &Analysis) -> String {
             },
             a.plan.lines,
             run.shard
-                .map(|(k, m)| format!(", shard {k} of {m}"))
+                .map(|s| format!(", shard {} of {}", s.index, s.count))
                 .unwrap_or_default()
         );
     }
@@ -512,10 +518,10 @@ pub fn table(run: &RunInfo, a: &Analysis) -> String {
         "\nstandard errors: {errors} (statistical error only).\n\
          corrected: row entropies by the {} estimator; the plug-in H_s and I_s are biased when rows are \
          undersampled.",
-        a.estimator.name()
+        a.spec.estimator.name()
     );
     reliability_summary(&mut s, a);
-    if run.bundle > 0 && a.estimate(Measure::MutualInformationCorrected).is_some() {
+    if bundle(a) > 0 && a.estimate(Measure::MutualInformationCorrected).is_some() {
         // Measured: 8 x 8 bundles moved the corrected I_s of @cube:30 by 7.7 standard errors (README).
         let _ = writeln!(
             s,

@@ -181,7 +181,7 @@ fn check_material(emission: f64, reflectance: f64) -> Result<(), String> {
 }
 
 /// When the Gauss-Seidel iteration stops.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct SolveOptions {
     /// Stop when `max_i |B_i - E_i - R_i sum_j F_ij B_j| / max_i B_i` is at most this.
     pub tolerance: f64,

@@ -20,7 +20,7 @@ use std::time::Instant;
 use crate::analysis::{analyze, AnalysisError, RadiosityOutcome};
 use crate::measure::{ByMeasure, Estimate};
 use crate::refine::RefineError;
-use crate::run::{AnalysisConfig, Measures, RunControl};
+use crate::run::{Measures, RunControl, RunSpec};
 use crate::scene::{Scene, SceneError};
 use crate::trace::{make_tracer, Backend, Query, TraceError};
 
@@ -300,13 +300,13 @@ impl Session<'_> {
     fn run_scene(&mut self, scene: &Scene, lines: u64, want: Want) -> Result<Run, ReproduceError> {
         let start = Instant::now();
         let tracer = make_tracer(self.cfg.backend, scene, Query::Single)?;
-        let cfg = AnalysisConfig {
+        let cfg = RunSpec {
             measures: Measures {
                 discrete: want != Want::Continuous,
                 continuous: true,
                 radiosity: want == Want::Radiosity,
             },
-            ..AnalysisConfig::new(lines, self.cfg.seed)
+            ..RunSpec::new(lines, self.cfg.seed)
         };
         let a = analyze(scene, tracer.as_ref(), &cfg, &RunControl::default())?;
         let radiosity = match &a.radiosity {

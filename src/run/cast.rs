@@ -9,7 +9,7 @@ use std::time::{Duration, Instant};
 use super::batches::LineStream;
 use super::control::{RunControl, StopReason};
 use super::plan::{BatchPlan, BatchSet, MAX_ROUND_KEYS, MAX_ROUND_LINES};
-use super::spec::AnalysisConfig;
+use super::spec::RunSpec;
 use super::state::{RunState, TracedBatches};
 use crate::measure::radiosity::{MaterialError, PatchMaterials};
 use crate::sample::tally::Wanted;
@@ -41,7 +41,7 @@ pub struct CastHooks<'a> {
 
 /// Which measures a run of `cfg` gathers on `scene`: the pair counts also for the radiosity measures
 /// when something emits. Checks the materials first when radiosity is asked for.
-fn gathered(scene: &Scene, cfg: &AnalysisConfig) -> Result<Wanted, MaterialError> {
+fn gathered(scene: &Scene, cfg: &RunSpec) -> Result<Wanted, MaterialError> {
     let lit = if cfg.measures.radiosity {
         PatchMaterials::of_scene(scene)?.any_emission()
     } else {
@@ -54,23 +54,23 @@ fn gathered(scene: &Scene, cfg: &AnalysisConfig) -> Result<Wanted, MaterialError
     })
 }
 
-/// The batch plan of a run of `cfg`: fixed by the line count, or full batches when a budget may end the
-/// run anywhere.
-pub fn plan_of(cfg: &AnalysisConfig) -> BatchPlan {
-    if cfg.budget.is_open_ended() {
-        BatchPlan::open_ended(cfg.lines, cfg.source)
-    } else {
-        BatchPlan::for_source(cfg.lines, cfg.source)
-    }
-}
-
 /// The empty state of a run of `cfg` on `scene`, checked before any line is cast (the materials, when
 /// radiosity is asked for).
-pub fn start(scene: &Scene, cfg: &AnalysisConfig) -> Result<RunState, MaterialError> {
-    let plan = plan_of(cfg);
-    // A short fixed run has fewer batches than groups: one group per batch then.
-    let groups = (cfg.groups.max(2) as u64).min(plan.batches().max(2)) as usize;
-    Ok(RunState::new(plan, groups, gathered(scene, cfg)?))
+pub fn start(scene: &Scene, cfg: &RunSpec) -> Result<RunState, MaterialError> {
+    Ok(RunState::new(
+        cfg.plan(),
+        cfg.group_count(),
+        gathered(scene, cfg)?,
+    ))
+}
+
+/// Shard `index` (from 1) of `count`: a contiguous block of about 1/count of a run's batches.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub struct Shard {
+    /// Which shard, 1 to `count`.
+    pub index: u32,
+    /// How many shards.
+    pub count: u32,
 }
 
 /// The batches a run casts: all of them, or one shard's share.
@@ -78,21 +78,21 @@ pub fn start(scene: &Scene, cfg: &AnalysisConfig) -> Result<RunState, MaterialEr
 pub enum Scope {
     /// Every batch of the plan.
     All,
-    /// Shard `index` (from 1) of `count`: a contiguous block of about 1/count of the batches.
-    Shard {
-        /// Which shard, 1 to `count`.
-        index: u32,
-        /// How many shards.
-        count: u32,
-    },
+    /// One shard's batches.
+    Shard(Shard),
 }
 
 impl Scope {
+    /// The scope of a run that is `shard`, or all of it.
+    pub fn of(shard: Option<Shard>) -> Self {
+        shard.map_or(Scope::All, Scope::Shard)
+    }
+
     /// The batches of a plan of `batches` batches in this scope.
     pub fn batches(self, batches: u64) -> std::ops::Range<u64> {
         match self {
             Scope::All => 0..batches,
-            Scope::Shard { index, count } => {
+            Scope::Shard(Shard { index, count }) => {
                 let (k, m) = (u64::from(index.max(1) - 1), u64::from(count.max(1)));
                 (k * batches / m)..((k + 1) * batches / m)
             }
@@ -137,7 +137,7 @@ pub fn remaining_lines(state: &RunState, scope: Scope) -> u64 {
 pub fn cast(
     scene: &Scene,
     tracer: &dyn Tracer,
-    cfg: &AnalysisConfig,
+    cfg: &RunSpec,
     state: &mut RunState,
     options: CastOptions,
     control: &RunControl,

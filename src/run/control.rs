@@ -6,7 +6,7 @@ use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use crate::measure::Measure;
 
 /// Limits that end a run before its line count.
-#[derive(Clone, Copy, Debug, Default)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Budget {
     /// Stop when this much wall-clock time is spent.
     pub seconds: Option<f64>,
@@ -22,7 +22,7 @@ impl Budget {
 }
 
 /// A precision target: run until `measure`'s standard error is at most `stderr`.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Target {
     /// The measure watched (one of [`Measure::targets`]).
     pub measure: Measure,

@@ -10,7 +10,8 @@ use crate::measure::Estimate;
 /// How the standard errors of the measures built from pair counts (H_s, I_s, H(X, Y), E(MSE), the
 /// corrected values, the accuracies and the radiosity measures) are estimated. I_s^c, a mean, always
 /// gets batch means, which are exact for it.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
 pub enum ErrorMethod {
     /// Batch means: the spread of the G groups' own values / sqrt(G). Cheap, and conservative where the
     /// form-factor rows are undersampled (each group has 1/G of the lines).

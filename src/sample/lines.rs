@@ -145,7 +145,8 @@ impl DiscPoints {
 /// measure), so every estimate stays unbiased; bundles make the lines of one bundle correlated, which the
 /// standard errors see because a batch always holds whole bundles (see [`LineSource::lines_per_unit`]) and
 /// the standard-error groups are made of whole batches.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
 pub enum LineSource {
     /// Every line drawn on its own ([`global_line`]).
     #[default]

@@ -8,8 +8,8 @@ use scene_complexity::measure::Measure;
 use scene_complexity::scenes;
 
 use scene_complexity::analysis::{analyze, Analysis};
-use scene_complexity::run::{AnalysisConfig, RunControl};
 use scene_complexity::run::{BatchPlan, Measures};
+use scene_complexity::run::{RunControl, RunSpec};
 use scene_complexity::sample::lines::LineSource;
 use scene_complexity::scene::Scene;
 use scene_complexity::trace::{make_tracer, Backend, LineHits, Query, Tracer};
@@ -22,10 +22,10 @@ fn rust_tracer(scene: &Scene) -> Box<dyn Tracer> {
 }
 
 fn run(scene: &Scene, tracer: &dyn Tracer, lines: u64, seed: u64, grid: u32) -> Analysis {
-    let cfg = AnalysisConfig {
+    let cfg = RunSpec {
         measures: ALL,
         source: LineSource::bundles(grid).unwrap(),
-        ..AnalysisConfig::new(lines, seed)
+        ..RunSpec::new(lines, seed)
     };
     analyze(scene, tracer, &cfg, &RunControl::default()).unwrap()
 }

@@ -92,9 +92,9 @@ fn the_public_cornell_boxes_give_finite_measures() {
             scene_complexity::Query::Single,
         )
         .unwrap();
-        let cfg = scene_complexity::AnalysisConfig {
+        let cfg = scene_complexity::RunSpec {
             enclose: true,
-            ..scene_complexity::AnalysisConfig::new(100_000, 1)
+            ..scene_complexity::RunSpec::new(100_000, 1)
         };
         let a =
             scene_complexity::analyze(&scene, tracer.as_ref(), &cfg, &Default::default()).unwrap();

@@ -7,7 +7,7 @@ use scene_complexity::scenes;
 
 use scene_complexity::analysis::{analyze, Analysis};
 use scene_complexity::measure::Estimate;
-use scene_complexity::run::{AnalysisConfig, RunControl};
+use scene_complexity::run::{RunControl, RunSpec};
 use scene_complexity::scene::Scene;
 use scene_complexity::trace::Tracer;
 use support::{all_tracers, cube_exact_measures};
@@ -20,7 +20,7 @@ fn run(scene: &Scene, tracer: &dyn Tracer, lines: u64, seed: u64) -> Analysis {
     analyze(
         scene,
         tracer,
-        &AnalysisConfig::new(lines, seed),
+        &RunSpec::new(lines, seed),
         &RunControl::default(),
     )
     .unwrap()

@@ -7,7 +7,7 @@
 use scene_complexity::analysis::{analyze, Analysis, RadiosityOutcome};
 use scene_complexity::geom::DVec3;
 use scene_complexity::measure::Measure;
-use scene_complexity::run::{AnalysisConfig, Measures, RunControl};
+use scene_complexity::run::{Measures, RunControl, RunSpec};
 use scene_complexity::scene::Scene;
 use scene_complexity::scenes;
 use scene_complexity::scenes::cube_clusters::{fig2_corners, Fig2Placement};
@@ -19,14 +19,14 @@ use scene_complexity::trace::{make_tracer, Backend, Query};
 fn run(spec: &str, lines: u64, discrete: bool) -> Analysis {
     let scene = scenes::load(spec).unwrap();
     let tracer = make_tracer(Backend::Rust, &scene, Query::Single).unwrap();
-    let cfg = AnalysisConfig {
+    let cfg = RunSpec {
         measures: Measures {
             discrete,
             continuous: true,
             radiosity: false,
         },
         groups: 2,
-        ..AnalysisConfig::new(lines, 7)
+        ..RunSpec::new(lines, 7)
     };
     let a = analyze(&scene, tracer.as_ref(), &cfg, &RunControl::default()).unwrap();
     assert_eq!(a.escapes, 0, "{spec}: a closed scene");
@@ -231,7 +231,7 @@ fn labyrinth_radiosity_measures_equal_visibility_measures() {
         );
     }
     let tracer = make_tracer(Backend::Rust, &s, Query::Single).unwrap();
-    let cfg = AnalysisConfig::new(100_000, 3);
+    let cfg = RunSpec::new(100_000, 3);
     let a = analyze(&s, tracer.as_ref(), &cfg, &RunControl::default()).unwrap();
     let r = a.radiosity.clone();
     let RadiosityOutcome::Computed(_) = r else {

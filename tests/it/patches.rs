@@ -5,7 +5,7 @@ use scene_complexity::analysis::{analyze, Analysis};
 use scene_complexity::measure::patches::information_loss;
 use scene_complexity::measure::{Measure, PatchMeasure};
 use scene_complexity::refine::oracle;
-use scene_complexity::run::{AnalysisConfig, RunControl};
+use scene_complexity::run::{RunControl, RunSpec};
 use scene_complexity::scenes;
 use scene_complexity::trace::{make_tracer, Backend, Query};
 use scene_complexity::EntropyEstimator;
@@ -17,10 +17,10 @@ fn run_with_patches(
 ) -> (scene_complexity::Scene, Analysis) {
     let scene = scenes::load(spec).unwrap();
     let tracer = make_tracer(Backend::Rust, &scene, Query::Single).unwrap();
-    let cfg = AnalysisConfig {
+    let cfg = RunSpec {
         per_patch: true,
         estimator,
-        ..AnalysisConfig::new(lines, 7)
+        ..RunSpec::new(lines, 7)
     };
     let a = analyze(&scene, tracer.as_ref(), &cfg, &RunControl::default()).unwrap();
     (scene, a)
@@ -149,7 +149,7 @@ fn refines_information_scores_are_the_tables_lost_information() {
     let (lines, seed) = (300_000, 7);
     for spec in ["@cube:4", "@cornell:2"] {
         let (scene, a) = run_with_patches(spec, lines, EntropyEstimator::PlugIn);
-        assert_eq!(a.seed, seed);
+        assert_eq!(a.spec.seed, seed);
         let tracer = make_tracer(Backend::Rust, &scene, Query::Single).unwrap();
         let sample = oracle::sample_pairs(&scene, tracer.as_ref(), lines, seed).unwrap();
         let areas: Vec<f64> = scene.patches.iter().map(|p| p.area).collect();
@@ -175,9 +175,9 @@ fn refines_information_scores_are_the_tables_lost_information() {
 fn per_patch_results_do_not_depend_on_the_threads() {
     let scene = scenes::load("@cube:30").unwrap();
     let tracer = make_tracer(Backend::Rust, &scene, Query::Single).unwrap();
-    let cfg = AnalysisConfig {
+    let cfg = RunSpec {
         per_patch: true,
-        ..AnalysisConfig::new(60_000, 3)
+        ..RunSpec::new(60_000, 3)
     };
     let run = |threads: usize| {
         let pool = rayon::ThreadPoolBuilder::new()

@@ -12,13 +12,13 @@ use scene_complexity::measure::radiosity::{
     for_each_transition, solve, transformed_areas, FormFactors, PatchMaterials, SolveOptions,
 };
 use scene_complexity::refine::{oracle, refine, RefineConfig, Strategy};
-use scene_complexity::run::{AnalysisConfig, RunControl};
+use scene_complexity::run::{RunControl, RunSpec};
 use scene_complexity::scene::{self, Material, Scene};
 use scene_complexity::trace::{make_tracer, Backend, Query, Tracer};
 use support::*;
 
-fn config(lines: u64, seed: u64) -> AnalysisConfig {
-    AnalysisConfig::new(lines, seed)
+fn config(lines: u64, seed: u64) -> RunSpec {
+    RunSpec::new(lines, seed)
 }
 
 fn rust_tracer(scene: &Scene) -> Box<dyn Tracer> {

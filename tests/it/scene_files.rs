@@ -9,8 +9,7 @@ use scene_complexity::analysis::RunWarningKind;
 use scene_complexity::scene::{ObjectSet, Planarity, SceneOptions};
 use scene_complexity::scenes::load_with;
 use scene_complexity::{
-    analyze, load, make_tracer, Analysis, AnalysisConfig, Backend, Measures, Query, RunControl,
-    Scene,
+    analyze, load, make_tracer, Analysis, Backend, Measures, Query, RunControl, RunSpec, Scene,
 };
 
 use crate::support::room_with_box_obj;
@@ -27,9 +26,9 @@ fn load_file(path: &Path, options: &SceneOptions) -> Scene {
 
 fn run(scene: &Scene, lines: u64, seed: u64, measures: Measures) -> Analysis {
     let tracer = make_tracer(Backend::Rust, scene, Query::Single).unwrap();
-    let cfg = AnalysisConfig {
+    let cfg = RunSpec {
         measures,
-        ..AnalysisConfig::new(lines, seed)
+        ..RunSpec::new(lines, seed)
     };
     analyze(scene, tracer.as_ref(), &cfg, &RunControl::default()).unwrap()
 }

@@ -15,7 +15,7 @@ use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
 use scene_complexity::analysis::{analyze, Analysis};
 use scene_complexity::measure::channel::row_totals;
-use scene_complexity::run::{AnalysisConfig, RunControl};
+use scene_complexity::run::{RunControl, RunSpec};
 use scene_complexity::sample::pairs::{segments, Segment};
 use scene_complexity::scene::{Material, Scene, SceneBuilder};
 use scene_complexity::trace::{make_tracer, Backend, Line, LineHits, Query, Tracer};
@@ -32,7 +32,7 @@ fn run(scene: &Scene, lines: u64, seed: u64) -> Analysis {
     analyze(
         scene,
         tracer(scene).as_ref(),
-        &AnalysisConfig::new(lines, seed),
+        &RunSpec::new(lines, seed),
         &RunControl::default(),
     )
     .expect("analysis runs")
@@ -1097,9 +1097,9 @@ const OPEN_BOX: &str = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nv 0 0 1\nv 1 0 1\nv 
 #[test]
 fn enclose_closes_open_scenes_consistently() {
     let lines = 200_000;
-    let cfg = AnalysisConfig {
+    let cfg = RunSpec {
         enclose: true,
-        ..AnalysisConfig::new(lines, 19)
+        ..RunSpec::new(lines, 19)
     };
     let r2 = 0.75;
     let sphere = 4.0 * PI * r2;

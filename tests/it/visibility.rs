@@ -8,7 +8,7 @@ use scene_complexity::scenes;
 use scene_complexity::analysis::{analyze, Analysis};
 use scene_complexity::measure::channel::{for_each_form_factor, row_totals};
 use scene_complexity::run::Measures;
-use scene_complexity::run::{AnalysisConfig, RunControl};
+use scene_complexity::run::{RunControl, RunSpec};
 use scene_complexity::scene::Scene;
 use scene_complexity::trace::Tracer;
 use support::*;
@@ -16,9 +16,9 @@ use support::*;
 const ALL: Measures = Measures::VISIBILITY;
 
 fn run(scene: &Scene, tracer: &dyn Tracer, lines: u64, seed: u64) -> Analysis {
-    let cfg = AnalysisConfig {
+    let cfg = RunSpec {
         measures: ALL,
-        ..AnalysisConfig::new(lines, seed)
+        ..RunSpec::new(lines, seed)
     };
     analyze(scene, tracer, &cfg, &RunControl::default()).expect("analysis runs")
 }
