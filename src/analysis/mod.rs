@@ -7,7 +7,7 @@
 //! ([`crate::run::Spread`]).
 
 mod orientation;
-pub mod patches;
+pub mod patch_results;
 pub mod radiosity;
 pub mod reliability;
 mod values;
@@ -15,12 +15,12 @@ pub mod warnings;
 
 use std::time::Instant;
 
-pub use patches::{PatchEstimate, PatchLight};
+pub use patch_results::{PatchLight, PatchResult};
 pub use radiosity::{RadiosityOutcome, RadiositySolve, SolveFailure, NOTHING_EMITS};
 pub use reliability::{Reliability, SamplingReport, Verdict};
 pub use warnings::{RunWarning, RunWarningKind};
 
-use patches as per_patch;
+use patch_results as per_patch;
 use values::visibility_estimates;
 
 use crate::measure::estimators::EntropyEstimator;
@@ -111,7 +111,7 @@ pub struct Analysis {
     pub tally: Tally,
     /// Each patch's results, with standard errors, when [`RunSpec::per_patch`] asked for them
     /// (`None` as well for an enclosed open scene).
-    pub patches: Option<Vec<PatchEstimate>>,
+    pub patches: Option<Vec<PatchResult>>,
 }
 
 impl Analysis {

@@ -16,7 +16,7 @@ use scene_complexity::trace::Query;
 
 use super::args::{parse_count, parse_positive, target_measure_parser, ReportOutput, RunOptions};
 use super::output::{self, warn};
-use super::patches::PatchFiles;
+use super::patch_files::PatchFiles;
 use super::report::{self, Format};
 use super::runner::Runner;
 use super::{Exit, Failure};

@@ -10,7 +10,7 @@ use scene_complexity::run::{RunSpec, RunState, SavedRun, StopReason};
 use super::analyze::{check_same_scene, persist_failure};
 use super::args::{ReportOutput, Threads};
 use super::output::{self, check_all, warn};
-use super::patches::PatchFiles;
+use super::patch_files::PatchFiles;
 use super::report::Format;
 use super::runner::Runner;
 use super::{report, Exit, Failure};

@@ -9,7 +9,7 @@ mod export;
 mod input;
 mod merge;
 mod output;
-mod patches;
+mod patch_files;
 mod plot;
 mod progress;
 mod refine;

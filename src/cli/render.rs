@@ -288,7 +288,7 @@ fn tracer_failure(e: impl ToString) -> Failure {
 /// Each patch's value of the quantity, divided by its area fraction when `per_area`.
 fn patch_values(
     scene: &Scene,
-    patches: &[scene_complexity::analysis::PatchEstimate],
+    patches: &[scene_complexity::analysis::PatchResult],
     quantity: Quantity,
     per_area: bool,
 ) -> Vec<Option<f64>> {

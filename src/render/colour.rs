@@ -1,7 +1,7 @@
 //! What a picture colours its patches by, and how: a per-patch quantity of the run mapped through
 //! viridis (perceptually uniform, readable with the common colour-vision deficiencies and in grey).
 
-use crate::analysis::PatchEstimate;
+use crate::analysis::PatchResult;
 use crate::measure::{PatchMeasure, Unit};
 
 /// A per-patch quantity a picture can show: one of the per-patch catalogue ([`PatchMeasure`]), or the
@@ -72,7 +72,7 @@ impl Quantity {
     }
 
     /// The patch's value; `None` when the run has none (an unsampled patch, no light, no I_s^c).
-    pub fn of(self, p: &PatchEstimate) -> Option<f64> {
+    pub fn of(self, p: &PatchResult) -> Option<f64> {
         match self {
             Quantity::Segments => Some(p.segments as f64),
             Quantity::Patch(_) if !p.sampled() => None,

@@ -26,7 +26,7 @@ use super::spec::{RunSpec, SpecDifference};
 use super::state::RunState;
 use crate::sample::counts::{pair_key, split_key, PairCounts};
 use crate::sample::exact::ExactSum;
-use crate::sample::patch_sums::PatchKernelSums;
+use crate::sample::kernel_sums::PatchKernelSums;
 use crate::sample::tally::{Counters, ObjectSides, Tally, Wanted};
 use crate::scene::{Scene, SceneOptions};
 use crate::trace::{Backend, Query};

@@ -2,7 +2,7 @@
 //! the radiosity columns solve eq. (2). (`cli_patches` checks the files `scx analyze` writes.)
 
 use scene_complexity::analysis::{analyze, Analysis};
-use scene_complexity::measure::patches::information_loss;
+use scene_complexity::measure::shares::information_loss;
 use scene_complexity::measure::{Measure, PatchMeasure};
 use scene_complexity::refine::oracle;
 use scene_complexity::run::{RunControl, RunSpec};

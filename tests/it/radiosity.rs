@@ -7,10 +7,10 @@ use scene_complexity::measure::Measure;
 use scene_complexity::scenes;
 
 use scene_complexity::analysis::{analyze, RadiosityOutcome};
-use scene_complexity::measure::patches::information_loss;
 use scene_complexity::measure::radiosity::{
     for_each_transition, solve, transformed_areas, FormFactors, PatchMaterials, SolveOptions,
 };
+use scene_complexity::measure::shares::information_loss;
 use scene_complexity::refine::{oracle, refine, RefineConfig, Strategy};
 use scene_complexity::run::{RunControl, RunSpec};
 use scene_complexity::scene::{self, Material, Scene};

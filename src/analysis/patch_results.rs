@@ -1,4 +1,4 @@
-//! The per-patch results of a run ([`crate::measure::patches`]), each with its standard error.
+//! The per-patch results of a run ([`crate::measure::shares`]), each with its standard error.
 //!
 //! Every group of lines gets its own per-patch terms (and, when the scene emits, its own radiosity
 //! solution), and each full-run value gets the batch-means standard error of the group values, as the
@@ -8,8 +8,8 @@
 use rayon::prelude::*;
 
 use crate::measure::estimators::EntropyEstimator;
-use crate::measure::patches::{patch_values, ContinuousSums, PatchValues};
 use crate::measure::radiosity::{self, FormFactors, PatchMaterials, SolveOptions};
+use crate::measure::shares::{patch_values, ContinuousSums, PatchValues};
 use crate::measure::{Estimate, PatchMeasure};
 use crate::run::FinishedRun;
 use crate::sample::tally::Tally;
@@ -19,7 +19,7 @@ use crate::scene::Scene;
 /// quantity of the catalogue ([`PatchMeasure`]), its value with a standard error. Bits for the entropies
 /// and terms; the radiosities in the units of the scene's emissions.
 #[derive(Clone, Debug, PartialEq)]
-pub struct PatchEstimate {
+pub struct PatchResult {
     /// `N_i`: segments leaving the patch's front side (to patches, or escaping).
     pub segments: u64,
     /// Of them, the escapes.
@@ -28,7 +28,7 @@ pub struct PatchEstimate {
     values: [Option<Estimate>; PatchMeasure::COUNT],
 }
 
-impl PatchEstimate {
+impl PatchResult {
     /// Whether any segment left the patch (an unsampled patch's terms are 0 and say nothing).
     pub fn sampled(&self) -> bool {
         self.segments > 0
@@ -61,7 +61,7 @@ pub(crate) fn estimates(
     run: &FinishedRun,
     estimator: EntropyEstimator,
     light: Option<PatchLight<'_>>,
-) -> Option<Vec<PatchEstimate>> {
+) -> Option<Vec<PatchResult>> {
     let of = |t: &Tally| of_tally(scene, t, estimator, light);
     let (all, groups): (Option<TallyPatches>, Vec<Option<TallyPatches>>) = rayon::join(
         || of(&run.total),
@@ -99,7 +99,7 @@ fn of_tally(
 }
 
 /// Patch `i`'s values from all the lines, with the batch-means standard errors of the groups'.
-fn patch_estimate(i: usize, all: &TallyPatches, groups: &[TallyPatches]) -> PatchEstimate {
+fn patch_estimate(i: usize, all: &TallyPatches, groups: &[TallyPatches]) -> PatchResult {
     let est = |f: &dyn Fn(&TallyPatches) -> Option<f64>| -> Option<Estimate> {
         let value = f(all)?;
         let per_group: Option<Vec<f64>> = groups.iter().map(f).collect();
@@ -137,7 +137,7 @@ fn patch_estimate(i: usize, all: &TallyPatches, groups: &[TallyPatches]) -> Patc
             PatchMeasure::IncomingRadiosity => Some(t.light.as_ref()?.1[i]),
         }
     };
-    PatchEstimate {
+    PatchResult {
         segments: all.values.segments[i],
         escapes: all.values.escapes[i],
         values: PatchMeasure::ALL.map(|q| est(&|t| value(q, t))),

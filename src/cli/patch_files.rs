@@ -13,7 +13,7 @@ use std::path::{Path, PathBuf};
 
 use rayon::prelude::*;
 
-use scene_complexity::analysis::{Analysis, PatchEstimate};
+use scene_complexity::analysis::{Analysis, PatchResult};
 use scene_complexity::geom::Point;
 use scene_complexity::measure::PatchMeasure;
 use scene_complexity::run::RunIdentity;
@@ -338,7 +338,7 @@ fn centroid(scene: &Scene, patch: usize) -> Point {
     }
 }
 
-fn patches_csv(w: &mut dyn Write, scene: &Scene, patches: &[PatchEstimate]) -> std::io::Result<()> {
+fn patches_csv(w: &mut dyn Write, scene: &Scene, patches: &[PatchResult]) -> std::io::Result<()> {
     let mut out = csv::Writer::from_writer(w);
     let mut header: Vec<String> = [
         "id",
