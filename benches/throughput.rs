@@ -1,5 +1,5 @@
-//! A throughput table for notes and the README: million lines per second of the all-hits kernel (canonical
-//! hits of lines drawn beforehand), of first-hit queries, of drawing the lines and tracing them (what an
+//! A throughput table for notes and docs/performance.md: million lines per second of the all-hits kernel
+//! (canonical hits of lines drawn beforehand), of first-hit queries, of drawing the lines and tracing them (what an
 //! analysis does before pairing and counting), and of the whole analysis on the same lines, per tracer
 //! (Embree single lines and native packets, the pure-Rust BVH) and thread count. Best of three runs (the
 //! machine is shared). Then the analysis's share of the kernel's rate, against the kernel alone and
