@@ -15,11 +15,11 @@ use scene_complexity::sample::lines::LineSource;
 use scene_complexity::trace::Query;
 
 use super::args::{parse_count, parse_positive, target_measure_parser, ReportOutput, RunOptions};
+use super::exit::{Exit, Failure};
 use super::output::{self, warn};
 use super::patch_files::PatchFiles;
 use super::report::{self, Format};
 use super::runner::Runner;
-use super::{Exit, Failure};
 
 /// Arguments of `scx analyze`.
 #[derive(clap::Args, Debug)]
@@ -147,7 +147,7 @@ fn parse_bundle(s: &str) -> Result<u32, String> {
         .trim()
         .parse()
         .map_err(|_| format!("`{s}` is not a whole number"))?;
-    LineSource::bundles(g).map(|_| g)
+    LineSource::bundles(g).map(|_| g).map_err(|e| e.to_string())
 }
 
 /// The spec of a new run from the arguments: the command line, parsed once.

@@ -11,12 +11,12 @@ use scene_complexity::run::StopReason;
 use serde_json::json;
 
 use super::args::{parse_count, ReportOutput, RunOptions};
+use super::exit::{Exit, Failure};
 use super::output::{self, check_all, note};
 use super::plot::{self, Curve, Series};
 use super::report;
 use super::runner::Runner;
 use super::table::{fixed, Align, Table};
-use super::{Exit, Failure};
 
 /// Arguments of `scx convergence`.
 #[derive(clap::Args, Debug)]

@@ -6,10 +6,10 @@ use scene_complexity::trace::{make_tracer, Backend, Query};
 
 use super::args::SceneArgs;
 use super::args::{parse_count, ReportOutput, Seed, Threads};
+use super::exit::{Exit, Failure};
 use super::input::load_scene;
 use super::output::{self, check_all};
 use super::runner::thread_pool;
-use super::{Exit, Failure};
 
 /// Arguments of `scx crosscheck`.
 #[derive(clap::Args, Debug)]

@@ -5,9 +5,9 @@ use std::path::PathBuf;
 use scene_complexity::scene::{gltf, obj};
 
 use super::args::SceneArgs;
+use super::exit::{Exit, Failure};
 use super::input::load_scene;
 use super::output::{self, check_all};
-use super::{Exit, Failure};
 
 /// Arguments of `scx export`.
 #[derive(clap::Args, Debug)]

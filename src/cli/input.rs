@@ -6,8 +6,8 @@ use std::path::Path;
 use scene_complexity::scene::{obj, Scene, SceneOptions};
 use scene_complexity::scenes;
 
+use super::exit::{Exit, Failure};
 use super::output::warn;
-use super::{Exit, Failure};
 
 /// Loads the scene a command names, read as `options` ask, printing its loading warnings; bad input is
 /// exit code 2.

@@ -9,11 +9,12 @@ use scene_complexity::run::{RunSpec, RunState, SavedRun, StopReason};
 
 use super::analyze::{check_same_scene, persist_failure};
 use super::args::{ReportOutput, Threads};
+use super::exit::{Exit, Failure};
 use super::output::{self, check_all, warn};
 use super::patch_files::PatchFiles;
+use super::report;
 use super::report::Format;
 use super::runner::Runner;
-use super::{report, Exit, Failure};
 
 /// Arguments of `scx merge`.
 #[derive(clap::Args, Debug)]

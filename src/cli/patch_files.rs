@@ -21,8 +21,8 @@ use scene_complexity::sample::counts::PairCounts;
 use scene_complexity::sample::tally::Wanted;
 use scene_complexity::scene::Scene;
 
+use super::exit::Failure;
 use super::output::{self, io_failure, warn, wrote};
-use super::Failure;
 
 /// The per-patch files of `scx analyze` and `scx merge`.
 #[derive(clap::Args, Debug)]

@@ -12,10 +12,10 @@ use std::sync::Arc;
 
 use super::args::SceneArgs;
 use super::args::{parse_count, parse_positive, Seed, Threads, Tracer, TracerArg};
+use super::exit::{Exit, Failure};
 use super::input::load_scene;
 use super::output::{self, check_all, note};
 use super::runner::{thread_pool, watch_ctrl_c};
-use super::{Exit, Failure};
 
 /// Arguments of `scx refine`.
 #[derive(clap::Args, Debug)]

@@ -15,10 +15,10 @@ use scene_complexity::run::{Measures, RunSpec, StopReason};
 use scene_complexity::scene::Scene;
 
 use super::args::{parse_count, RunOptions};
+use super::exit::{Exit, Failure};
 use super::output::{self, io_failure, warn};
 use super::plot::{font_path, register_font};
 use super::runner::Runner;
-use super::{Exit, Failure};
 
 /// Arguments of `scx render`.
 #[derive(clap::Args, Debug)]

@@ -7,9 +7,9 @@ use scene_complexity::reproduce::{reproduce, LinePlan, ReproduceConfig, TableRep
 use scene_complexity::trace::Backend;
 
 use super::args::{ReportOutput, Seed, Threads, Tracer, TracerArg};
+use super::exit::{Exit, Failure};
 use super::output::{self, check_all};
 use super::runner::thread_pool;
-use super::{Exit, Failure};
 
 /// Arguments of `scx reproduce`.
 #[derive(clap::Args, Debug)]

@@ -8,8 +8,9 @@ use scene_complexity::scene::{Scene, SceneOptions};
 use scene_complexity::trace::{make_tracer, Tracer};
 
 use super::args::RunOptions;
+use super::exit::{Exit, Failure};
 use super::input::load_scene;
-use super::{progress, report, Exit, Failure};
+use super::{progress, report};
 
 /// A scene with its tracer and thread pool, ready to run analyses.
 pub struct Runner {

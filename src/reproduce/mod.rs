@@ -63,9 +63,22 @@ pub enum LinePlan {
     Fixed(u64),
 }
 
+/// A `--lines` of `scx reproduce` that is not one ([`LinePlan::parse`]).
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum LinePlanError {
+    /// A factor out of range.
+    #[error("`{0}`: a factor must be a number above 0 and at most 1e6, as in x0.1")]
+    Factor(String),
+    /// Neither a name, a factor nor a count.
+    #[error(
+        "`{0}`: expected default, paper, a factor such as x0.1, or a whole line count such as 1e6"
+    )]
+    Unknown(String),
+}
+
 impl LinePlan {
     /// Reads `default`, `paper`, `xF` (a factor on the defaults, `x0.1`) or a count (`1e6`).
-    pub fn parse(s: &str) -> Result<Self, String> {
+    pub fn parse(s: &str) -> Result<Self, LinePlanError> {
         let s = s.trim();
         let positive = |v: f64| v.is_finite() && v > 0.0;
         match s {
@@ -73,15 +86,13 @@ impl LinePlan {
             "paper" => Ok(LinePlan::Paper),
             _ if s.starts_with('x') => match s[1..].parse::<f64>() {
                 Ok(f) if positive(f) && f <= 1e6 => Ok(LinePlan::Scale(f)),
-                _ => Err(format!("`{s}`: a factor must be a number above 0 and at most 1e6, as in x0.1")),
+                _ => Err(LinePlanError::Factor(s.into())),
             },
             _ => match s.parse::<f64>() {
                 Ok(n) if (1.0..=1e15).contains(&n) && n.fract() == 0.0 => {
                     Ok(LinePlan::Fixed(n as u64))
                 }
-                _ => Err(format!(
-                    "`{s}`: expected default, paper, a factor such as x0.1, or a whole line count such as 1e6"
-                )),
+                _ => Err(LinePlanError::Unknown(s.into())),
             },
         }
     }

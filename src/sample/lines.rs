@@ -158,19 +158,28 @@ pub enum LineSource {
     },
 }
 
+/// A bundle grid beyond [`MAX_BUNDLE_GRID`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, thiserror::Error)]
+#[error(
+    "a bundle grid of {grid} x {grid} lines: need 0 (independent lines) to {}",
+    MAX_BUNDLE_GRID
+)]
+pub struct BundleError {
+    /// The grid asked for.
+    pub grid: u32,
+}
+
 /// The largest bundle grid: 64 x 64 = 4096 lines, the largest batch.
 pub const MAX_BUNDLE_GRID: u32 = 64;
 
 impl LineSource {
     /// Bundles of `grid x grid` lines, or independent lines for `grid == 0`; errors beyond
     /// [`MAX_BUNDLE_GRID`].
-    pub fn bundles(grid: u32) -> Result<Self, String> {
+    pub fn bundles(grid: u32) -> Result<Self, BundleError> {
         match grid {
             0 => Ok(LineSource::Independent),
             1..=MAX_BUNDLE_GRID => Ok(LineSource::Bundles { grid }),
-            _ => Err(format!(
-                "a bundle grid of {grid} x {grid} lines: need 0 (independent lines) to {MAX_BUNDLE_GRID}"
-            )),
+            _ => Err(BundleError { grid }),
         }
     }
 
