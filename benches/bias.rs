@@ -6,13 +6,13 @@
 #[path = "../tests/it/support.rs"]
 mod support;
 
-use scene_complexity::analysis::analyze;
-use scene_complexity::measure::bias::corrected;
-use scene_complexity::measure::estimators::EntropyEstimator;
-use scene_complexity::run::Measures;
-use scene_complexity::run::{RunControl, RunSpec};
-use scene_complexity::scenes;
-use scene_complexity::trace::{make_tracer, Backend, Query};
+use scene_complexity::internals::analysis::analyze;
+use scene_complexity::internals::measure::bias::corrected;
+use scene_complexity::internals::measure::estimators::EntropyEstimator;
+use scene_complexity::internals::run::Measures;
+use scene_complexity::internals::run::{RunControl, RunSpec};
+use scene_complexity::internals::scenes;
+use scene_complexity::internals::trace::{make_tracer, Backend, Query};
 
 fn list(arg: Option<&String>, default: &str) -> Vec<f64> {
     arg.map_or(default, |s| s.as_str())

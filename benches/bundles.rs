@@ -14,16 +14,16 @@
 
 mod common;
 
-use scene_complexity::measure::Measure;
-use scene_complexity::scenes;
+use scene_complexity::internals::measure::Measure;
+use scene_complexity::internals::scenes;
 use std::time::Instant;
 
-use scene_complexity::analysis::analyze;
-use scene_complexity::measure::Estimate;
-use scene_complexity::run::{RunControl, RunSpec};
-use scene_complexity::sample::lines::LineSource;
-use scene_complexity::scene::Scene;
-use scene_complexity::trace::{make_tracer, Backend, Query, Tracer};
+use scene_complexity::internals::analysis::analyze;
+use scene_complexity::internals::measure::Estimate;
+use scene_complexity::internals::run::{RunControl, RunSpec};
+use scene_complexity::internals::sample::lines::LineSource;
+use scene_complexity::internals::scene::Scene;
+use scene_complexity::internals::trace::{make_tracer, Backend, Query, Tracer};
 
 const SEEDS: u64 = 3;
 const GROUPS: usize = 64;
@@ -116,7 +116,7 @@ fn measure(scene: &Scene, tracer: &dyn Tracer, lines: u64, grid: u32) -> Row {
         row.wall += w0.elapsed().as_secs_f64();
         row.cpu += common::cpu_seconds() - c0;
         row.lines += a.lines as f64;
-        let se = |e: Option<scene_complexity::measure::Estimate>| {
+        let se = |e: Option<scene_complexity::internals::measure::Estimate>| {
             e.and_then(|e| e.stderr).unwrap_or(f64::NAN)
         };
         row.var_cmi += se(a.estimate(Measure::ContinuousMutualInformation)).powi(2) / SEEDS as f64;

@@ -11,15 +11,15 @@
 
 mod common;
 
-use scene_complexity::scenes;
+use scene_complexity::internals::scenes;
 use std::time::Instant;
 
 use rayon::prelude::*;
-use scene_complexity::analysis::analyze;
-use scene_complexity::run::{BatchPlan, Measures};
-use scene_complexity::run::{RunControl, RunSpec, DEFAULT_GROUPS};
-use scene_complexity::sample::lines::batch_lines;
-use scene_complexity::trace::{make_tracer, Backend, Line, LineHits, Query, Tracer};
+use scene_complexity::internals::analysis::analyze;
+use scene_complexity::internals::run::{BatchPlan, Measures};
+use scene_complexity::internals::run::{RunControl, RunSpec, DEFAULT_GROUPS};
+use scene_complexity::internals::sample::lines::batch_lines;
+use scene_complexity::internals::trace::{make_tracer, Backend, Line, LineHits, Query, Tracer};
 
 const CHUNK: usize = 4096;
 const REPEATS: usize = 3;

@@ -7,12 +7,12 @@
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
-use scene_complexity::measure::Measure;
-use scene_complexity::run::{RunSpec, RunControl};
-use scene_complexity::analysis::analyze;
-use scene_complexity::scene::{obj, Scene};
-use scene_complexity::scenes;
-use scene_complexity::trace::{make_tracer, Backend, Query};
+use scene_complexity::internals::measure::Measure;
+use scene_complexity::internals::run::{RunSpec, RunControl};
+use scene_complexity::internals::analysis::analyze;
+use scene_complexity::internals::scene::{obj, Scene};
+use scene_complexity::internals::scenes;
+use scene_complexity::internals::trace::{make_tracer, Backend, Query};
 
 fuzz_target!(|data: &[u8]| {
     let Ok(text) = std::str::from_utf8(data) else {

@@ -175,7 +175,7 @@ impl TargetOutcome {
 ///
 /// With radiosity asked for, the materials are checked before any line is cast; when nothing emits the
 /// radiosity measures are left out with the reason. Uses the current rayon thread pool; results do not
-/// depend on its size. [`start`], [`cast`] and [`finish`] are its three steps, for runs that are
+/// depend on its size. [`crate::run::start`], [`cast`] and [`finish`] are its three steps, for runs that are
 /// sharded, checkpointed or resumed.
 pub fn analyze(
     scene: &Scene,
@@ -203,7 +203,7 @@ pub fn analyze(
     )
 }
 
-/// Casts the batches of `options.scope` not done yet in `state` ([`crate::run::cast`]), stopping early
+/// Casts the batches of `options.scope` not done yet in `state` (the engine's `run::cast`), stopping early
 /// when the run's precision target is met; `after_round` sees the state after each round (to save a
 /// checkpoint).
 pub fn cast(

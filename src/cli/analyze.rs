@@ -4,15 +4,14 @@ use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use clap::ValueEnum;
-use scene_complexity::analysis::{cast, finish};
-use scene_complexity::measure::Measure;
-use scene_complexity::run::persist;
-use scene_complexity::run::{
+use scene_complexity::LineSource;
+use scene_complexity::Measure;
+use scene_complexity::Query;
+use scene_complexity::{cast, finish};
+use scene_complexity::{
     remaining_lines, start, Budget, CastOptions, Measures, PersistError, RunControl, RunIdentity,
     RunSpec, RunState, SceneRef, Scope, Shard, StopReason, Target,
 };
-use scene_complexity::sample::lines::LineSource;
-use scene_complexity::trace::Query;
 
 use super::args::{parse_count, parse_positive, target_measure_parser, ReportOutput, RunOptions};
 use super::exit::{Exit, Failure};
@@ -220,7 +219,7 @@ fn new_run(args: &AnalyzeArgs, name: &str) -> Result<Prepared, Failure> {
 /// A saved run to continue, to `--lines` when given, traced as `--tracer`/`--query` ask or else as it
 /// was.
 fn resumed_run(args: &AnalyzeArgs, file: &Path) -> Result<Prepared, Failure> {
-    let saved = persist::load(file).map_err(persist_failure)?;
+    let saved = scene_complexity::load_state(file).map_err(persist_failure)?;
     let mut identity = saved.identity;
     let name = args
         .scene
@@ -317,7 +316,7 @@ impl Checkpoints<'_> {
         if self.failed.is_some() || self.last.elapsed() < self.every {
             return;
         }
-        match persist::save(path, identity, state, self.seconds()) {
+        match scene_complexity::save_state(path, identity, state, self.seconds()) {
             Ok(()) => self.last = Instant::now(),
             Err(e) => {
                 self.failed = Some(persist_failure(e));
@@ -391,7 +390,7 @@ pub fn run(args: &AnalyzeArgs) -> Result<Exit, Failure> {
         return Err(f);
     }
     for path in [args.save.as_deref(), checkpoint].into_iter().flatten() {
-        persist::save(path, &identity, &state, seconds).map_err(persist_failure)?;
+        scene_complexity::save_state(path, &identity, &state, seconds).map_err(persist_failure)?;
         output::wrote(path);
     }
     // In the run's pool: the measures use the threads asked for, like the tracing.

@@ -4,13 +4,13 @@
 use std::path::PathBuf;
 
 use clap::ValueEnum;
-use scene_complexity::measure::estimators::EntropyEstimator;
-use scene_complexity::measure::Measure;
-use scene_complexity::run::{
+use scene_complexity::EntropyEstimator;
+use scene_complexity::Measure;
+use scene_complexity::{Backend, Query};
+use scene_complexity::{
     ErrorMethod, Measures, RunSpec, Tracing, DEFAULT_ESTIMATOR, DEFAULT_GROUPS,
 };
-use scene_complexity::scene::{ObjectSet, Planarity, SceneOptions, DEFAULT_PLANARITY};
-use scene_complexity::trace::{Backend, Query};
+use scene_complexity::{ObjectSet, Planarity, SceneOptions, DEFAULT_PLANARITY};
 
 /// How a scene file is read: non-planar polygons, and objects to flip or make two-sided.
 #[derive(clap::Args, Debug, Clone)]

@@ -108,7 +108,7 @@ pub struct ScenesArgs {
 
 /// Runs `scx scenes`.
 pub fn scenes(args: &ScenesArgs) -> Result<Exit, Failure> {
-    let list: String = scene_complexity::scenes::CATALOGUE
+    let list: String = scene_complexity::CATALOGUE
         .iter()
         .map(|b| format!("{:<18} {}\n", b.usage, b.description))
         .collect();

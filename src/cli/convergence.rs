@@ -5,9 +5,9 @@ use std::fmt::Write as _;
 use std::path::PathBuf;
 
 use clap::ValueEnum;
-use scene_complexity::analysis::Analysis;
-use scene_complexity::measure::{Estimate, Measure};
-use scene_complexity::run::StopReason;
+use scene_complexity::Analysis;
+use scene_complexity::StopReason;
+use scene_complexity::{Estimate, Measure};
 use serde_json::json;
 
 use super::args::{parse_count, ReportOutput, RunOptions};

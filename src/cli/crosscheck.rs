@@ -1,8 +1,8 @@
 //! `scx crosscheck`: Embree and the pure-Rust tracer on the same lines, hit for hit.
 
 use scene_complexity::crosscheck::{self, CrossCheckConfig, Tolerance};
-use scene_complexity::run::DEFAULT_GROUPS;
-use scene_complexity::trace::{make_tracer, Backend, Query};
+use scene_complexity::DEFAULT_GROUPS;
+use scene_complexity::{make_tracer, Backend, Query};
 
 use super::args::SceneArgs;
 use super::args::{parse_count, ReportOutput, Seed, Threads};

@@ -42,7 +42,7 @@ macro_rules! input_errors {
 }
 
 input_errors!(
-    scene_complexity::analysis::AnalysisError,
+    scene_complexity::AnalysisError,
     scene_complexity::refine::RefineError,
     scene_complexity::reproduce::ReproduceError
 );

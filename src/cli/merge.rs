@@ -3,9 +3,8 @@
 
 use std::path::PathBuf;
 
-use scene_complexity::analysis::finish;
-use scene_complexity::run::persist;
-use scene_complexity::run::{RunSpec, RunState, SavedRun, StopReason};
+use scene_complexity::finish;
+use scene_complexity::{RunSpec, RunState, SavedRun, StopReason};
 
 use super::analyze::{check_same_scene, persist_failure};
 use super::args::{ReportOutput, Threads};
@@ -59,7 +58,7 @@ fn merged(args: &MergeArgs) -> Result<Merged, Failure> {
     for path in &args.states {
         runs.push((
             path.display().to_string(),
-            persist::load(path).map_err(persist_failure)?,
+            scene_complexity::load_state(path).map_err(persist_failure)?,
         ));
     }
     seconds += runs.iter().map(|(_, r)| r.seconds).sum::<f64>();
@@ -159,7 +158,7 @@ pub fn run(args: &MergeArgs) -> Result<Exit, Failure> {
         ..identity.spec.clone()
     };
     if let Some(path) = &args.save {
-        persist::save(path, &identity, &state, seconds).map_err(persist_failure)?;
+        scene_complexity::save_state(path, &identity, &state, seconds).map_err(persist_failure)?;
         output::wrote(path);
     }
     let analysis = runner

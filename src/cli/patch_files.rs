@@ -13,13 +13,13 @@ use std::path::{Path, PathBuf};
 
 use rayon::prelude::*;
 
-use scene_complexity::analysis::{Analysis, PatchResult};
-use scene_complexity::geom::Point;
-use scene_complexity::measure::PatchMeasure;
-use scene_complexity::run::RunIdentity;
-use scene_complexity::sample::counts::PairCounts;
-use scene_complexity::sample::tally::Wanted;
-use scene_complexity::scene::Scene;
+use scene_complexity::PairCounts;
+use scene_complexity::PatchMeasure;
+use scene_complexity::Point;
+use scene_complexity::RunIdentity;
+use scene_complexity::Scene;
+use scene_complexity::Wanted;
+use scene_complexity::{Analysis, PatchResult};
 
 use super::exit::Failure;
 use super::output::{self, io_failure, warn, wrote};

@@ -3,11 +3,11 @@
 use std::path::PathBuf;
 
 use clap::ValueEnum;
-use scene_complexity::measure::radiosity::SolveOptions;
 use scene_complexity::refine::{refine, RefineConfig, RefineRound, Strategy};
-use scene_complexity::run::RunControl;
-use scene_complexity::scene::obj;
-use scene_complexity::trace::{make_tracer, Query};
+use scene_complexity::write_obj;
+use scene_complexity::RunControl;
+use scene_complexity::SolveOptions;
+use scene_complexity::{make_tracer, Query};
 use std::sync::Arc;
 
 use super::args::SceneArgs;
@@ -103,7 +103,7 @@ pub fn run(args: &RefineArgs) -> Result<Exit, Failure> {
             )
         })
         .map_err(Failure::of)?;
-    obj::write(&refined.scene, &args.output).map_err(|e| Failure {
+    write_obj(&refined.scene, &args.output).map_err(|e| Failure {
         code: Exit::Io,
         message: e.to_string(),
     })?;

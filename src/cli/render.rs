@@ -5,14 +5,14 @@ use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 
 use plotters::prelude::*;
-use scene_complexity::geom::{Point, Vector};
-use scene_complexity::measure::radiosity::PatchMaterials;
 use scene_complexity::render::{
     default_camera, trace_view, write_ply, Camera, ColourScale, Quantity, Sample, BACK_SIDE,
     NO_DATA,
 };
-use scene_complexity::run::{Measures, RunSpec, StopReason};
-use scene_complexity::scene::Scene;
+use scene_complexity::PatchMaterials;
+use scene_complexity::Scene;
+use scene_complexity::{Measures, RunSpec, StopReason};
+use scene_complexity::{Point, Vector};
 
 use super::args::{parse_count, RunOptions};
 use super::exit::{Exit, Failure};
@@ -288,7 +288,7 @@ fn tracer_failure(e: impl ToString) -> Failure {
 /// Each patch's value of the quantity, divided by its area fraction when `per_area`.
 fn patch_values(
     scene: &Scene,
-    patches: &[scene_complexity::analysis::PatchResult],
+    patches: &[scene_complexity::PatchResult],
     quantity: Quantity,
     per_area: bool,
 ) -> Vec<Option<f64>> {

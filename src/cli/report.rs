@@ -6,12 +6,12 @@ use std::fmt::Write;
 
 use clap::ValueEnum;
 
-use scene_complexity::analysis::{Analysis, RadiosityOutcome, Reliability, TargetOutcome, Verdict};
-use scene_complexity::measure::catalogue::VerdictRule;
-use scene_complexity::measure::{Estimate, Family, Measure, Unit};
-use scene_complexity::run::{ErrorMethod, Shard, StopReason, Tracing};
-use scene_complexity::sample::lines::LineSource;
-use scene_complexity::scene::Scene;
+use scene_complexity::LineSource;
+use scene_complexity::Scene;
+use scene_complexity::VerdictRule;
+use scene_complexity::{Analysis, RadiosityOutcome, Reliability, TargetOutcome, Verdict};
+use scene_complexity::{ErrorMethod, Shard, StopReason, Tracing};
+use scene_complexity::{Estimate, Family, Measure, Unit};
 use serde_json::{json, Value};
 
 use super::table::{fixed, Align, Table};

@@ -4,7 +4,7 @@
 use std::time::Instant;
 
 use scene_complexity::reproduce::{reproduce, LinePlan, ReproduceConfig, TableReport, TABLES};
-use scene_complexity::trace::Backend;
+use scene_complexity::Backend;
 
 use super::args::{ReportOutput, Seed, Threads, Tracer, TracerArg};
 use super::exit::{Exit, Failure};

@@ -2,10 +2,10 @@
 
 use std::sync::Arc;
 
-use scene_complexity::analysis::{analyze, Analysis};
-use scene_complexity::run::{RunControl, RunSpec, Tracing};
-use scene_complexity::scene::{Scene, SceneOptions};
-use scene_complexity::trace::{make_tracer, Tracer};
+use scene_complexity::{analyze, Analysis};
+use scene_complexity::{make_tracer, Tracer};
+use scene_complexity::{RunControl, RunSpec, Tracing};
+use scene_complexity::{Scene, SceneOptions};
 
 use super::args::RunOptions;
 use super::exit::{Exit, Failure};

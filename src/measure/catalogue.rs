@@ -4,7 +4,7 @@
 //!
 //! The report's rows, the JSON keys, the CSV rows, the measures a precision target accepts, the
 //! reliability verdicts, the readings `scx convergence` follows and the per-patch columns all come from
-//! here: adding a measure is one entry here plus its estimator (in [`crate::analysis`]).
+//! here: adding a measure is one entry here plus its estimator (in the analysis layer, `analysis::values` and `analysis::radiosity`).
 //!
 //! Two tables: [`Measure`] for the measures of the whole scene (sec. 3 and 4 of the paper), and
 //! [`PatchMeasure`] for their shares per patch (where the complexity is).

@@ -17,7 +17,7 @@ use crate::scene::Scene;
 use crate::trace::{TraceError, Tracer};
 
 /// What a precision target's measure reads on the run so far: its standard error, and whether its
-/// reading is reliable. The analysis computes it ([`crate::analysis`]); the engine only decides, from
+/// reading is reliable. The analysis computes it (`analysis::cast`); the engine only decides, from
 /// it, whether to stop and how long the next round is.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TargetReading {

@@ -2,7 +2,7 @@
 //!
 //! Counts are symmetric (every pair counts once i -> j and once j -> i), so only the entry with `i <= j`
 //! is stored. Memory follows the number of distinct visible pairs, not n_p^2: a dense ndarray while the
-//! scene has at most [`DENSE_MAX_PATCHES`] patches, a sorted sparse list otherwise.
+//! scene has at most `DENSE_MAX_PATCHES` patches, a sorted sparse list otherwise.
 
 use ndarray::Array2;
 use rayon::prelude::*;

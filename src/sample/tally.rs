@@ -3,7 +3,7 @@
 //! [`tally_lines`] turns one batch of traced lines into a [`BatchTally`]: its [`Counters`], the keys of
 //! its visible pairs and the patches its escapes left. Batches are added up into a [`Tally`] in batch
 //! order, so that even the f64 sums are bit-identical whatever the number of threads that traced them.
-//! The hot loop knows nothing of I/O, threads or scheduling (that is the run engine's, [`crate::run`]).
+//! The hot loop knows nothing of I/O, threads or scheduling (that is the run engine's, `run`).
 
 use rayon::prelude::*;
 

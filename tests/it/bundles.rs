@@ -4,15 +4,15 @@
 //! for a scene with sparse pair counts.
 
 use crate::support;
-use scene_complexity::measure::Measure;
-use scene_complexity::scenes;
+use scene_complexity::internals::measure::Measure;
+use scene_complexity::internals::scenes;
 
-use scene_complexity::analysis::{analyze, Analysis};
-use scene_complexity::run::{BatchPlan, Measures};
-use scene_complexity::run::{RunControl, RunSpec};
-use scene_complexity::sample::lines::LineSource;
-use scene_complexity::scene::Scene;
-use scene_complexity::trace::{make_tracer, Backend, LineHits, Query, Tracer};
+use scene_complexity::internals::analysis::{analyze, Analysis};
+use scene_complexity::internals::run::{BatchPlan, Measures};
+use scene_complexity::internals::run::{RunControl, RunSpec};
+use scene_complexity::internals::sample::lines::LineSource;
+use scene_complexity::internals::scene::Scene;
+use scene_complexity::internals::trace::{make_tracer, Backend, LineHits, Query, Tracer};
 use support::{count_entries, ff_parallel_rectangles, ff_perpendicular_rectangles};
 
 const ALL: Measures = Measures::VISIBILITY;

@@ -3,16 +3,16 @@
 //! exactly the lines it spoils, by the right kind; the `scx crosscheck` command exits accordingly.
 
 use crate::support;
-use scene_complexity::scenes;
+use scene_complexity::internals::scenes;
 #[cfg(feature = "cli")]
 use support::scx;
 
 use scene_complexity::crosscheck::{
     compare_hits, crosscheck, CrossCheckConfig, DifferenceKind, Tolerance,
 };
-use scene_complexity::scene::Scene;
-use scene_complexity::trace::rust::{BruteForceTracer, BvhTracer};
-use scene_complexity::trace::{HitRules, Line, RawHit, TraceError, Tracer};
+use scene_complexity::internals::scene::Scene;
+use scene_complexity::internals::trace::rust::{BruteForceTracer, BvhTracer};
+use scene_complexity::internals::trace::{HitRules, Line, RawHit, TraceError, Tracer};
 
 fn config(lines: u64) -> CrossCheckConfig {
     CrossCheckConfig {
@@ -73,7 +73,7 @@ fn planted_faults_are_found_on_their_lines_and_by_kind() {
     assert_eq!(c.lines, lines);
     assert!(!c.agrees());
     // 2000 lines are at most a few batches; each batch holds lines 3, 5 and 7 of its own.
-    let batches = scene_complexity::run::BatchPlan::new(lines).batches();
+    let batches = scene_complexity::internals::run::BatchPlan::new(lines).batches();
     // A line that misses the cube (about 1 in 4 within the unit sphere) has nothing to spoil.
     let [count, patch, distance] = c.differing;
     assert!(count <= batches && patch <= batches && distance <= batches);
@@ -99,7 +99,7 @@ struct BatchPlanSize;
 
 impl BatchPlanSize {
     fn of(lines: u64) -> u64 {
-        scene_complexity::run::BatchPlan::new(lines).batch_size
+        scene_complexity::internals::run::BatchPlan::new(lines).batch_size
     }
 }
 
@@ -127,7 +127,7 @@ fn the_bvh_and_brute_force_agree_line_for_line() {
 #[cfg(feature = "embree")]
 #[test]
 fn embree_and_the_rust_bvh_agree_on_small_scenes() {
-    use scene_complexity::trace::{make_tracer, Backend, Query};
+    use scene_complexity::internals::trace::{make_tracer, Backend, Query};
     let dir = tempfile::tempdir().unwrap();
     let room = dir.path().join("room.obj");
     std::fs::write(&room, support::room_with_box_obj(1.0)).unwrap();

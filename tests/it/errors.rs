@@ -2,14 +2,14 @@
 //! the bias-corrected I_s is closer to the exact value than the plug-in.
 
 use crate::support;
-use scene_complexity::measure::Measure;
-use scene_complexity::scenes;
+use scene_complexity::internals::measure::Measure;
+use scene_complexity::internals::scenes;
 
-use scene_complexity::analysis::{analyze, Analysis};
-use scene_complexity::measure::Estimate;
-use scene_complexity::run::{RunControl, RunSpec};
-use scene_complexity::scene::Scene;
-use scene_complexity::trace::Tracer;
+use scene_complexity::internals::analysis::{analyze, Analysis};
+use scene_complexity::internals::measure::Estimate;
+use scene_complexity::internals::run::{RunControl, RunSpec};
+use scene_complexity::internals::scene::Scene;
+use scene_complexity::internals::trace::Tracer;
 use support::{all_tracers, cube_exact_measures};
 
 fn fastest_tracer(scene: &Scene) -> Box<dyn Tracer> {

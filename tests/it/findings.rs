@@ -4,15 +4,15 @@
 //! figs. 5/6 are the best discretised (Tables 6, 7); constant radiosity leaves the measures unchanged
 //! (fig. 9, Table 8).
 
-use scene_complexity::analysis::{analyze, Analysis, RadiosityOutcome};
-use scene_complexity::geom::DVec3;
-use scene_complexity::measure::Measure;
-use scene_complexity::run::{Measures, RunControl, RunSpec};
-use scene_complexity::scene::Scene;
-use scene_complexity::scenes;
-use scene_complexity::scenes::cube_clusters::{fig2_corners, Fig2Placement};
-use scene_complexity::scenes::cube_lattice::fig56_corners;
-use scene_complexity::trace::{make_tracer, Backend, Query};
+use scene_complexity::internals::analysis::{analyze, Analysis, RadiosityOutcome};
+use scene_complexity::internals::geom::DVec3;
+use scene_complexity::internals::measure::Measure;
+use scene_complexity::internals::run::{Measures, RunControl, RunSpec};
+use scene_complexity::internals::scene::Scene;
+use scene_complexity::internals::scenes;
+use scene_complexity::internals::scenes::cube_clusters::{fig2_corners, Fig2Placement};
+use scene_complexity::internals::scenes::cube_lattice::fig56_corners;
+use scene_complexity::internals::trace::{make_tracer, Backend, Query};
 
 /// An analysis with the pure-Rust tracer; 2 groups, since these tests compare values, not errors (every
 /// group's own measures cost as much as the run's on scenes of ~2000 patches).
@@ -33,7 +33,7 @@ fn run(spec: &str, lines: u64, discrete: bool) -> Analysis {
     a
 }
 
-fn value(e: Option<scene_complexity::measure::Estimate>) -> f64 {
+fn value(e: Option<scene_complexity::internals::measure::Estimate>) -> f64 {
     e.expect("computed").value
 }
 

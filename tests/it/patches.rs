@@ -1,13 +1,13 @@
 //! The per-patch results against invariants: the per-patch terms add up to the scene's measures, and
 //! the radiosity columns solve eq. (2). (`cli_patches` checks the files `scx analyze` writes.)
 
-use scene_complexity::analysis::{analyze, Analysis};
-use scene_complexity::measure::shares::information_loss;
-use scene_complexity::measure::{Measure, PatchMeasure};
+use scene_complexity::internals::analysis::{analyze, Analysis};
+use scene_complexity::internals::measure::shares::information_loss;
+use scene_complexity::internals::measure::{Measure, PatchMeasure};
+use scene_complexity::internals::run::{RunControl, RunSpec};
+use scene_complexity::internals::scenes;
+use scene_complexity::internals::trace::{make_tracer, Backend, Query};
 use scene_complexity::refine::oracle;
-use scene_complexity::run::{RunControl, RunSpec};
-use scene_complexity::scenes;
-use scene_complexity::trace::{make_tracer, Backend, Query};
 use scene_complexity::EntropyEstimator;
 
 fn run_with_patches(

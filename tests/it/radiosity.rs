@@ -3,18 +3,18 @@
 //! refinement strategies.
 
 use crate::support;
-use scene_complexity::measure::Measure;
-use scene_complexity::scenes;
+use scene_complexity::internals::measure::Measure;
+use scene_complexity::internals::scenes;
 
-use scene_complexity::analysis::{analyze, RadiosityOutcome};
-use scene_complexity::measure::radiosity::{
+use scene_complexity::internals::analysis::{analyze, RadiosityOutcome};
+use scene_complexity::internals::measure::radiosity::{
     for_each_transition, solve, transformed_areas, FormFactors, PatchMaterials, SolveOptions,
 };
-use scene_complexity::measure::shares::information_loss;
+use scene_complexity::internals::measure::shares::information_loss;
+use scene_complexity::internals::run::{RunControl, RunSpec};
+use scene_complexity::internals::scene::{self, Material, Scene};
+use scene_complexity::internals::trace::{make_tracer, Backend, Query, Tracer};
 use scene_complexity::refine::{oracle, refine, RefineConfig, Strategy};
-use scene_complexity::run::{RunControl, RunSpec};
-use scene_complexity::scene::{self, Material, Scene};
-use scene_complexity::trace::{make_tracer, Backend, Query, Tracer};
 use support::*;
 
 fn config(lines: u64, seed: u64) -> RunSpec {

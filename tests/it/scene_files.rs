@@ -2,12 +2,12 @@
 //! `w`, objects flipped or two-sided, the orientation diagnosis, glTF with node transforms, PLY and STL
 //! in ASCII and binary, materials in RGB, and I_s^c the same whatever the format and the triangulation.
 
-use scene_complexity::measure::Measure;
+use scene_complexity::internals::measure::Measure;
 use std::path::{Path, PathBuf};
 
-use scene_complexity::analysis::RunWarningKind;
-use scene_complexity::scene::{ObjectSet, Planarity, SceneOptions};
-use scene_complexity::scenes::load_with;
+use scene_complexity::internals::analysis::RunWarningKind;
+use scene_complexity::internals::scene::{ObjectSet, Planarity, SceneOptions};
+use scene_complexity::internals::scenes::load_with;
 use scene_complexity::{
     analyze, load, make_tracer, Analysis, Backend, Measures, Query, RunControl, RunSpec, Scene,
 };
@@ -487,7 +487,7 @@ fn continuous_mutual_information_is_the_same_in_every_format() {
     let triangles_path = write(dir.path(), "triangles.obj", triangles.as_bytes());
     let scene = load(quads_path.to_str().unwrap()).unwrap();
     let gltf_path = dir.path().join("room.glb");
-    scene_complexity::scene::gltf::write(&scene, &gltf_path).unwrap();
+    scene_complexity::internals::scene::gltf::write(&scene, &gltf_path).unwrap();
     let mut ply = format!(
         "ply\nformat ascii 1.0\nelement vertex {}\nproperty double x\nproperty double y\nproperty double z\n\
          element face {}\nproperty list uchar uint vertex_indices\nend_header\n",
@@ -545,15 +545,17 @@ fn continuous_mutual_information_is_the_same_in_every_format() {
 /// same single value (exactly the built-in's), so the exported box measures the same.
 #[test]
 fn materials_keep_their_colours_through_export() {
-    use scene_complexity::scene::grey_value;
-    use scene_complexity::scenes::cornell::{GREEN, GREEN_RGB, RED, RED_RGB, WHITE, WHITE_RGB};
+    use scene_complexity::internals::scene::grey_value;
+    use scene_complexity::internals::scenes::cornell::{
+        GREEN, GREEN_RGB, RED, RED_RGB, WHITE, WHITE_RGB,
+    };
     for (rgb, mean) in [(RED_RGB, RED), (WHITE_RGB, WHITE), (GREEN_RGB, GREEN)] {
         assert_eq!(grey_value(rgb), mean);
     }
     let scene = load("@cornell").unwrap();
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("cornell.obj");
-    scene_complexity::scene::obj::write(&scene, &path).unwrap();
+    scene_complexity::internals::scene::obj::write(&scene, &path).unwrap();
     let mtl = std::fs::read_to_string(dir.path().join("cornell.mtl")).unwrap();
     let [r, g, b] = RED_RGB;
     assert!(mtl.contains(&format!("Kd {r} {g} {b}")), "{mtl}");
@@ -568,7 +570,7 @@ fn materials_keep_their_colours_through_export() {
         dir.path().join("cornell.gltf"),
         dir.path().join("cornell.glb"),
     ] {
-        scene_complexity::scene::gltf::write(&scene, &path).unwrap();
+        scene_complexity::internals::scene::gltf::write(&scene, &path).unwrap();
         let back = load(path.to_str().unwrap()).unwrap();
         let red = back.materials.iter().find(|m| m.name == "red").unwrap();
         for (a, b) in red.reflectance_rgb.iter().zip(RED_RGB) {
@@ -586,8 +588,8 @@ fn materials_keep_their_colours_through_export() {
 /// is reached from the first one's front at its back: a `BackSeen` segment.
 #[test]
 fn the_ends_of_a_line_and_back_sides_seen() {
-    use scene_complexity::sample::pairs::{segments, segments_and_ends, Segment};
-    use scene_complexity::trace::{Line, LineHits};
+    use scene_complexity::internals::sample::pairs::{segments, segments_and_ends, Segment};
+    use scene_complexity::internals::trace::{Line, LineHits};
     let dir = tempfile::tempdir().unwrap();
     let obj = "o a\nv -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nf 1 2 3 4\n\
                o b\nv -1 -1 1\nv 1 -1 1\nv 1 1 1\nv -1 1 1\nf 5 6 7 8\n";

@@ -6,19 +6,19 @@
 //! reference computed here (never against scx's own earlier output).
 
 use crate::support;
-use scene_complexity::measure::Measure;
-use scene_complexity::scenes;
+use scene_complexity::internals::measure::Measure;
+use scene_complexity::internals::scenes;
 
 use std::f64::consts::{LN_2, PI};
 
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
-use scene_complexity::analysis::{analyze, Analysis};
-use scene_complexity::measure::channel::row_totals;
-use scene_complexity::run::{RunControl, RunSpec};
-use scene_complexity::sample::pairs::{segments, Segment};
-use scene_complexity::scene::{Material, Scene, SceneBuilder};
-use scene_complexity::trace::{make_tracer, Backend, Line, LineHits, Query, Tracer};
+use scene_complexity::internals::analysis::{analyze, Analysis};
+use scene_complexity::internals::measure::channel::row_totals;
+use scene_complexity::internals::run::{RunControl, RunSpec};
+use scene_complexity::internals::sample::pairs::{segments, Segment};
+use scene_complexity::internals::scene::{Material, Scene, SceneBuilder};
+use scene_complexity::internals::trace::{make_tracer, Backend, Line, LineHits, Query, Tracer};
 use support::{count_entries, ff_parallel_rectangles, room_with_box_obj};
 
 // ------------------------------------------------------------------------------------------------
@@ -158,7 +158,7 @@ fn room_with_floor_square(b: &mut SceneBuilder, a: f64, c: f64, m: u32) {
     );
     add_quad(b, [p(0.0, a), p(a, a), p(a, c), p(0.0, c)], m, "floor west");
     add_quad(b, [p(c, a), p(1.0, a), p(1.0, c), p(c, c)], m, "floor east");
-    let room = scene_complexity::scenes::solids::cube("room", 1).expect("cube");
+    let room = scene_complexity::internals::scenes::solids::cube("room", 1).expect("cube");
     // The other five walls of the unit cube, inward, from the built-in cube (face 4 is the floor z = 0).
     for (k, patch) in room.patches.iter().enumerate() {
         if k == 4 {
@@ -1121,7 +1121,11 @@ fn enclose_closes_open_scenes_consistently() {
     let counts = t.counts.as_ref().unwrap();
     let rows = row_totals(n, counts, &t.escapes_by_patch);
     let mut f = vec![vec![0.0; n]; n];
-    scene_complexity::measure::channel::for_each_form_factor(counts, &rows, |i, j, v| f[i][j] = v);
+    scene_complexity::internals::measure::channel::for_each_form_factor(
+        counts,
+        &rows,
+        |i, j, v| f[i][j] = v,
+    );
     for (i, row) in f.iter().enumerate() {
         assert!((row.iter().sum::<f64>() - 1.0).abs() < 1e-12, "row {i}");
     }
@@ -1160,7 +1164,11 @@ fn enclose_closes_open_scenes_consistently() {
     let counts = t.counts.as_ref().unwrap();
     let rows = row_totals(6, counts, &t.escapes_by_patch);
     let mut f = vec![vec![0.0; 6]; 6];
-    scene_complexity::measure::channel::for_each_form_factor(counts, &rows, |i, j, v| f[i][j] = v);
+    scene_complexity::internals::measure::channel::for_each_form_factor(
+        counts,
+        &rows,
+        |i, j, v| f[i][j] = v,
+    );
     for (i, row) in f.iter().enumerate() {
         assert!((row.iter().sum::<f64>() - 1.0).abs() < 1e-12, "row {i}");
     }

@@ -2,15 +2,15 @@
 //! positional entropy, closure and reciprocity, thread and scale invariance.
 
 use crate::support;
-use scene_complexity::measure::Measure;
-use scene_complexity::scenes;
+use scene_complexity::internals::measure::Measure;
+use scene_complexity::internals::scenes;
 
-use scene_complexity::analysis::{analyze, Analysis};
-use scene_complexity::measure::channel::{for_each_form_factor, row_totals};
-use scene_complexity::run::Measures;
-use scene_complexity::run::{RunControl, RunSpec};
-use scene_complexity::scene::Scene;
-use scene_complexity::trace::Tracer;
+use scene_complexity::internals::analysis::{analyze, Analysis};
+use scene_complexity::internals::measure::channel::{for_each_form_factor, row_totals};
+use scene_complexity::internals::run::Measures;
+use scene_complexity::internals::run::{RunControl, RunSpec};
+use scene_complexity::internals::scene::Scene;
+use scene_complexity::internals::trace::Tracer;
 use support::*;
 
 const ALL: Measures = Measures::VISIBILITY;
