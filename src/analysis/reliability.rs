@@ -1,5 +1,5 @@
 //! The reliability verdict of every reading: whether its standard error tells the whole story, and the
-//! bounds of the theory it breaks (README, "Reading the reliability verdict").
+//! bounds of the theory it breaks (docs/results.md, "Reading the reliability verdict").
 //!
 //! The discrete measures of an undersampled run are biased (their standard errors do not include it):
 //! * a plug-in reading (H_s, H(X, Y), I_s and the accuracies built on them) is `ok` when the rows' sample

@@ -64,7 +64,7 @@ pub struct AnalyzeArgs {
     #[command(flatten)]
     out: ReportOutput,
     /// Save the run's state to FILE at the end (also when interrupted): `scx merge` reports it,
-    /// `--resume` continues it (README, "Runs beyond one machine and one sitting").
+    /// `--resume` continues it (docs/runs.md, "Runs beyond one machine").
     #[arg(long, value_name = "FILE")]
     save: Option<PathBuf>,
     /// Run only shard K of M of the run's batches (K from 1); needs --save or --checkpoint, and no

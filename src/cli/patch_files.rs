@@ -1,8 +1,8 @@
 //! `--patches FILE` and `--form-factors FILE` of `scx analyze` and `scx merge`: the per-patch results
 //! and the sparse form-factor matrix, written for pandas, polars, numpy and scipy.
 //!
-//! * `--patches x.csv`: one row per patch, in the order `scx export` writes the faces (README,
-//!   "Per-patch results" lists the columns and their units);
+//! * `--patches x.csv`: one row per patch, in the order `scx export` writes the faces
+//!   (docs/per-patch.md, "Per-patch results", lists the columns and their units);
 //! * `--form-factors x.csv`: one row per non-zero `F_ij` (i, j, N_ij, N_i, F_ij and its standard error
 //!   `sqrt(F (1 - F) / N_i)`, the binomial error of a row's share);
 //! * `--form-factors x.mtx`: the same matrix as Matrix Market coordinates (`scipy.io.mmread`), 1-based.

@@ -522,7 +522,7 @@ pub fn table(run: &RunInfo, a: &Analysis) -> String {
     );
     reliability_summary(&mut s, a);
     if bundle(a) > 0 && a.estimate(Measure::MutualInformationCorrected).is_some() {
-        // Measured: 8 x 8 bundles moved the corrected I_s of @cube:30 by 7.7 standard errors (README).
+        // Measured: 8 x 8 bundles moved the corrected I_s of @cube:30 by 7.7 standard errors (docs/performance.md, "Bundles").
         let _ = writeln!(
             s,
             "bundles: the corrections infer unseen patch pairs as if the lines were independent; the lines \
@@ -584,7 +584,7 @@ fn reliability_summary(s: &mut String, a: &Analysis) {
         let _ = writeln!(
             s,
             "reliability: an `undersampled` reading is biased beyond its standard error, an `unusable` one \
-             cannot be trusted (rows' coverage below 0.5){needed} (README, \"Reading the reliability \
+             cannot be trusted (rows' coverage below 0.5){needed} (docs/results.md, \"Reading the reliability \
              verdict\")."
         );
     }

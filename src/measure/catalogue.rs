@@ -97,7 +97,7 @@ impl Needs {
     }
 }
 
-/// How a reading's reliability is judged (README, "Reading the reliability verdict").
+/// How a reading's reliability is judged (docs/results.md, "Reading the reliability verdict").
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum VerdictRule {
     /// Exact (from the areas): no verdict.

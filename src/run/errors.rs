@@ -1,4 +1,4 @@
-//! Standard errors from the groups of a run (README, "Standard errors").
+//! Standard errors from the groups of a run (docs/results.md, "Standard errors").
 //!
 //! Batch `b` of a run belongs to group `b mod G`; every batch has its own random stream, so the groups
 //! are independent. Every measure is computed on the whole run, on each group alone, and (for the

@@ -20,7 +20,7 @@ use crate::sample::lines::LineSource;
 pub const DEFAULT_GROUPS: usize = 16;
 
 /// The entropy estimator behind the bias-corrected H_s and I_s, chosen by measurement against the exact
-/// I_s of `@cube:N` (docs/performance.md, "Error against run time").
+/// I_s of `@cube:N` (docs/results.md, "The default estimator").
 pub const DEFAULT_ESTIMATOR: EntropyEstimator = EntropyEstimator::ChaoWangJost;
 
 /// Which families of measures a run computes.

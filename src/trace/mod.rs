@@ -239,7 +239,7 @@ impl Backend {
 
     /// The backend used when none is named: the pure-Rust tracer, in every build. Its hits are
     /// Embree's to the bit (`scx crosscheck`) and it is the faster of the two end to end on every scene
-    /// size measured (README, "Packets, bundles and throughput"); Embree stays one flag away.
+    /// size measured (docs/performance.md, "The two tracers: throughput and packets"); Embree stays one flag away.
     pub fn default_available() -> Self {
         Backend::Rust
     }
