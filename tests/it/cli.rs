@@ -299,7 +299,7 @@ fn convergence_writes_a_table_a_csv_and_a_plot() {
         plot.starts_with("<svg")
             && plot.contains("run time (s, log scale)")
             && plot.contains("error (bits, log scale)")
-            && plot.contains("mutual information I(s), corrected"),
+            && plot.contains("mutual information I_s, corrected"),
         "{plot}"
     );
 }
