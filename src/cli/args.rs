@@ -6,7 +6,9 @@ use std::path::PathBuf;
 use clap::ValueEnum;
 use scene_complexity::measure::estimators::EntropyEstimator;
 use scene_complexity::run::{ErrorMethod, TargetMeasure, DEFAULT_ESTIMATOR, DEFAULT_GROUPS};
-use scene_complexity::scene::{ObjectSet, Planarity, SceneOptions, DEFAULT_PLANARITY};
+use scene_complexity::scene::{
+    ObjectSet, Planarity, Reach, ReadPolicy, SceneOptions, DEFAULT_PLANARITY,
+};
 use scene_complexity::trace::{Backend, Query};
 
 /// How a scene file is read: non-planar polygons, and objects to flip or make two-sided.
@@ -27,11 +29,36 @@ pub struct SceneArgs {
     /// and material); without a list, every object. Put it after the scene.
     #[arg(long, value_name = "OBJECT,...", num_args = 0..=1, value_delimiter = ',', default_missing_value = "")]
     pub two_sided: Option<Vec<String>>,
+    /// Let the scene's references (glTF buffer URIs, OBJ `mtllib`) name files anywhere: absolute paths,
+    /// `..`, `file:` URIs, links out of the folder. Without it they are read only inside the scene's
+    /// folder (a scene file is untrusted input).
+    #[arg(long)]
+    pub read_anywhere: bool,
+    /// The largest file read for the scene (the scene file or standard input, each glTF buffer, each
+    /// MTL library): a number of bytes, or with a unit (`512MB`, `2GiB`; K, M, G, T are powers of 1000,
+    /// KiB, MiB, GiB, TiB of 1024). Memory grows with the scene, so this bounds it too.
+    #[arg(long, value_name = "SIZE", default_value = "256MiB", value_parser = parse_size)]
+    pub max_file_size: u64,
 }
 
 impl SceneArgs {
-    /// The loading options these flags ask for.
+    /// The reading policy these flags ask for: where references may point, how large a file may be.
+    pub fn policy(&self) -> ReadPolicy {
+        ReadPolicy {
+            reach: if self.read_anywhere {
+                Reach::Anywhere
+            } else {
+                Reach::SceneFolder
+            },
+            max_bytes: self.max_file_size,
+        }
+    }
+
+    /// The loading options these flags ask for. The reading policy is not among them (a saved run keeps
+    /// the options, and the policy belongs to one reading): it is handed to the scene reader here, for
+    /// the scene this command loads ([`super::input::use_policy`]).
     pub fn options(&self) -> SceneOptions {
+        super::input::use_policy(self.policy());
         let set = |names: &Option<Vec<String>>| match names {
             None => ObjectSet::None,
             Some(list) if list.iter().all(|n| n.is_empty()) => ObjectSet::All,
@@ -164,6 +191,43 @@ fn parse_tolerance(s: &str) -> Result<f64, String> {
     }
 }
 
+/// A size in bytes: a whole number (`1e9` too), or a number with a unit: K, M, G, T (powers of 1000,
+/// a trailing `B` allowed) or KiB, MiB, GiB, TiB (powers of 1024), in any case.
+pub fn parse_size(s: &str) -> Result<u64, String> {
+    let t = s.trim();
+    let split = t
+        .find(|c: char| c.is_ascii_alphabetic() && c != 'e' && c != 'E')
+        .unwrap_or(t.len());
+    let (number, unit) = t.split_at(split);
+    let scale: f64 = match unit.to_ascii_lowercase().as_str() {
+        "" | "b" => 1.0,
+        "k" | "kb" => 1e3,
+        "m" | "mb" => 1e6,
+        "g" | "gb" => 1e9,
+        "t" | "tb" => 1e12,
+        "kib" => 1024.0,
+        "mib" => 1024.0 * 1024.0,
+        "gib" => 1024.0 * 1024.0 * 1024.0,
+        "tib" => 1024.0 * 1024.0 * 1024.0 * 1024.0,
+        _ => {
+            return Err(format!(
+                "`{s}`: unknown unit `{unit}`; use bytes, K, M, G, T (powers of 1000) or KiB, MiB, GiB, \
+                 TiB (powers of 1024)"
+            ))
+        }
+    };
+    let value = number
+        .trim()
+        .parse::<f64>()
+        .ok()
+        .map(|v| v * scale)
+        .filter(|v| v.is_finite() && *v >= 1.0 && *v <= 1e18)
+        .ok_or_else(|| {
+            format!("`{s}`: need a size from 1 byte to 1e18 bytes, such as 512MB or 2GiB")
+        })?;
+    Ok(value.round() as u64)
+}
+
 /// A positive number (seconds, a standard error).
 pub fn parse_positive(s: &str) -> Result<f64, String> {
     match s.trim().parse::<f64>() {
@@ -216,5 +280,15 @@ mod tests {
         assert!(parse_count("1.5").is_err());
         assert_eq!(parse_threads("0"), Ok(0));
         assert!(parse_positive("-1").unwrap_err().contains("positive"));
+        assert_eq!(parse_size("256MiB"), Ok(256 << 20));
+        assert_eq!(parse_size("2GB"), Ok(2_000_000_000));
+        assert_eq!(parse_size("1e9"), Ok(1_000_000_000));
+        assert_eq!(parse_size("1.5 kib"), Ok(1536));
+        assert_eq!(parse_size("100"), Ok(100));
+        assert!(parse_size("2 parsecs")
+            .unwrap_err()
+            .contains("unknown unit"));
+        assert!(parse_size("-1GB").is_err());
+        assert!(parse_size("0").is_err());
     }
 }

@@ -1,41 +1,71 @@
 //! Reading a scene: a built-in (`@cube:10`), a file, or `-` for standard input.
 
-use std::io::Read;
 use std::path::Path;
+use std::sync::Mutex;
 
-use scene_complexity::scene::{obj, Scene, SceneOptions};
+use scene_complexity::scene::{format, ReadPolicy, Scene, SceneError, SceneOptions};
 use scene_complexity::scenes;
 
 use super::output::warn;
-use super::{Exit, Failure};
+use super::Failure;
+
+/// The reading policy of this run's scene (`--read-anywhere`, `--max-file-size`). It is kept here, not
+/// in the [`SceneOptions`] handed to [`load_scene`], because those options are saved with a run and
+/// compared on resume and merge, and what one reading may touch is no property of the run.
+static POLICY: Mutex<Option<ReadPolicy>> = Mutex::new(None);
+
+/// Makes `policy` the one the scenes of this run are read under (the command's `SceneArgs` call it
+/// when they hand over their options). Commands without those flags read under the default policy.
+pub fn use_policy(policy: ReadPolicy) {
+    *POLICY.lock().unwrap_or_else(|e| e.into_inner()) = Some(policy);
+}
+
+/// The policy set by [`use_policy`], or the default.
+fn policy() -> ReadPolicy {
+    POLICY
+        .lock()
+        .unwrap_or_else(|e| e.into_inner())
+        .unwrap_or_default()
+}
 
 /// Loads the scene a command names, read as `options` ask, printing its loading warnings; bad input is
 /// exit code 2.
 pub fn load_scene(spec: &str, options: &SceneOptions) -> Result<Scene, Failure> {
-    let scene = if spec == "-" {
-        from_stdin(options)?
-    } else {
-        scenes::load_with(spec, options).map_err(|e| Failure::bad_input(e.to_string()))?
-    };
+    let policy = policy();
+    let scene = quietly(spec, || {
+        if spec == "-" {
+            // A scene on standard input names its files relative to the current folder.
+            let stdin = std::io::stdin().lock();
+            format::load_stream("<stdin>", stdin, Path::new(""), options, &policy)
+        } else {
+            scenes::load_with_policy(spec, options, &policy)
+        }
+    })
+    .map_err(|e| Failure::bad_input(e.to_string()))?;
     for w in &scene.warnings {
         warn(w);
     }
     Ok(scene)
 }
 
-/// An OBJ scene from standard input; an `mtllib` is looked for in the current folder.
-fn from_stdin(options: &SceneOptions) -> Result<Scene, Failure> {
-    let mut text = String::new();
-    std::io::stdin()
-        .read_to_string(&mut text)
-        .map_err(|e| Failure {
-            code: Exit::Io,
-            message: format!("cannot read the scene from standard input: {e}"),
-        })?;
-    let materials = |mtl: &Path| {
-        let text = std::fs::read_to_string(mtl).map_err(|e| e.to_string())?;
-        Ok((mtl.display().to_string(), text))
-    };
-    obj::load_text_with("<stdin>", &text, &materials, options)
-        .map_err(|e| Failure::bad_input(e.to_string()))
+/// Runs a scene reader with Rust's panic message switched off: the readers turn a panic in a dependency
+/// into an error of their own (the glTF reader) and this catches any other, so that the user sees one
+/// clear message and never a panic's text or backtrace. Reading happens before any other thread of the
+/// run starts, so the process-wide hook is this reading's alone while it is swapped.
+fn quietly(
+    spec: &str,
+    read: impl FnOnce() -> Result<Scene, SceneError>,
+) -> Result<Scene, SceneError> {
+    let previous = std::panic::take_hook();
+    std::panic::set_hook(Box::new(|_| {}));
+    let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(read));
+    std::panic::set_hook(previous);
+    result.unwrap_or_else(|_| {
+        Err(SceneError::Geometry {
+            scene: spec.to_string(),
+            message: "scx failed to read it (an internal error in a scene reader); please report \
+                      the file"
+                .into(),
+        })
+    })
 }
