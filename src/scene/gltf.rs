@@ -58,6 +58,7 @@ fn load_document(
     options: &SceneOptions,
 ) -> Result<Scene, SceneError> {
     let file_error = |message: String| SceneError::in_file(shown, message);
+    check_glb_header(bytes).map_err(file_error)?;
     let gltf = ::gltf::Gltf::from_slice(bytes)
         .map_err(|e| file_error(format!("not a readable glTF 2.0 file: {e}")))?;
     let root = gltf.document.as_json();
@@ -183,6 +184,27 @@ fn load_document(
         ));
     }
     b.build_with(options)
+}
+
+/// The length a .glb's header gives must cover the header itself (the gltf crate subtracts the one from
+/// the other unchecked).
+fn check_glb_header(bytes: &[u8]) -> Result<(), String> {
+    if !bytes.starts_with(b"glTF") {
+        return Ok(());
+    }
+    let Some(length) = bytes.get(8..12) else {
+        return Err(format!(
+            "a .glb of {} bytes, shorter than its 12-byte header",
+            bytes.len()
+        ));
+    };
+    let length = u32::from_le_bytes([length[0], length[1], length[2], length[3]]);
+    if length < 12 {
+        return Err(format!(
+            "a .glb whose header gives a length of {length} bytes, less than the header's own 12"
+        ));
+    }
+    Ok(())
 }
 
 /// A glTF 2.x asset: glTF 1.0 is another format (the gltf crate would read its JSON as 2.0 and find

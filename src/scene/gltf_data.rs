@@ -333,9 +333,11 @@ impl Data<'_> {
             Checked::Valid(json::accessor::IndexComponentType(ComponentType::U8)) => 1,
             Checked::Valid(json::accessor::IndexComponentType(ComponentType::U16)) => 2,
             Checked::Valid(json::accessor::IndexComponentType(ComponentType::U32)) => 4,
-            _ => return Err(format!(
+            _ => {
+                return Err(format!(
                 "{what}: its sparse indices are not UNSIGNED_BYTE, UNSIGNED_SHORT or UNSIGNED_INT"
-            )),
+            ))
+            }
         };
         let sparse_what = format!("{what} (sparse)");
         let (indices, index_stride) = self.range(
