@@ -25,6 +25,11 @@ pub enum Format {
 }
 
 impl Format {
+    /// Whether files of this format are text (PLY may be either; its header is text).
+    pub fn is_text(self) -> bool {
+        matches!(self, Format::Obj | Format::Gltf | Format::StlAscii)
+    }
+
     /// A name for messages.
     pub fn name(self) -> &'static str {
         match self {
@@ -227,6 +232,10 @@ fn read_stream(stream: impl Read, path: &Path, max_bytes: u64) -> Result<Vec<u8>
         return within(bytes, max_bytes);
     }
     let limit = match detect(&bytes) {
+        Some(format) if format.is_text() => {
+            text_head(&bytes)?;
+            max_bytes
+        }
         Some(_) => max_bytes,
         None => match stl_size(&bytes) {
             Some(size) if size <= max_bytes => size,
@@ -238,6 +247,26 @@ fn read_stream(stream: impl Read, path: &Path, max_bytes: u64) -> Result<Vec<u8>
         .read_to_end(&mut bytes)
         .map_err(cannot)?;
     within(bytes, max_bytes)
+}
+
+/// The first bytes of a stream in a text format must be text: valid UTF-8 (but for a character cut at
+/// the end) without NUL bytes. Anything else is refused before more is read (random bytes whose start
+/// is not even UTF-8 would otherwise be read to the size limit as an OBJ).
+fn text_head(head: &[u8]) -> Result<(), String> {
+    let valid = match std::str::from_utf8(head) {
+        Ok(_) => head.len(),
+        Err(e) if e.error_len().is_none() => e.valid_up_to(),
+        Err(e) => {
+            return Err(format!(
+                "not a text file (invalid UTF-8 at byte {})",
+                e.valid_up_to()
+            ))
+        }
+    };
+    match head[..valid].iter().position(|&b| b == 0) {
+        Some(at) => Err(format!("not a text file (a NUL byte at byte {at})")),
+        None => Ok(()),
+    }
 }
 
 /// Bytes read from a stream, refused when over the size limit.
