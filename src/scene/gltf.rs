@@ -59,8 +59,15 @@ fn load_document(
 ) -> Result<Scene, SceneError> {
     let file_error = |message: String| SceneError::in_file(shown, message);
     check_glb_header(bytes).map_err(file_error)?;
-    let gltf = ::gltf::Gltf::from_slice(bytes)
-        .map_err(|e| file_error(format!("not a readable glTF 2.0 file: {e}")))?;
+    let unreadable = |e: ::gltf::Error| file_error(format!("not a readable glTF 2.0 file: {e}"));
+    let raw = ::gltf::Gltf::from_slice_without_validation(bytes).map_err(unreadable)?;
+    // gltf-json's validation indexes the accessors with each POSITION attribute unchecked: check
+    // those indices first, then validate as `Gltf::from_slice` does.
+    check_position_accessors(raw.document.as_json()).map_err(file_error)?;
+    let gltf = ::gltf::Gltf {
+        document: ::gltf::Document::from_json(raw.document.into_json()).map_err(unreadable)?,
+        blob: raw.blob,
+    };
     let root = gltf.document.as_json();
     check_version(&root.asset).map_err(file_error)?;
     let buffers = gltf_data::buffers(&gltf, folder).map_err(file_error)?;
@@ -184,6 +191,26 @@ fn load_document(
         ));
     }
     b.build_with(options)
+}
+
+/// Every POSITION attribute names an accessor that exists.
+fn check_position_accessors(root: &::gltf::json::Root) -> Result<(), String> {
+    let positions = ::gltf::json::validation::Checked::Valid(Semantic::Positions);
+    for (m, mesh) in root.meshes.iter().enumerate() {
+        for (p, primitive) in mesh.primitives.iter().enumerate() {
+            let Some(k) = primitive.attributes.get(&positions) else {
+                continue;
+            };
+            if k.value() >= root.accessors.len() {
+                return Err(format!(
+                    "mesh {m} primitive {p}: its POSITION accessor {} does not exist (the file has {})",
+                    k.value(),
+                    root.accessors.len()
+                ));
+            }
+        }
+    }
+    Ok(())
 }
 
 /// The length a .glb's header gives must cover the header itself (the gltf crate subtracts the one from

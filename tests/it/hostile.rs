@@ -534,6 +534,12 @@ fn hostile_gltf_accessors_must_fit_their_buffers() {
             "sparse index",
         ),
         (
+            // Found by fuzzing: gltf-json's validation indexed the accessors with it unchecked.
+            "no such accessor",
+            indexed_gltf(|d| d["meshes"][0]["primitives"][0]["attributes"]["POSITION"] = json!(5)),
+            "its POSITION accessor 5 does not exist",
+        ),
+        (
             "version 1",
             indexed_gltf(|d| d["asset"]["version"] = json!("1.0")),
             "glTF version `1.0`: scx reads glTF 2.0",
