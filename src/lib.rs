@@ -69,12 +69,14 @@ pub mod reproduce;
 
 // Scenes: loading (files and built-ins), building from arrays, writing.
 pub use geom::{Direction, Normal, Point, Vector};
+pub use scene::format::load_stream;
 pub use scene::{
     gltf::write as write_gltf, obj::load_text_with as load_obj_text, obj::write as write_obj,
     Material, Normalization, ObjectSet, Patch, Planarity, Scene, SceneBuilder, SceneError,
     SceneOptions, DEFAULT_PLANARITY,
 };
-pub use scenes::{load, load_with, Builtin, CATALOGUE};
+pub use scene::{Reach, ReadPolicy};
+pub use scenes::{load, load_with, load_with_policy, Builtin, CATALOGUE};
 
 // Tracing.
 pub use trace::{make_tracer, Backend, Query, QueryError, TraceError, Tracer};

@@ -200,7 +200,12 @@ fn new_run(args: &AnalyzeArgs, name: &str) -> Result<Prepared, Failure> {
         ));
     }
     let reading = args.run.input.options();
-    let runner = Runner::with(name, &reading, args.run.tracing(), args.run.threads.value)?;
+    let runner = Runner::with(
+        name,
+        (&reading, &args.run.input.policy()),
+        args.run.tracing(),
+        args.run.threads.value,
+    )?;
     let state = start(&runner.scene, &spec).map_err(Failure::bad_input)?;
     let identity = RunIdentity::new(
         SceneRef::of(name, &reading, &runner.scene),
@@ -231,7 +236,7 @@ fn resumed_run(args: &AnalyzeArgs, file: &Path) -> Result<Prepared, Failure> {
     };
     let runner = Runner::with(
         &name,
-        &identity.scene.reading,
+        (&identity.scene.reading, &args.run.input.policy()),
         tracing,
         args.run.threads.value,
     )?;

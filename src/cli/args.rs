@@ -4,13 +4,11 @@
 use std::path::PathBuf;
 
 use clap::ValueEnum;
-use scene_complexity::EntropyEstimator;
-use scene_complexity::Measure;
-use scene_complexity::{Backend, Query};
+use scene_complexity::{Backend, EntropyEstimator, Measure, Query};
 use scene_complexity::{
     ErrorMethod, Measures, RunSpec, Tracing, DEFAULT_ESTIMATOR, DEFAULT_GROUPS,
 };
-use scene_complexity::{ObjectSet, Planarity, SceneOptions, DEFAULT_PLANARITY};
+use scene_complexity::{ObjectSet, Planarity, Reach, ReadPolicy, SceneOptions, DEFAULT_PLANARITY};
 
 /// How a scene file is read: non-planar polygons, and objects to flip or make two-sided.
 #[derive(clap::Args, Debug, Clone)]
@@ -30,10 +28,18 @@ pub struct SceneArgs {
     /// and material); without a list, every object. Put it after the scene.
     #[arg(long, value_name = "OBJECT,...", num_args = 0..=1, value_delimiter = ',', default_missing_value = "")]
     pub two_sided: Option<Vec<String>>,
+    #[command(flatten)]
+    pub reading: ReadArgs,
 }
 
 impl SceneArgs {
-    /// The loading options these flags ask for.
+    /// The reading policy these flags ask for: where references may point, how large a file may be.
+    pub fn policy(&self) -> ReadPolicy {
+        self.reading.policy()
+    }
+
+    /// The loading options these flags ask for. The reading policy is not among them: a saved run keeps
+    /// the options, and the policy belongs to one reading ([`SceneArgs::policy`]).
     pub fn options(&self) -> SceneOptions {
         let set = |names: &Option<Vec<String>>| match names {
             None => ObjectSet::None,
@@ -79,6 +85,36 @@ pub struct Tracer {
     /// the same hits (`scx crosscheck`).
     #[arg(id = "tracer", long = "tracer", value_name = "TRACER", value_enum)]
     pub value: Option<TracerArg>,
+}
+
+/// What reading a scene may touch: how far its references reach, how large a file may be (a scene file
+/// is untrusted input). Not part of a run: a resume or a merge may read the same scene under others.
+#[derive(clap::Args, Debug, Clone)]
+pub struct ReadArgs {
+    /// Let the scene's references (glTF buffer URIs, OBJ `mtllib`) name files anywhere: absolute paths,
+    /// `..`, `file:` URIs, links out of the folder. Without it they are read only inside the scene's
+    /// folder (a scene file is untrusted input).
+    #[arg(long)]
+    pub read_anywhere: bool,
+    /// The largest file read for the scene (the scene file or standard input, each glTF buffer, each
+    /// MTL library): a number of bytes, or with a unit (`512MB`, `2GiB`; K, M, G, T are powers of 1000,
+    /// KiB, MiB, GiB, TiB of 1024). Memory grows with the scene, so this bounds it too.
+    #[arg(long, value_name = "SIZE", default_value = "256MiB", value_parser = parse_size)]
+    pub max_file_size: u64,
+}
+
+impl ReadArgs {
+    /// The reading policy these flags ask for: where references may point, how large a file may be.
+    pub fn policy(&self) -> ReadPolicy {
+        ReadPolicy {
+            reach: if self.read_anywhere {
+                Reach::Anywhere
+            } else {
+                Reach::SceneFolder
+            },
+            max_bytes: self.max_file_size,
+        }
+    }
 }
 
 /// Options of every command that casts lines and measures them: how the scene is read, the seed, how
@@ -215,6 +251,43 @@ fn parse_tolerance(s: &str) -> Result<f64, String> {
     }
 }
 
+/// A size in bytes: a whole number (`1e9` too), or a number with a unit: K, M, G, T (powers of 1000,
+/// a trailing `B` allowed) or KiB, MiB, GiB, TiB (powers of 1024), in any case.
+pub fn parse_size(s: &str) -> Result<u64, String> {
+    let t = s.trim();
+    let split = t
+        .find(|c: char| c.is_ascii_alphabetic() && c != 'e' && c != 'E')
+        .unwrap_or(t.len());
+    let (number, unit) = t.split_at(split);
+    let scale: f64 = match unit.to_ascii_lowercase().as_str() {
+        "" | "b" => 1.0,
+        "k" | "kb" => 1e3,
+        "m" | "mb" => 1e6,
+        "g" | "gb" => 1e9,
+        "t" | "tb" => 1e12,
+        "kib" => 1024.0,
+        "mib" => 1024.0 * 1024.0,
+        "gib" => 1024.0 * 1024.0 * 1024.0,
+        "tib" => 1024.0 * 1024.0 * 1024.0 * 1024.0,
+        _ => {
+            return Err(format!(
+                "`{s}`: unknown unit `{unit}`; use bytes, K, M, G, T (powers of 1000) or KiB, MiB, GiB, \
+                 TiB (powers of 1024)"
+            ))
+        }
+    };
+    let value = number
+        .trim()
+        .parse::<f64>()
+        .ok()
+        .map(|v| v * scale)
+        .filter(|v| v.is_finite() && *v >= 1.0 && *v <= 1e18)
+        .ok_or_else(|| {
+            format!("`{s}`: need a size from 1 byte to 1e18 bytes, such as 512MB or 2GiB")
+        })?;
+    Ok(value.round() as u64)
+}
+
 /// A positive number (seconds, a standard error).
 pub fn parse_positive(s: &str) -> Result<f64, String> {
     match s.trim().parse::<f64>() {
@@ -268,5 +341,15 @@ mod tests {
         assert!(parse_count("1.5").is_err());
         assert_eq!(parse_threads("0"), Ok(0));
         assert!(parse_positive("-1").unwrap_err().contains("positive"));
+        assert_eq!(parse_size("256MiB"), Ok(256 << 20));
+        assert_eq!(parse_size("2GB"), Ok(2_000_000_000));
+        assert_eq!(parse_size("1e9"), Ok(1_000_000_000));
+        assert_eq!(parse_size("1.5 kib"), Ok(1536));
+        assert_eq!(parse_size("100"), Ok(100));
+        assert!(parse_size("2 parsecs")
+            .unwrap_err()
+            .contains("unknown unit"));
+        assert!(parse_size("-1GB").is_err());
+        assert!(parse_size("0").is_err());
     }
 }

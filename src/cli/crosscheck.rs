@@ -45,7 +45,7 @@ pub fn run(args: &CrosscheckArgs) -> Result<Exit, Failure> {
         )));
     }
     check_all(args.out.output.as_deref())?;
-    let scene = load_scene(&args.scene, &args.input.options())?;
+    let scene = load_scene(&args.scene, &args.input.options(), &args.input.policy())?;
     let embree = make_tracer(Backend::Embree, &scene, Query::Single).map_err(Failure::bad_input)?;
     let rust = make_tracer(Backend::Rust, &scene, Query::Single).map_err(Failure::bad_input)?;
     let (_, pool) = thread_pool(args.threads.value)?;

@@ -31,7 +31,7 @@ pub fn run(args: &ExportArgs) -> Result<Exit, Failure> {
     } else {
         check_all([args.output.as_path(), mtl.as_path()])?;
     }
-    let scene = load_scene(&args.scene, &args.input.options())?;
+    let scene = load_scene(&args.scene, &args.input.options(), &args.input.policy())?;
     let written = if gltf {
         write_gltf(&scene, &args.output)
     } else {

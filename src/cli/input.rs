@@ -1,40 +1,55 @@
 //! Reading a scene: a built-in (`@cube:10`), a file, or `-` for standard input.
 
-use std::io::Read;
 use std::path::Path;
 
-use scene_complexity::{load_obj_text, load_with, Scene, SceneOptions};
+use scene_complexity::{
+    load_stream, load_with_policy, ReadPolicy, Scene, SceneError, SceneOptions,
+};
 
-use super::exit::{Exit, Failure};
+use super::exit::Failure;
 use super::output::warn;
 
-/// Loads the scene a command names, read as `options` ask, printing its loading warnings; bad input is
-/// exit code 2.
-pub fn load_scene(spec: &str, options: &SceneOptions) -> Result<Scene, Failure> {
-    let scene = if spec == "-" {
-        from_stdin(options)?
-    } else {
-        load_with(spec, options).map_err(|e| Failure::bad_input(e.to_string()))?
-    };
+/// Loads the scene a command names, read as `options` ask and touching only what `policy` lets it,
+/// printing its loading warnings; bad input is exit code 2.
+pub fn load_scene(
+    spec: &str,
+    options: &SceneOptions,
+    policy: &ReadPolicy,
+) -> Result<Scene, Failure> {
+    let scene = quietly(spec, || {
+        if spec == "-" {
+            // A scene on standard input names its files relative to the current folder.
+            let stdin = std::io::stdin().lock();
+            load_stream("<stdin>", stdin, Path::new(""), options, policy)
+        } else {
+            load_with_policy(spec, options, policy)
+        }
+    })
+    .map_err(|e| Failure::bad_input(e.to_string()))?;
     for w in &scene.warnings {
         warn(w);
     }
     Ok(scene)
 }
 
-/// An OBJ scene from standard input; an `mtllib` is looked for in the current folder.
-fn from_stdin(options: &SceneOptions) -> Result<Scene, Failure> {
-    let mut text = String::new();
-    std::io::stdin()
-        .read_to_string(&mut text)
-        .map_err(|e| Failure {
-            code: Exit::Io,
-            message: format!("cannot read the scene from standard input: {e}"),
-        })?;
-    let materials = |mtl: &Path| {
-        let text = std::fs::read_to_string(mtl).map_err(|e| e.to_string())?;
-        Ok((mtl.display().to_string(), text))
-    };
-    load_obj_text("<stdin>", &text, &materials, options)
-        .map_err(|e| Failure::bad_input(e.to_string()))
+/// Runs a scene reader with Rust's panic message switched off: the readers turn a panic in a dependency
+/// into an error of their own (the glTF reader) and this catches any other, so that the user sees one
+/// clear message and never a panic's text or backtrace. Reading happens before any other thread of the
+/// run starts, so the process-wide hook is this reading's alone while it is swapped.
+fn quietly(
+    spec: &str,
+    read: impl FnOnce() -> Result<Scene, SceneError>,
+) -> Result<Scene, SceneError> {
+    let previous = std::panic::take_hook();
+    std::panic::set_hook(Box::new(|_| {}));
+    let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(read));
+    std::panic::set_hook(previous);
+    result.unwrap_or_else(|_| {
+        Err(SceneError::Geometry {
+            scene: spec.to_string(),
+            message: "scx failed to read it (an internal error in a scene reader); please report \
+                      the file"
+                .into(),
+        })
+    })
 }

@@ -7,7 +7,7 @@ use scene_complexity::finish;
 use scene_complexity::{RunSpec, RunState, SavedRun, StopReason};
 
 use super::analyze::{check_same_scene, persist_failure};
-use super::args::{ReportOutput, Threads};
+use super::args::{ReadArgs, ReportOutput, Threads};
 use super::exit::{Exit, Failure};
 use super::output::{self, check_all, warn};
 use super::patch_files::PatchFiles;
@@ -34,6 +34,8 @@ pub struct MergeArgs {
     save: Option<PathBuf>,
     #[command(flatten)]
     threads: Threads,
+    #[command(flatten)]
+    reading: ReadArgs,
     /// Output format, as for `scx analyze`.
     #[arg(long, value_enum, default_value_t = Format::Table)]
     format: Format,
@@ -146,7 +148,7 @@ pub fn run(args: &MergeArgs) -> Result<Exit, Failure> {
         .unwrap_or_else(|| identity.scene.name.clone());
     let runner = Runner::with(
         &name,
-        &identity.scene.reading,
+        (&identity.scene.reading, &args.reading.policy()),
         identity.tracing,
         args.threads.value,
     )?;

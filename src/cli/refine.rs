@@ -60,7 +60,7 @@ enum StrategyArg {
 pub fn run(args: &RefineArgs) -> Result<Exit, Failure> {
     let mtl = args.output.with_extension("mtl");
     check_all([args.output.as_path(), mtl.as_path()])?;
-    let scene = load_scene(&args.scene, &args.input.options())?;
+    let scene = load_scene(&args.scene, &args.input.options(), &args.input.policy())?;
     let backend = TracerArg::backend(args.tracer.value);
     // Check the backend once up front, so that an unavailable one is a clear input error.
     make_tracer(backend, &scene, Query::Single).map_err(Failure::bad_input)?;

@@ -4,8 +4,8 @@ use std::sync::Arc;
 
 use scene_complexity::{analyze, Analysis};
 use scene_complexity::{make_tracer, Tracer};
+use scene_complexity::{ReadPolicy, Scene, SceneOptions};
 use scene_complexity::{RunControl, RunSpec, Tracing};
-use scene_complexity::{Scene, SceneOptions};
 
 use super::args::RunOptions;
 use super::exit::{Exit, Failure};
@@ -28,21 +28,21 @@ impl Runner {
     pub fn new(name: &str, opts: &RunOptions) -> Result<Runner, Failure> {
         Runner::with(
             name,
-            &opts.input.options(),
+            (&opts.input.options(), &opts.input.policy()),
             opts.tracing(),
             opts.threads.value,
         )
     }
 
-    /// Loads the scene `name` read as `reading` asks, and builds the tracer `tracing` asks for and a
-    /// pool of `threads` threads.
+    /// Loads the scene `name` read as `reading` asks (its options, and what the reading may touch), and
+    /// builds the tracer `tracing` asks for and a pool of `threads` threads.
     pub fn with(
         name: &str,
-        reading: &SceneOptions,
+        (options, policy): (&SceneOptions, &ReadPolicy),
         tracing: Tracing,
         threads: Option<usize>,
     ) -> Result<Runner, Failure> {
-        let scene = load_scene(name, reading)?;
+        let scene = load_scene(name, options, policy)?;
         let tracer =
             make_tracer(tracing.backend, &scene, tracing.query).map_err(Failure::bad_input)?;
         let (threads, pool) = thread_pool(threads)?;

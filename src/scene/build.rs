@@ -273,7 +273,8 @@ impl SceneBuilder {
                         options.planarity.tolerance
                     )));
                 }
-                let pieces = planar_pieces(&pts);
+                let pieces = planar_pieces(&pts)
+                    .map_err(|e| self.geometry_error(format!("{}: {e}", poly.origin)))?;
                 splits.add(&poly.origin, deviation, pieces.len());
                 let mut any = false;
                 for piece in pieces {
@@ -289,12 +290,14 @@ impl SceneBuilder {
                 }
                 any
             } else {
+                let triangles = triangulate(&pts)
+                    .map_err(|e| self.geometry_error(format!("{}: {e}", poly.origin)))?;
                 add_patch(
                     &mut scene,
                     &traced,
                     poly,
                     &poly.vertices,
-                    &triangulate(&pts),
+                    &triangles,
                     &mut dropped_triangles,
                 )
             };
@@ -413,7 +416,16 @@ impl SceneBuilder {
             .iter()
             .map(|&p| (p - center).length())
             .fold(0.0f64, f64::max);
-        if !(radius > 0.0 && radius.is_finite()) {
+        if !radius.is_finite() {
+            // Each coordinate is finite (checked before), but the extent is beyond f64's range.
+            return Err(self.geometry_error(format!(
+                "the scene is too large to measure: its bounding box runs from ({:e}, {:e}, {:e}) to \
+                 ({:e}, {:e}, {:e}), and the radius of its bounding sphere is beyond the range of 64-bit \
+                 numbers (rescale it)",
+                lo.x, lo.y, lo.z, hi.x, hi.y, hi.z
+            )));
+        }
+        if radius <= 0.0 {
             return Err(self.geometry_error(format!(
                 "the scene has no extent (bounding radius {radius})"
             )));

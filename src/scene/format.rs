@@ -1,7 +1,9 @@
 //! Which format a scene file is in, from its content (the extension only breaks a tie), and loading it.
 
+use std::io::Read;
 use std::path::Path;
 
+use super::read::{self, Folder, ReadPolicy};
 use super::stl::is_binary_stl;
 use super::{gltf, obj, ply, stl, Scene, SceneError, SceneOptions};
 
@@ -23,6 +25,11 @@ pub enum Format {
 }
 
 impl Format {
+    /// Whether files of this format are text (PLY may be either; its header is text).
+    pub fn is_text(self) -> bool {
+        matches!(self, Format::Obj | Format::Gltf | Format::StlAscii)
+    }
+
     /// A name for messages.
     pub fn name(self) -> &'static str {
         match self {
@@ -90,33 +97,193 @@ fn looks_like_obj(text: &str) -> bool {
         .any(|l| KEYWORDS.contains(&l.split_whitespace().next().unwrap_or("")))
 }
 
-/// Loads a scene file in any format scx reads, found from its content ([`detect`]).
+/// Loads a scene file in any format scx reads, found from its content ([`detect`]), under the default
+/// [`ReadPolicy`].
 pub fn load_file(path: &Path, options: &SceneOptions) -> Result<Scene, SceneError> {
+    load_file_with_policy(path, options, &ReadPolicy::default())
+}
+
+/// [`load_file`] under a reading policy: the file and those it names are regular files within the size
+/// limit, and what it names is read inside its folder unless the policy reaches further.
+pub fn load_file_with_policy(
+    path: &Path,
+    options: &SceneOptions,
+    policy: &ReadPolicy,
+) -> Result<Scene, SceneError> {
     let shown = path.display().to_string();
-    let file_error = |message: String| SceneError::in_file(&shown, message);
-    if !path.exists() {
-        return Err(file_error("no such file".into()));
-    }
-    if path.is_dir() {
-        return Err(file_error("is a directory, not a scene file".into()));
-    }
-    let bytes =
-        std::fs::read(path).map_err(|e| file_error(format!("cannot read the file: {e}")))?;
+    let bytes = read::read_scene_file(path, policy.max_bytes)
+        .map_err(|m| SceneError::in_file(&shown, m))?;
+    load_detected(
+        &shown,
+        bytes,
+        path,
+        &Folder::of_file(path, *policy),
+        options,
+    )
+}
+
+/// Loads a scene from bytes in any format scx reads ([`detect`]), called `shown` in messages and object
+/// names; the files it names are read in `folder` under `policy`.
+pub fn load_bytes(
+    shown: &str,
+    bytes: Vec<u8>,
+    folder: &Path,
+    options: &SceneOptions,
+    policy: &ReadPolicy,
+) -> Result<Scene, SceneError> {
+    let folder = Folder::new(folder, *policy);
+    load_detected(shown, bytes, Path::new(shown), &folder, options)
+}
+
+/// [`load_bytes`] for a stream such as standard input: read up to the policy's size limit, and no
+/// further than its first bytes allow (a stream that starts in no format scx reads is refused after
+/// its first 64 KiB, not read to the limit).
+pub fn load_stream(
+    shown: &str,
+    stream: impl Read,
+    folder: &Path,
+    options: &SceneOptions,
+    policy: &ReadPolicy,
+) -> Result<Scene, SceneError> {
+    let bytes = read_stream(stream, Path::new(shown), policy.max_bytes)
+        .map_err(|m| SceneError::in_file(shown, m))?;
+    load_bytes(shown, bytes, folder, options, policy)
+}
+
+/// Loads bytes as the given format (no detection), as [`load_bytes`] does: for readers of one format
+/// (the fuzz targets).
+pub fn load_as(
+    format: Format,
+    shown: &str,
+    bytes: &[u8],
+    folder: &Path,
+    options: &SceneOptions,
+    policy: &ReadPolicy,
+) -> Result<Scene, SceneError> {
+    let folder = Folder::new(folder, *policy);
+    load_format(format, shown, bytes, Path::new(shown), &folder, options)
+}
+
+/// Loads bytes in the format [`detect`] finds; `path` names single-object scenes (PLY, STL).
+fn load_detected(
+    shown: &str,
+    bytes: Vec<u8>,
+    path: &Path,
+    folder: &Folder,
+    options: &SceneOptions,
+) -> Result<Scene, SceneError> {
+    let file_error = |message: String| SceneError::in_file(shown, message);
     let format = detect(&bytes).ok_or_else(|| file_error(unknown_format(path, &bytes)))?;
+    if format == Format::Obj {
+        let text = String::from_utf8(bytes).map_err(|e| {
+            file_error(format!(
+                "not a text file (invalid UTF-8 at byte {})",
+                e.utf8_error().valid_up_to()
+            ))
+        })?;
+        return obj::load_obj_text(shown, &text, folder, options);
+    }
+    load_format(format, shown, &bytes, path, folder, options)
+}
+
+/// Loads bytes as `format`.
+fn load_format(
+    format: Format,
+    shown: &str,
+    bytes: &[u8],
+    path: &Path,
+    folder: &Folder,
+    options: &SceneOptions,
+) -> Result<Scene, SceneError> {
     match format {
         Format::Obj => {
-            let text = String::from_utf8(bytes).map_err(|e| {
-                file_error(format!(
-                    "not a text file (invalid UTF-8 at byte {})",
-                    e.utf8_error().valid_up_to()
-                ))
+            let text = std::str::from_utf8(bytes).map_err(|e| {
+                SceneError::in_file(
+                    shown,
+                    format!(
+                        "not a text file (invalid UTF-8 at byte {})",
+                        e.valid_up_to()
+                    ),
+                )
             })?;
-            obj::load_obj_text(&shown, &text, path, options)
+            obj::load_obj_text(shown, text, folder, options)
         }
-        Format::Gltf | Format::Glb => gltf::load_bytes(&shown, &bytes, path, options),
-        Format::Ply => ply::load_bytes(&shown, &bytes, path, options),
-        Format::StlAscii | Format::StlBinary => stl::load_bytes(&shown, &bytes, path, options),
+        Format::Gltf | Format::Glb => gltf::load_bytes(shown, bytes, folder, options),
+        Format::Ply => ply::load_bytes(shown, bytes, path, options),
+        Format::StlAscii | Format::StlBinary => stl::load_bytes(shown, bytes, path, options),
     }
+}
+
+/// How much of a stream is read before deciding whether it can be a scene at all.
+const STREAM_HEAD: u64 = 64 << 10;
+
+/// Reads a stream up to `max_bytes`. After its first [`STREAM_HEAD`] bytes, a stream in no format scx
+/// reads is refused at once, and a binary STL (the one format told by its size) is read only up to the
+/// size its header gives.
+fn read_stream(stream: impl Read, path: &Path, max_bytes: u64) -> Result<Vec<u8>, String> {
+    let cannot = |e: std::io::Error| format!("cannot read it: {e}");
+    let mut stream = stream;
+    let mut bytes = Vec::new();
+    (&mut stream)
+        .take(STREAM_HEAD.min(max_bytes + 1))
+        .read_to_end(&mut bytes)
+        .map_err(cannot)?;
+    if (bytes.len() as u64) < STREAM_HEAD {
+        return within(bytes, max_bytes);
+    }
+    let limit = match detect(&bytes) {
+        Some(format) if format.is_text() => {
+            text_head(&bytes)?;
+            max_bytes
+        }
+        Some(_) => max_bytes,
+        None => match stl_size(&bytes) {
+            Some(size) if size <= max_bytes => size,
+            _ => return Err(unknown_format(path, &bytes)),
+        },
+    };
+    stream
+        .take((limit + 1).saturating_sub(bytes.len() as u64))
+        .read_to_end(&mut bytes)
+        .map_err(cannot)?;
+    within(bytes, max_bytes)
+}
+
+/// The first bytes of a stream in a text format must be text: valid UTF-8 (but for a character cut at
+/// the end) without NUL bytes. Anything else is refused before more is read (random bytes whose start
+/// is not even UTF-8 would otherwise be read to the size limit as an OBJ).
+fn text_head(head: &[u8]) -> Result<(), String> {
+    let valid = match std::str::from_utf8(head) {
+        Ok(_) => head.len(),
+        Err(e) if e.error_len().is_none() => e.valid_up_to(),
+        Err(e) => {
+            return Err(format!(
+                "not a text file (invalid UTF-8 at byte {})",
+                e.valid_up_to()
+            ))
+        }
+    };
+    match head[..valid].iter().position(|&b| b == 0) {
+        Some(at) => Err(format!("not a text file (a NUL byte at byte {at})")),
+        None => Ok(()),
+    }
+}
+
+/// Bytes read from a stream, refused when over the size limit.
+fn within(bytes: Vec<u8>, max_bytes: u64) -> Result<Vec<u8>, String> {
+    if bytes.len() as u64 > max_bytes {
+        return Err(format!(
+            "it holds more than the {} scx reads (--max-file-size raises the limit)",
+            read::size_text(max_bytes)
+        ));
+    }
+    Ok(bytes)
+}
+
+/// The size a binary STL with this header has: 84 bytes and 50 per triangle its count gives.
+fn stl_size(bytes: &[u8]) -> Option<u64> {
+    let count = bytes.get(80..84)?;
+    Some(84 + 50 * u64::from(u32::from_le_bytes(count.try_into().ok()?)))
 }
 
 /// Why a file is in no format scx reads, naming what it looks like.
@@ -144,10 +311,15 @@ fn unknown_format(path: &Path, bytes: &[u8]) -> String {
         .is_some_and(|e| e.eq_ignore_ascii_case("stl"));
     if stl && bytes.len() >= 84 {
         let count = u32::from_le_bytes([bytes[80], bytes[81], bytes[82], bytes[83]]) as u64;
+        let expected = 84 + 50 * count;
+        let why = if (bytes.len() as u64) < expected {
+            "cut short?"
+        } else {
+            "more bytes than its triangles need: a wrong count, or data after the triangles"
+        };
         return format!(
-            "a binary STL of the wrong size: its header says {count} triangles ({} bytes), the file has \
-             {} bytes (cut short?)",
-            84 + 50 * count,
+            "a binary STL of the wrong size: its header says {count} triangles ({expected} bytes), \
+             the file has {} bytes ({why})",
             bytes.len()
         );
     }

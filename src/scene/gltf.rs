@@ -14,9 +14,12 @@
 use std::path::Path;
 
 use ::gltf::mesh::Mode;
+use ::gltf::Semantic;
 use base64::Engine as _;
 use serde_json::json;
 
+use super::gltf_data::{self, Budget, Data};
+use super::read::Folder;
 use super::{Material, Scene, SceneBuilder, SceneError, SceneOptions, Sides};
 
 type Matrix = [[f64; 4]; 4];
@@ -28,21 +31,22 @@ const IDENTITY: Matrix = [
     [0.0, 0.0, 0.0, 1.0],
 ];
 
-/// Loads glTF bytes (JSON or binary) read from `path` (external buffers are looked up beside it).
+/// Loads glTF bytes (JSON or binary); external buffers are read in `folder`, as its policy allows.
 pub(crate) fn load_bytes(
     shown: &str,
     bytes: &[u8],
-    path: &Path,
+    folder: &Folder,
     options: &SceneOptions,
 ) -> Result<Scene, SceneError> {
-    // The gltf crate validates indices between its objects, but a reader of untrusted files should not
-    // take down the program if one of its accessors does not: any panic becomes a clear error.
-    let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
-    let result = std::panic::catch_unwind(|| load_document(shown, bytes, &base, options));
+    // Every range and index is checked before it is used (gltf_data), so nothing here should panic; a
+    // reader of untrusted files still keeps a panic in a dependency from taking the program down.
+    let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        load_document(shown, bytes, folder, options)
+    }));
     result.unwrap_or_else(|_| {
         Err(SceneError::File {
             path: shown.to_string(),
-            message: "malformed glTF: its accessors do not fit its buffers".into(),
+            message: "malformed glTF: the glTF reader failed on it".into(),
         })
     })
 }
@@ -50,35 +54,48 @@ pub(crate) fn load_bytes(
 fn load_document(
     shown: &str,
     bytes: &[u8],
-    base: &Path,
+    folder: &Folder,
     options: &SceneOptions,
 ) -> Result<Scene, SceneError> {
     let file_error = |message: String| SceneError::in_file(shown, message);
-    let gltf = ::gltf::Gltf::from_slice(bytes)
-        .map_err(|e| file_error(format!("not a readable glTF 2.0 file: {e}")))?;
-    let buffers = gltf
-        .buffers()
-        .map(|buffer| buffer_data(&gltf, &buffer, base))
-        .collect::<Result<Vec<Vec<u8>>, String>>()
-        .map_err(file_error)?;
+    check_glb_header(bytes).map_err(file_error)?;
+    let unreadable = |e: ::gltf::Error| file_error(format!("not a readable glTF 2.0 file: {e}"));
+    let raw = ::gltf::Gltf::from_slice_without_validation(bytes).map_err(unreadable)?;
+    // gltf-json's validation indexes the accessors with each POSITION attribute unchecked: check
+    // those indices first, then validate as `Gltf::from_slice` does.
+    check_position_accessors(raw.document.as_json()).map_err(file_error)?;
+    let gltf = ::gltf::Gltf {
+        document: ::gltf::Document::from_json(raw.document.into_json()).map_err(unreadable)?,
+        blob: raw.blob,
+    };
+    let root = gltf.document.as_json();
+    check_version(&root.asset).map_err(file_error)?;
+    let buffers = gltf_data::buffers(&gltf, folder).map_err(file_error)?;
+    let data = Data {
+        root,
+        buffers: &buffers,
+    };
+    let mut budget = Budget::new(folder.policy().max_bytes);
 
     let mut b = SceneBuilder::new(shown);
     let mut materials: Vec<Option<u32>> = vec![None; gltf.materials().len()];
     let mut default_material = None;
     let mut textured = Vec::new();
-    let roots: Vec<::gltf::Node> = match gltf.default_scene().or_else(|| gltf.scenes().next()) {
-        Some(scene) => scene.nodes().collect(),
-        None => gltf.nodes().collect(),
+    let roots: Vec<usize> = match gltf.default_scene().or_else(|| gltf.scenes().next()) {
+        Some(scene) => scene.nodes().map(|n| n.index()).collect(),
+        None => gltf_data::parentless_nodes(root),
     };
-    // Depth first in document order (a stack, so pushed in reverse): objects come in the file's order.
-    let mut stack: Vec<(::gltf::Node, Matrix)> =
-        roots.into_iter().rev().map(|n| (n, IDENTITY)).collect();
+    // Depth first in document order: objects come in the file's order.
+    let tree = gltf_data::node_tree(root, &roots).map_err(file_error)?;
+    let nodes: Vec<::gltf::Node> = gltf.nodes().collect();
+    let mut worlds: Vec<Matrix> = Vec::with_capacity(tree.len());
     let mut primitives_seen = 0usize;
     let mut skipped_modes = 0usize;
-    while let Some((node, parent)) = stack.pop() {
+    for &(k, parent_at) in &tree {
+        let node = &nodes[k];
+        let parent = parent_at.map_or(IDENTITY, |p| worlds[p]);
         let world = multiply(&parent, &to_f64(node.transform().matrix()));
-        let children: Vec<::gltf::Node> = node.children().collect();
-        stack.extend(children.into_iter().rev().map(|child| (child, world)));
+        worlds.push(world);
         let Some(mesh) = node.mesh() else {
             continue;
         };
@@ -106,34 +123,47 @@ fn load_document(
             } else {
                 Sides::Front
             };
-            let reader = primitive.reader(|buffer| buffers.get(buffer.index()).map(Vec::as_slice));
-            let Some(positions) = reader.read_positions() else {
-                return Err(file_error(format!(
-                    "mesh `{name}` primitive {}: no POSITION attribute",
+            let at = |message: String| {
+                file_error(format!(
+                    "mesh `{name}` primitive {}: {message}",
                     primitive.index()
-                )));
+                ))
             };
-            let ids: Vec<u32> = positions
+            let Some(positions) = primitive.get(&Semantic::Positions) else {
+                return Err(at("no POSITION attribute".into()));
+            };
+            let ids: Vec<u32> = data
+                .positions(positions.index(), &mut budget)
+                .map_err(at)?
+                .into_iter()
                 .map(|p| b.vertex(transform_point(&world, p)))
                 .collect();
-            let indices: Vec<u32> = match reader.read_indices() {
-                Some(i) => i.into_u32().collect(),
+            let indices: Vec<u32> = match primitive.indices() {
+                Some(i) => data.indices(i.index(), &mut budget).map_err(at)?,
                 None => (0..ids.len() as u32).collect(),
             };
-            let Some(triangles) = triangles(primitive.mode(), &indices) else {
+            let mode = primitive.mode();
+            if mode == Mode::Triangles && indices.len() % 3 != 0 {
+                let what = if primitive.indices().is_some() {
+                    "indices"
+                } else {
+                    "vertices and no indices"
+                };
+                return Err(at(format!(
+                    "{} {what}: a list of triangles needs a multiple of 3",
+                    indices.len()
+                )));
+            }
+            let Some(triangles) = triangles(mode, &indices) else {
                 skipped_modes += 1;
                 continue;
             };
             for (k, t) in triangles.into_iter().enumerate() {
                 let mut corners = [0u32; 3];
                 for (c, &i) in corners.iter_mut().zip(&t) {
-                    *c = *ids.get(i as usize).ok_or_else(|| {
-                        file_error(format!(
-                            "mesh `{name}` primitive {}: index {i} past its {} vertices",
-                            primitive.index(),
-                            ids.len()
-                        ))
-                    })?;
+                    *c = *ids
+                        .get(i as usize)
+                        .ok_or_else(|| at(format!("index {i} past its {} vertices", ids.len())))?;
                 }
                 if mirrored {
                     corners.swap(1, 2);
@@ -163,69 +193,65 @@ fn load_document(
     b.build_with(options)
 }
 
-/// A buffer's bytes: the binary chunk of a .glb, a base64 data URI, or a file beside the glTF.
-fn buffer_data(
-    gltf: &::gltf::Gltf,
-    buffer: &::gltf::Buffer,
-    base: &Path,
-) -> Result<Vec<u8>, String> {
-    let data = match buffer.source() {
-        ::gltf::buffer::Source::Bin => gltf.blob.clone().ok_or_else(|| {
-            format!(
-                "buffer {} is the binary chunk, which is missing",
-                buffer.index()
-            )
-        })?,
-        ::gltf::buffer::Source::Uri(uri) if uri.starts_with("data:") => {
-            let (_, payload) = uri.split_once(";base64,").ok_or_else(|| {
-                format!("buffer {}: a data URI that is not base64", buffer.index())
-            })?;
-            base64::engine::general_purpose::STANDARD
-                .decode(payload)
-                .map_err(|e| {
-                    format!("buffer {}: bad base64 in its data URI: {e}", buffer.index())
-                })?
-        }
-        ::gltf::buffer::Source::Uri(uri) => {
-            let file = base.join(percent_decode(uri));
-            std::fs::read(&file).map_err(|e| {
-                format!(
-                    "buffer {}: cannot read `{}`: {e}",
-                    buffer.index(),
-                    file.display()
-                )
-            })?
-        }
-    };
-    if data.len() < buffer.length() {
-        return Err(format!(
-            "buffer {} has {} bytes, the file says {}",
-            buffer.index(),
-            data.len(),
-            buffer.length()
-        ));
-    }
-    Ok(data)
-}
-
-/// A relative URI's path with its `%XX` escapes decoded (glTF URIs are percent-encoded).
-fn percent_decode(uri: &str) -> String {
-    let bytes = uri.as_bytes();
-    let mut out = Vec::with_capacity(bytes.len());
-    let mut k = 0;
-    while k < bytes.len() {
-        let hex = |b: u8| (b as char).to_digit(16);
-        if bytes[k] == b'%' && k + 2 < bytes.len() {
-            if let (Some(h), Some(l)) = (hex(bytes[k + 1]), hex(bytes[k + 2])) {
-                out.push((h * 16 + l) as u8);
-                k += 3;
+/// Every POSITION attribute names an accessor that exists.
+fn check_position_accessors(root: &::gltf::json::Root) -> Result<(), String> {
+    let positions = ::gltf::json::validation::Checked::Valid(Semantic::Positions);
+    for (m, mesh) in root.meshes.iter().enumerate() {
+        for (p, primitive) in mesh.primitives.iter().enumerate() {
+            let Some(k) = primitive.attributes.get(&positions) else {
                 continue;
+            };
+            if k.value() >= root.accessors.len() {
+                return Err(format!(
+                    "mesh {m} primitive {p}: its POSITION accessor {} does not exist (the file has {})",
+                    k.value(),
+                    root.accessors.len()
+                ));
             }
         }
-        out.push(bytes[k]);
-        k += 1;
     }
-    String::from_utf8_lossy(&out).into_owned()
+    Ok(())
+}
+
+/// The length a .glb's header gives must cover the header itself (the gltf crate subtracts the one from
+/// the other unchecked).
+fn check_glb_header(bytes: &[u8]) -> Result<(), String> {
+    if !bytes.starts_with(b"glTF") {
+        return Ok(());
+    }
+    let Some(length) = bytes.get(8..12) else {
+        return Err(format!(
+            "a .glb of {} bytes, shorter than its 12-byte header",
+            bytes.len()
+        ));
+    };
+    let length = u32::from_le_bytes([length[0], length[1], length[2], length[3]]);
+    if length < 12 {
+        return Err(format!(
+            "a .glb whose header gives a length of {length} bytes, less than the header's own 12"
+        ));
+    }
+    Ok(())
+}
+
+/// A glTF 2.x asset: glTF 1.0 is another format (the gltf crate would read its JSON as 2.0 and find
+/// nonsense), and a `minVersion` above 2.0 asks for features scx does not know.
+fn check_version(asset: &::gltf::json::Asset) -> Result<(), String> {
+    let major = |v: &str| v.split('.').next().map(str::to_string);
+    if major(&asset.version).as_deref() != Some("2") {
+        return Err(format!(
+            "glTF version `{}`: scx reads glTF 2.0",
+            asset.version
+        ));
+    }
+    if let Some(min) = asset.min_version.as_deref() {
+        if min != "2.0" {
+            return Err(format!(
+                "the file needs a reader of glTF {min} (its minVersion): scx reads glTF 2.0"
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// The triangles of a primitive's index list (`None` for points and lines).
@@ -513,7 +539,5 @@ mod tests {
         let mut mirror = IDENTITY;
         mirror[2][2] = -1.0;
         assert!(determinant3(&multiply(&m, &mirror)) < 0.0);
-        assert_eq!(percent_decode("my%20scene.bin"), "my scene.bin");
-        assert_eq!(percent_decode("100%"), "100%");
     }
 }

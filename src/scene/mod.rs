@@ -8,12 +8,15 @@
 mod build;
 pub mod format;
 pub mod gltf;
+mod gltf_data;
 pub mod obj;
 mod obj_check;
 mod ply;
+pub mod read;
 mod stl;
 
 pub use build::{ObjectSet, Planarity, SceneBuilder, SceneOptions, Sides, DEFAULT_PLANARITY};
+pub use read::{Reach, ReadPolicy, DEFAULT_MAX_BYTES};
 
 use std::fmt;
 

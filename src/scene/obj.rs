@@ -6,6 +6,7 @@
 
 use std::path::Path;
 
+use super::read::{self, Fetched, Folder, ReadPolicy, RefError};
 use super::{Material, Scene, SceneBuilder, SceneError, SceneOptions};
 
 /// Loads an OBJ file (and its MTL library, if any, beside it) as a scene.
@@ -15,65 +16,112 @@ pub fn load(path: &Path) -> Result<Scene, SceneError> {
 
 /// [`load`] with options (planarity, flipped and two-sided objects).
 pub fn load_with(path: &Path, options: &SceneOptions) -> Result<Scene, SceneError> {
+    load_with_policy(path, options, &ReadPolicy::default())
+}
+
+/// [`load_with`] under a reading policy: the OBJ and its libraries are regular files within the size
+/// limit, and its libraries are read inside its folder unless the policy reaches further.
+pub fn load_with_policy(
+    path: &Path,
+    options: &SceneOptions,
+    policy: &ReadPolicy,
+) -> Result<Scene, SceneError> {
     let shown = path.display().to_string();
     let file_error = |message: String| SceneError::in_file(&shown, message);
-    if !path.exists() {
-        return Err(file_error("no such file".into()));
-    }
-    if path.is_dir() {
-        return Err(file_error("is a directory, not an OBJ file".into()));
-    }
-    let bytes =
-        std::fs::read(path).map_err(|e| file_error(format!("cannot read the file: {e}")))?;
+    let bytes = read::read_scene_file(path, policy.max_bytes).map_err(file_error)?;
     let text = String::from_utf8(bytes).map_err(|e| {
         file_error(format!(
             "not a text file (invalid UTF-8 at byte {})",
             e.utf8_error().valid_up_to()
         ))
     })?;
-    load_obj_text(&shown, &text, path, options)
+    load_obj_text(&shown, &text, &Folder::of_file(path, *policy), options)
 }
 
-/// Loads OBJ text read from `path` (its MTL libraries are looked up beside it).
+/// Loads OBJ text whose MTL libraries are read in `folder`.
 pub(crate) fn load_obj_text(
     shown: &str,
     text: &str,
-    path: &Path,
+    folder: &Folder,
     options: &SceneOptions,
 ) -> Result<Scene, SceneError> {
-    let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
     load_text_with(
         shown,
         text,
-        &|mtl: &Path| read_libraries(&base, mtl),
+        &|mtl: &Path| read_libraries(folder, mtl),
         options,
     )
 }
 
-/// The MTL text an `mtllib` statement names, read beside the OBJ. The statement may list several files
-/// (a space inside a name escaped as `\ `); `tobj` hands over the whole list, so when it is no file,
-/// each listed file that exists is read and their texts are joined.
-fn read_libraries(base: &Path, mtl: &Path) -> Result<(String, String), String> {
-    let full = base.join(mtl);
-    let whole = match std::fs::read_to_string(&full) {
-        Ok(text) => return Ok((full.display().to_string(), text)),
-        Err(e) => e.to_string(),
+/// The reason given when no library of an `mtllib` statement exists (the warning has always said so).
+const NO_LIBRARY: &str = "cannot open the file";
+
+/// The MTL text an `mtllib` statement names, read in the OBJ's folder. The statement may list several
+/// files (a space inside a name escaped as `\ `); `tobj` hands over the whole list, so when it is no
+/// file, each listed file that exists is read and their texts are joined. A library read before gives
+/// no text (its materials are there already). `Err` says why nothing was read.
+fn read_libraries(folder: &Folder, mtl: &Path) -> Result<(String, String), String> {
+    let whole = match read_library(folder, &mtl.to_string_lossy()) {
+        Ok(found) => return Ok(found),
+        Err(why) => why,
     };
     let listed = mtl.to_string_lossy().replace("\\ ", "\u{0}");
-    let found: Vec<(String, String)> = listed
-        .split_whitespace()
-        .map(|name| base.join(name.replace('\u{0}', " ")))
-        .filter_map(|p| {
-            let text = std::fs::read_to_string(&p).ok()?;
-            Some((p.display().to_string(), text))
-        })
-        .collect();
+    let mut refused = None;
+    let mut found: Vec<(String, String)> = Vec::new();
+    for name in listed.split_whitespace() {
+        match read_library(folder, &name.replace('\u{0}', " ")) {
+            Ok(library) => found.push(library),
+            Err(why) if why != NO_LIBRARY => {
+                refused.get_or_insert(why);
+            }
+            Err(_) => {}
+        }
+    }
     if found.is_empty() {
-        return Err(whole);
+        return Err(refused.unwrap_or(whole));
     }
     let names: Vec<&str> = found.iter().map(|(n, _)| n.as_str()).collect();
     let texts: Vec<&str> = found.iter().map(|(_, t)| t.as_str()).collect();
     Ok((names.join(" + "), texts.join("\n")))
+}
+
+/// One MTL library: the name as written, in the OBJ's folder, else (as other readers of OBJ do, for
+/// files written with another machine's paths) its base name there. `Err` is [`NO_LIBRARY`] when
+/// neither exists, else why it was not read.
+fn read_library(folder: &Folder, written: &str) -> Result<(String, String), String> {
+    let as_written = match folder.fetch(Path::new(written)) {
+        Err(RefError::Missing(_)) => NO_LIBRARY.to_string(),
+        Err(e @ RefError::Outside(_)) => e.to_string(),
+        Err(e) => format!("`{written}`: {e}"),
+        Ok(fetched) => return library_text(fetched),
+    };
+    let Some(base) = read::base_name(written) else {
+        return Err(as_written);
+    };
+    match folder.fetch(Path::new(base)) {
+        Ok(fetched) => library_text(fetched),
+        Err(RefError::Missing(_)) if as_written == NO_LIBRARY => Err(NO_LIBRARY.into()),
+        Err(RefError::Missing(_)) => Err(format!(
+            "{as_written}; and there is no `{base}` in the scene's folder"
+        )),
+        Err(e @ RefError::Outside(_)) => Err(e.to_string()),
+        Err(e) => Err(format!("`{base}`: {e}")),
+    }
+}
+
+/// A library's name for messages and its text (empty when the scene named it before).
+fn library_text(fetched: Fetched) -> Result<(String, String), String> {
+    let name = fetched.shown.display().to_string();
+    if !fetched.first {
+        return Ok((name, String::new()));
+    }
+    let text = String::from_utf8(fetched.bytes.to_vec()).map_err(|e| {
+        format!(
+            "`{name}` is not a text file (invalid UTF-8 at byte {})",
+            e.utf8_error().valid_up_to()
+        )
+    })?;
+    Ok((name, text))
 }
 
 /// Where an OBJ's MTL library comes from: given the name in `mtllib`, the library's name for messages
@@ -111,8 +159,13 @@ pub fn load_text_with(
     let mtl_error: std::cell::RefCell<Option<SceneError>> = std::cell::RefCell::new(None);
     // Where each material is defined (library and line), for messages about it.
     let defined: std::cell::RefCell<Vec<(String, String, usize)>> = Default::default();
+    // Why libraries were not read, for the warning (tobj keeps only that one failed).
+    let unread: std::cell::RefCell<Vec<String>> = Default::default();
     let load_mtl = |name: &Path| match materials(name) {
-        Err(_) => Err(tobj::LoadError::OpenFileFailed),
+        Err(why) => {
+            unread.borrow_mut().push(why);
+            Err(tobj::LoadError::OpenFileFailed)
+        }
         Ok((mtl_shown, mtl_text)) => match super::obj_check::scan_mtl(&mtl_shown, &mtl_text) {
             Err(e) => {
                 mtl_error.borrow_mut().get_or_insert(e);
@@ -141,6 +194,7 @@ pub fn load_text_with(
     let mut global_face = 0usize;
 
     let mut b = SceneBuilder::new(shown.clone());
+    let any_library_read = materials.is_ok();
     let material_base = match materials {
         Ok(mats) => {
             let base = 0u32;
@@ -156,14 +210,19 @@ pub fn load_text_with(
             }
         }
         Err(e) => {
+            let why = match e {
+                tobj::LoadError::OpenFileFailed => unread.borrow().first().cloned(),
+                _ => None,
+            };
             b.warn(format!(
                 "{shown}: material library not loaded ({}); every face gets the default material \
                  (reflectance 0.5, no emission)",
-                describe_tobj_error(&e)
+                why.unwrap_or_else(|| describe_tobj_error(&e))
             ));
             None
         }
     };
+    warn_refused_libraries(&mut b, &shown, &unread.take(), any_library_read);
     warn_ignored_statements(&mut b, &shown, &prepared);
     let default_material = b.material(Material::default());
 
@@ -251,6 +310,21 @@ fn no_faces(shown: &str, prepared: &super::obj_check::Prepared) -> SceneError {
                 "the scene is empty: no faces (`f`) in its {lines} line(s), up to this last one"
             ),
         },
+    }
+}
+
+/// One warning for each library that was refused (outside the folder, not a regular file, too large)
+/// while other libraries were read: the faces that use its materials get the default material. When no
+/// library was read, the warning about that says why already.
+fn warn_refused_libraries(b: &mut SceneBuilder, shown: &str, unread: &[String], any_read: bool) {
+    if !any_read {
+        return;
+    }
+    for why in unread.iter().filter(|w| *w != NO_LIBRARY) {
+        b.warn(format!(
+            "{shown}: a material library was not read ({why}); faces using its materials get the \
+             default material (reflectance 0.5, no emission)"
+        ));
     }
 }
 

@@ -29,7 +29,7 @@ pub mod solids;
 use cube_lattice::Fig56Mesh;
 use solids::Solid;
 
-use crate::scene::{format, Scene, SceneBuilder, SceneError, SceneOptions};
+use crate::scene::{format, ReadPolicy, Scene, SceneBuilder, SceneError, SceneOptions};
 
 /// A built-in scene: its name, how to name it, what it is, and how to build it.
 #[derive(Clone, Copy, Debug)]
@@ -50,7 +50,7 @@ pub const CATALOGUE: &[Builtin] = &[
         name: "cube",
         usage: "@cube[:N]",
         description: "unit cube enclosure, each face cut into N x N square patches (N >= 1, default 1)",
-        build: |spec, p| solids::cube(spec, count(spec, p, 1, 2000)?),
+        build: |spec, p| solids::cube(spec, subdivisions(spec, p, 2000, 6)?),
     },
     Builtin {
         name: "sphere",
@@ -152,13 +152,22 @@ pub fn load(spec: &str) -> Result<Scene, SceneError> {
 /// [`load`] with options: the planarity rule, and objects to flip or make two-sided (a built-in is one
 /// object, named after it).
 pub fn load_with(spec: &str, options: &SceneOptions) -> Result<Scene, SceneError> {
+    load_with_policy(spec, options, &ReadPolicy::default())
+}
+
+/// [`load_with`] under a reading policy for scene files (see [`ReadPolicy`]; built-ins read no file).
+pub fn load_with_policy(
+    spec: &str,
+    options: &SceneOptions,
+    policy: &ReadPolicy,
+) -> Result<Scene, SceneError> {
     if spec.starts_with('@') {
         if *options == SceneOptions::default() {
             return build(spec);
         }
         return rebuild(&build(spec)?, options);
     }
-    format::load_file(std::path::Path::new(spec), options)
+    format::load_file_with_policy(std::path::Path::new(spec), options, policy)
 }
 
 /// A built scene built again with options: its patches as polygons (they are planar, so the planarity
@@ -199,7 +208,39 @@ pub fn build(spec: &str) -> Result<Scene, SceneError> {
 
 /// A regular solid with its optional subdivision parameter.
 fn solid(spec: &str, which: Solid, param: Option<&str>) -> Result<Scene, SceneError> {
-    solids::solid(spec, which, count(spec, param, 1, 1000)?)
+    // Triangles per unit of N^2: each face cut into N^2 (a dodecahedron's pentagons into 5 N^2).
+    let per_square = match which {
+        Solid::Tetrahedron => 4,
+        Solid::Octahedron => 8,
+        Solid::Icosahedron => 20,
+        Solid::Dodecahedron => 60,
+    };
+    solids::solid(spec, which, subdivisions(spec, param, 1000, per_square)?)
+}
+
+/// The most patches a built-in scene may have: parameters are checked against it before anything is
+/// built, so a large one is refused at once rather than failing to allocate (a patch takes some hundred
+/// bytes, so this is some gigabytes).
+pub const MAX_BUILTIN_PATCHES: usize = 1 << 22;
+
+/// Parses the subdivision N (from 1 to `max`, absent: 1) of a scene with `per_square` N^2 patches, and
+/// refuses one whose scene would have more than [`MAX_BUILTIN_PATCHES`].
+fn subdivisions(
+    spec: &str,
+    param: Option<&str>,
+    max: usize,
+    per_square: usize,
+) -> Result<usize, SceneError> {
+    let n = count(spec, param, 1, max)?;
+    let largest = (MAX_BUILTIN_PATCHES / per_square).isqrt();
+    if n > largest {
+        return Err(SceneError::Builtin(format!(
+            "{spec}: {} patches, more than the {MAX_BUILTIN_PATCHES} a built-in scene may have: the \
+             parameter can be at most {largest}",
+            per_square * n * n
+        )));
+    }
+    Ok(n)
 }
 
 /// Parses an optional whole-number parameter within `[min, max]` (absent: `min`).
@@ -224,6 +265,15 @@ mod tests {
         for bad in ["@cub", "@cube:0", "@cube:x", "@sphere:9", "@tetrahedron:-1"] {
             let e = build(bad).unwrap_err().to_string();
             assert!(e.starts_with(bad), "{e}");
+        }
+        // Too many patches: refused before anything is allocated.
+        for (bad, max) in [
+            ("@cube:2000", 836),
+            ("@icosahedron:1000", 457),
+            ("@dodecahedron:265", 264),
+        ] {
+            let e = build(bad).unwrap_err().to_string();
+            assert!(e.contains(&format!("at most {max}")), "{e}");
         }
     }
 

@@ -37,6 +37,8 @@ mod cli_reproduce;
 #[cfg(feature = "cli")]
 mod cli_scene_files;
 #[cfg(feature = "cli")]
+mod hostile;
+#[cfg(feature = "cli")]
 mod runs;
 
 // The source's structure.

@@ -1,0 +1,24 @@
+//! Fuzzes the PLY loader (ASCII and binary): whatever the bytes, scx must load them or refuse them with
+//! an error, never panic.
+#![no_main]
+
+#[path = "common.rs"]
+mod common;
+
+use libfuzzer_sys::fuzz_target;
+use scene_complexity::internals::scene::format::{load_as, Format};
+use scene_complexity::internals::scene::SceneOptions;
+
+fuzz_target!(|data: &[u8]| {
+    let loaded = load_as(
+        Format::Ply,
+        "fuzz.ply",
+        data,
+        common::NO_FOLDER.as_ref(),
+        &SceneOptions::default(),
+        &common::policy(),
+    );
+    if let Ok(scene) = loaded {
+        common::trace_a_little(&scene);
+    }
+});
