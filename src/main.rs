@@ -1,5 +1,9 @@
 //! `scx`: the command-line front end of the scene complexity analyser.
 
+// The JSON report is one `serde_json::json!` document of some forty fields, deeper than the macro's
+// default recursion allows.
+#![recursion_limit = "256"]
+
 mod cli;
 
 // jemalloc keeps the memory of long runs on large meshes compact, where glibc's malloc kept up to half a

@@ -83,6 +83,9 @@ pub struct Analysis {
     pub escapes: u64,
     /// Segments joining no two front sides.
     pub unpaired: u64,
+    /// Of them, segments from a front side to a back side: absorbed, they count in their rows as escapes
+    /// do (0 in a consistently oriented closed scene).
+    pub absorbed: u64,
     /// Pairs with coincident points, left out of eq. (27).
     pub degenerate_pairs: u64,
     /// Distinct patch pairs seen (when counted).
@@ -146,6 +149,14 @@ impl Analysis {
     /// segments).
     pub fn escape_fraction(&self) -> Option<f64> {
         warnings::escape_fraction(&self.tally.counters)
+    }
+
+    /// The fraction of the segments leaving a front side that arrive at a back side and are absorbed
+    /// (`None` without segments).
+    pub fn absorbed_fraction(&self) -> Option<f64> {
+        let c = &self.tally.counters;
+        let segments = c.pairs + c.escapes + c.absorbed;
+        (segments > 0).then(|| c.absorbed as f64 / segments as f64)
     }
 }
 
@@ -342,6 +353,7 @@ pub fn finish(
         pairs: total.counters.pairs,
         escapes: total.counters.escapes,
         unpaired: total.counters.unpaired,
+        absorbed: total.counters.absorbed,
         degenerate_pairs: total.counters.degenerate_pairs,
         environment_area: visibility.environment_area,
         distinct_pairs: total.counts.as_ref().map(|c| c.distinct_pairs()),

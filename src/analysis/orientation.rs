@@ -56,8 +56,8 @@ pub(crate) fn warnings(scene: &Scene, total: &Tally, enclosed: bool) -> Vec<RunW
             kind: RunWarningKind::InsideOut,
             message: format!(
                 "{}: normals face inwards: {} look(s) inside out: segments from front sides outside them \
-                 arrive at their back sides and join nothing, while their front sides are seen only from \
-                 inside them; try --flip-normals{}",
+                 arrive at their back sides and are absorbed there, while their front sides are seen only \
+                 from inside them; try --flip-normals{}",
                 scene.name,
                 named(scene, sides, &inside_out),
                 names_argument(scene, &inside_out)
@@ -69,8 +69,9 @@ pub(crate) fn warnings(scene: &Scene, total: &Tally, enclosed: bool) -> Vec<RunW
             kind: RunWarningKind::OneSided,
             message: format!(
                 "{}: one-sided surface(s) seen from behind: {}: segments from front sides arrive at \
-                 their back sides and join nothing (counted as unpaired); if they are thin surfaces meant \
-                 to be seen from both sides, try --two-sided{}",
+                 their back sides and are absorbed there (they count in their rows, as escapes do: the form \
+                 factors between the other surfaces stay right); if they are thin surfaces meant to be seen \
+                 from both sides, try --two-sided{}",
                 scene.name,
                 named(scene, sides, &one_sided),
                 names_argument(scene, &one_sided)

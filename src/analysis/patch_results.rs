@@ -24,6 +24,8 @@ pub struct PatchResult {
     pub segments: u64,
     /// Of them, the escapes.
     pub escapes: u64,
+    /// Of them, the segments to back sides (absorbed).
+    pub absorbed: u64,
     /// Each quantity's estimate, by [`PatchMeasure`] (`None`: not computed, e.g. no I_s^c or no light).
     values: [Option<Estimate>; PatchMeasure::COUNT],
 }
@@ -52,6 +54,10 @@ pub struct PatchLight<'a> {
 /// One tally's per-patch values and, when lit, its radiosities `(B, B^in)`.
 struct TallyPatches {
     values: PatchValues,
+    /// Escapes per patch.
+    escapes: Vec<u64>,
+    /// Segments to back sides per patch (empty when none).
+    absorbed: Vec<u64>,
     light: Option<(Vec<f64>, Vec<f64>)>,
 }
 
@@ -88,14 +94,20 @@ fn of_tally(
         sums,
         total_area: scene.total_area(),
     });
-    let values = patch_values(&areas, counts, &t.escapes_by_patch, estimator, continuous);
+    let lost = t.lost_by_patch();
+    let values = patch_values(&areas, counts, &lost, estimator, continuous);
     // A group whose own solve fails (too few lines) only loses the standard errors of B.
     let light = light.and_then(|l| {
-        let ff = FormFactors::from_counts(areas.len(), counts, &t.escapes_by_patch);
+        let ff = FormFactors::from_counts(areas.len(), counts, &lost);
         let s = radiosity::solve(&ff, l.materials, l.solve).ok()?;
         Some((s.radiosity, s.incoming))
     });
-    Some(TallyPatches { values, light })
+    Some(TallyPatches {
+        values,
+        escapes: t.escapes_by_patch.clone(),
+        absorbed: t.absorbed_by_patch.clone(),
+        light,
+    })
 }
 
 /// Patch `i`'s values from all the lines, with the batch-means standard errors of the groups'.
@@ -139,7 +151,8 @@ fn patch_estimate(i: usize, all: &TallyPatches, groups: &[TallyPatches]) -> Patc
     };
     PatchResult {
         segments: all.values.segments[i],
-        escapes: all.values.escapes[i],
+        escapes: all.escapes[i],
+        absorbed: all.absorbed.get(i).copied().unwrap_or(0),
         values: PatchMeasure::ALL.map(|q| est(&|t| value(q, t))),
     }
 }

@@ -7,7 +7,7 @@
 
 use rayon::prelude::*;
 
-use super::reliability::{self, Reliability, SamplingReport};
+use super::reliability::{self, Reliability, RunFacts, SamplingReport};
 use crate::measure::bias::row_corrections;
 use crate::measure::estimators::EntropyEstimator;
 use crate::measure::radiosity::{
@@ -122,12 +122,13 @@ pub(crate) fn estimates(
         let pick = value_of(m)?;
         spread.estimate(|v| v.as_ref().map(pick))
     });
-    let reliability = reliability::verdicts(
-        &estimates,
-        Some(sampling),
-        run.total.counters.lines,
-        run.total.counters.pairs,
-    );
+    let c = &run.total.counters;
+    let facts = RunFacts {
+        lines: c.lines,
+        pairs: c.pairs,
+        open: c.escapes + c.absorbed > 0,
+    };
+    let reliability = reliability::verdicts(&estimates, Some(sampling), facts);
     let solve = RadiositySolve {
         solver_residual: solution.residual,
         solver_tolerance: opts.tolerance,
@@ -169,12 +170,13 @@ fn solve_tally(
     let Some(counts) = &t.counts else {
         return Ok(None);
     };
-    let ff = FormFactors::from_counts(areas.len(), counts, &t.escapes_by_patch);
+    let lost = t.lost_by_patch();
+    let ff = FormFactors::from_counts(areas.len(), counts, &lost);
     let solution = radiosity::solve(&ff, materials, opts)?;
     let Some(mut values) = radiosity::measures(areas, &ff, &solution) else {
         return Ok(None);
     };
-    let deltas = row_corrections(counts, &t.escapes_by_patch, estimator);
+    let deltas = row_corrections(counts, &lost, estimator);
     radiosity::corrected(
         &mut values,
         areas,

@@ -164,6 +164,18 @@ fn flag_above_continuous(
     }
 }
 
+/// What a run's verdicts are judged from besides its readings.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct RunFacts {
+    /// Lines cast.
+    pub lines: u64,
+    /// Visible pairs.
+    pub pairs: u64,
+    /// Whether segments left front sides and arrived at no front side (escapes, segments to back
+    /// sides): the channel is open, and its mutual information may be below 0 ([`Bound`]).
+    pub open: bool,
+}
+
 /// What the verdicts of a family's readings are judged from.
 struct Evidence<'a> {
     estimates: &'a ByMeasure<Estimate>,
@@ -171,6 +183,7 @@ struct Evidence<'a> {
     sampling: Option<&'a SamplingReport>,
     lines: u64,
     pairs: u64,
+    open: bool,
 }
 
 impl Evidence<'_> {
@@ -187,20 +200,20 @@ impl Evidence<'_> {
     }
 }
 
-/// The verdicts on every reading of a run of `lines` lines with `pairs` pairs ([`VerdictRule`] of each
-/// measure's catalogue entry); `sampling` is the rows' sampling when the pairs were counted. A reading
-/// without a standard error (too few groups with lines) is `unusable`: nothing tells how far off it is.
+/// The verdicts on every reading of a run ([`VerdictRule`] of each measure's catalogue entry);
+/// `sampling` is the rows' sampling when the pairs were counted. A reading without a standard error (too
+/// few groups with lines) is `unusable`: nothing tells how far off it is.
 pub fn verdicts(
     estimates: &ByMeasure<Estimate>,
     sampling: Option<&SamplingReport>,
-    lines: u64,
-    pairs: u64,
+    facts: RunFacts,
 ) -> ByMeasure<Reliability> {
     let evidence = Evidence {
         estimates,
         sampling,
-        lines,
-        pairs,
+        lines: facts.lines,
+        pairs: facts.pairs,
+        open: facts.open,
     };
     let mut out = ByMeasure::default();
     for (m, &e) in estimates.iter() {
@@ -265,15 +278,25 @@ fn verdict(
             r
         }
     };
+    let closed = !evidence.open;
     match info.bound {
         Bound::None => {}
         Bound::NonNegative => flag_negative(&mut r, e, info.flag_name),
-        Bound::NonNegativeBelowContinuous => {
-            flag_negative(&mut r, e, info.flag_name);
+        Bound::MutualInformation => {
+            if closed {
+                flag_negative(&mut r, e, info.flag_name);
+            }
             flag_above_continuous(&mut r, e, continuous, info.flag_name);
         }
+        Bound::ContinuousMutualInformation => {
+            if closed {
+                flag_negative(&mut r, e, info.flag_name);
+            }
+        }
         Bound::UnitInterval => {
-            flag_unit_interval(&mut r, e, info.flag_name);
+            if closed {
+                flag_unit_interval(&mut r, e, info.flag_name);
+            }
             if continuous.is_some_and(|c| c.value.abs() <= 3.0 * stderr(c)) {
                 r.verdict = Verdict::Unusable;
                 r.flags
@@ -326,6 +349,14 @@ mod tests {
         })
     }
 
+    fn closed(lines: u64, pairs: u64) -> RunFacts {
+        RunFacts {
+            lines,
+            pairs,
+            open: false,
+        }
+    }
+
     fn of(r: &ByMeasure<Reliability>, m: Measure) -> Reliability {
         r.get(m).cloned().expect("a verdict")
     }
@@ -337,8 +368,7 @@ mod tests {
         let r = verdicts(
             &readings(7.8, 7.8005, 1.6),
             Some(&report(0.999)),
-            1_000_000,
-            1_000_000,
+            closed(1_000_000, 1_000_000),
         );
         assert_eq!(of(&r, Measure::MutualInformation).verdict, Verdict::Ok);
         assert_eq!(
@@ -353,8 +383,7 @@ mod tests {
         let r = verdicts(
             &readings(7.6, 7.8, 1.6),
             Some(&report(0.999)),
-            1_000_000,
-            1_000_000,
+            closed(1_000_000, 1_000_000),
         );
         let mi = of(&r, Measure::MutualInformation);
         assert_eq!(mi.verdict, Verdict::Undersampled);
@@ -370,8 +399,7 @@ mod tests {
         let r = verdicts(
             &readings(5.0, 7.5, 1.6),
             Some(&report(0.3)),
-            100_000,
-            100_000,
+            closed(100_000, 100_000),
         );
         assert_eq!(
             of(&r, Measure::MutualInformationCorrected).verdict,
@@ -388,8 +416,7 @@ mod tests {
         let r = verdicts(
             &readings(6.0, 6.0, 1.6),
             Some(&report(0.999)),
-            1_000_000,
-            1_000_000,
+            closed(1_000_000, 1_000_000),
         );
         let mi = of(&r, Measure::MutualInformation);
         assert!(
@@ -401,13 +428,43 @@ mod tests {
         // A negative I_s^c, and a ratio over an I_s^c indistinguishable from 0.
         let mut v = readings(7.8, 7.8, -0.5);
         v.set(Measure::ContinuousMutualInformation, est(-0.5, 0.01));
-        let r = verdicts(&v, Some(&report(0.999)), 100, 16);
+        let r = verdicts(&v, Some(&report(0.999)), closed(100, 16));
         assert!(!of(&r, Measure::ContinuousMutualInformation)
             .flags
             .is_empty());
         let mut v = readings(7.8, 7.8, 0.0005);
         v.set(Measure::ContinuousMutualInformation, est(0.0005, 0.001));
-        let r = verdicts(&v, Some(&report(0.999)), 1_000_000, 1_000_000);
+        let r = verdicts(&v, Some(&report(0.999)), closed(1_000_000, 1_000_000));
         assert_eq!(of(&r, Measure::Accuracy).verdict, Verdict::Unusable);
+    }
+
+    /// In an open scene a mutual information below 0 is no broken bound (two small squares far apart
+    /// read about -5 bits per pair); I_s above I_s^c still is.
+    #[test]
+    fn open_scenes_may_read_below_zero() {
+        let open = RunFacts {
+            lines: 1_000_000,
+            pairs: 1_000_000,
+            open: true,
+        };
+        let mut v = readings(7.8, 7.8, -0.5);
+        v.set(Measure::MutualInformation, est(-0.6, 0.01));
+        v.set(Measure::MutualInformationCorrected, est(-0.6, 0.01));
+        v.set(Measure::ContinuousMutualInformation, est(-0.5, 0.01));
+        let r = verdicts(&v, Some(&report(0.999)), open);
+        assert!(of(&r, Measure::ContinuousMutualInformation)
+            .flags
+            .is_empty());
+        assert!(of(&r, Measure::MutualInformation).flags.is_empty());
+        let closed = verdicts(&v, Some(&report(0.999)), closed(1_000_000, 1_000_000));
+        assert!(!of(&closed, Measure::ContinuousMutualInformation)
+            .flags
+            .is_empty());
+        v.set(Measure::MutualInformation, est(-0.3, 0.01));
+        let r = verdicts(&v, Some(&report(0.999)), open);
+        assert!(of(&r, Measure::MutualInformation)
+            .flags
+            .iter()
+            .any(|f| f.contains("Proposition 2")));
     }
 }

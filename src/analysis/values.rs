@@ -3,7 +3,7 @@
 
 use rayon::prelude::*;
 
-use super::reliability::{self, Reliability, SamplingReport, COVERAGE_OK};
+use super::reliability::{self, Reliability, RunFacts, SamplingReport, COVERAGE_OK};
 use crate::measure::bias::{self, CorrectedValues};
 use crate::measure::catalogue::VerdictRule;
 use crate::measure::channel;
@@ -14,7 +14,7 @@ use crate::measure::sampling::{lines_factor_for_coverage, Sampling};
 use crate::measure::visibility::{self, ContinuousValues, DiscreteValues};
 use crate::measure::{ByMeasure, Estimate, Family, Measure};
 use crate::run::{FinishedRun, Spread};
-use crate::sample::tally::{Tally, Wanted};
+use crate::sample::tally::{Counters, Tally, Wanted};
 use crate::scene::Scene;
 
 /// Measures of one group, of one group left out, or of the whole run.
@@ -58,6 +58,7 @@ impl GroupValues {
             continuous: ContinuousValues::from_sum(
                 t.counters.cmi_sum.value(),
                 t.counters.cmi_pairs,
+                lost(&t.counters),
             ),
             environment_area: None,
             sampling: None,
@@ -69,9 +70,10 @@ impl GroupValues {
         // One pass over the counts serves the plug-in and the corrected measures and the sampling.
         let a = channel::area_distribution(areas);
         let a = a.as_slice().expect("a fresh array is contiguous");
-        let rows = Rows::gather(a, c, &t.escapes_by_patch, estimator);
+        let lost = t.lost_by_patch();
+        let rows = Rows::gather(a, c, &lost, estimator);
         values.discrete = Some(visibility::discrete_from_rows(a, &rows.sums));
-        values.corrected = Some(bias::corrected_from_rows(a, &rows, c, &t.escapes_by_patch));
+        values.corrected = Some(bias::corrected_from_rows(a, &rows, c, &lost));
         values.sampling = Some(Sampling::of_rows(a, &rows.sums));
         if extrapolate {
             values.lines_factor = lines_factor_for_coverage(a, &rows.sums, COVERAGE_OK);
@@ -86,6 +88,12 @@ impl GroupValues {
     fn accuracy_corrected(&self) -> Option<f64> {
         Some(self.corrected?.mutual_information / self.continuous?.mutual_information)
     }
+}
+
+/// The segments that left a front side and arrived at no front side: escapes, and segments absorbed at
+/// back sides (eq. (27)'s estimate counts them, [`ContinuousValues::from_sum`]).
+fn lost(c: &Counters) -> u64 {
+    c.escapes + c.absorbed
 }
 
 fn areas(scene: &Scene) -> Vec<f64> {
@@ -153,12 +161,14 @@ pub(super) fn visibility_estimates(
         sampling,
         lines_for_coverage: all.lines_factor.map(|k| (k * lines as f64).ceil() as u64),
     });
-    let reliability = reliability::verdicts(
-        &estimates,
-        sampling.as_ref(),
+    let c = &run.total.counters;
+    let facts = RunFacts {
         lines,
-        run.total.counters.pairs,
-    );
+        pairs: c.pairs,
+        // Enclosed, the escapes are pairs with the environment: only back sides still lose segments.
+        open: c.absorbed > 0 || (c.escapes > 0 && !enclose),
+    };
+    let reliability = reliability::verdicts(&estimates, sampling.as_ref(), facts);
     VisibilityOfRun {
         estimates,
         sampling,
@@ -185,28 +195,22 @@ fn jackknife_replicates(
     let total_counts = total.counts.as_ref()?;
     let a = channel::area_distribution(&areas(scene));
     let a = a.as_slice()?;
-    let rows = Rows::gather(a, total_counts, &total.escapes_by_patch, estimator);
+    let total_lost = total.lost_by_patch();
+    let rows = Rows::gather(a, total_counts, &total_lost, estimator);
     groups
         .par_iter()
         .map(|g| {
             let counts = g.counts.as_ref()?;
-            let left = rows.without_group(
-                a,
-                (total_counts, &total.escapes_by_patch),
-                (counts, &g.escapes_by_patch),
-            );
+            let group_lost = g.lost_by_patch();
+            let left = rows.without_group(a, (total_counts, &total_lost), (counts, &group_lost));
             Some(GroupValues {
                 discrete: Some(visibility::discrete_from_rows(a, &left.sums)),
                 // The counts are read only by Chao–Shen, excluded by the caller.
-                corrected: Some(bias::corrected_from_rows(
-                    a,
-                    &left,
-                    counts,
-                    &g.escapes_by_patch,
-                )),
+                corrected: Some(bias::corrected_from_rows(a, &left, counts, &group_lost)),
                 continuous: ContinuousValues::from_sum(
                     total.counters.cmi_sum.minus(g.counters.cmi_sum).value(),
                     total.counters.cmi_pairs - g.counters.cmi_pairs,
+                    lost(&total.counters) - lost(&g.counters),
                 ),
                 environment_area: None,
                 sampling: None,

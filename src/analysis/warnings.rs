@@ -42,7 +42,7 @@ impl std::fmt::Display for RunWarning {
 
 /// The fraction of the segments leaving a front side that escape the scene (`None` without segments).
 pub fn escape_fraction(counters: &Counters) -> Option<f64> {
-    let segments = counters.pairs + counters.escapes;
+    let segments = counters.pairs + counters.escapes + counters.absorbed;
     (segments > 0).then(|| counters.escapes as f64 / segments as f64)
 }
 

@@ -179,7 +179,7 @@ fn write_form_factors(paths: &[PathBuf], scene: &Scene, a: &Analysis) -> Result<
         ));
     };
     let entries = ordered_entries(counts);
-    let totals = row_totals(scene.patch_count(), &entries, &a.tally.escapes_by_patch);
+    let totals = row_totals(scene.patch_count(), &entries, &a.tally.lost_by_patch());
     for path in paths {
         match matrix_format(path)? {
             MatrixFormat::Csv => write_with(path, |w| matrix_csv(w, &entries, &totals))?,
@@ -354,6 +354,7 @@ fn patches_csv(w: &mut dyn Write, scene: &Scene, patches: &[PatchResult]) -> std
         "area_fraction",
         "segments",
         "escapes",
+        "absorbed",
         "sampled",
     ]
     .map(String::from)
@@ -385,6 +386,7 @@ fn patches_csv(w: &mut dyn Write, scene: &Scene, patches: &[PatchResult]) -> std
             num(Some(patch.area / total_area)),
             p.segments.to_string(),
             p.escapes.to_string(),
+            p.absorbed.to_string(),
             p.sampled().to_string(),
         ];
         for e in PatchMeasure::ALL.map(|q| p.get(q)) {

@@ -37,8 +37,9 @@ pub fn render(format: Format, run: &RunInfo, a: &Analysis) -> String {
 }
 
 /// JSON schema version of `analyze --format json` (2: units, reliability, sampling, target, command
-/// line, CPU).
-pub const SCHEMA_VERSION: u32 = 2;
+/// line, CPU; 3: segments to back sides counted in their rows (`absorbed`), and I_s^c of an open scene
+/// on the footing of the discrete measures, the lost segments counted).
+pub const SCHEMA_VERSION: u32 = 3;
 
 /// Facts about the run that the analysis itself does not hold: the scene, how it ran.
 pub struct RunInfo<'a> {
@@ -219,6 +220,8 @@ pub fn json(run: &RunInfo, a: &Analysis) -> String {
         "escapes": a.escapes,
         "unpaired": a.unpaired,
         "escape_fraction": a.escape_fraction(),
+        "absorbed": a.absorbed,
+        "absorbed_fraction": a.absorbed_fraction(),
         "degenerate_pairs": a.degenerate_pairs,
         "coincident_crossings": a.tally.counters.coincident_crossings,
         "environment_area": a.environment_area.map(|e| json!({

@@ -128,15 +128,22 @@ pub enum VerdictRule {
 
 /// The bounds of the theory a reading must respect; one broken by more than twice the standard error
 /// is flagged, and the reading is then never `ok`.
+///
+/// In an open scene (segments leave front sides and arrive at no front side: escapes, back sides) the
+/// channel loses part of every row, and a mutual information, discrete or continuous, is a Kullback-
+/// Leibler divergence of a measure of less than 1 from one of 1: it may be below 0 (two small squares
+/// far apart). Proposition 2 (I_s <= I_s^c) still holds, both being on the same footing.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Bound {
     /// No bound checked.
     None,
-    /// An entropy or mutual information: at least 0.
+    /// An entropy: at least 0.
     NonNegative,
-    /// A mutual information: at least 0 and at most I_s^c (Proposition 2).
-    NonNegativeBelowContinuous,
-    /// A ratio: within [0, 1].
+    /// A discrete mutual information: at most I_s^c (Proposition 2), and at least 0 in a closed scene.
+    MutualInformation,
+    /// I_s^c: at least 0 in a closed scene.
+    ContinuousMutualInformation,
+    /// A ratio of I_s to I_s^c: within [0, 1] in a closed scene.
     UnitInterval,
 }
 
@@ -282,7 +289,7 @@ pub const CATALOGUE: [MeasureInfo; Measure::COUNT] = [
         symbol: "I_s",
         equation: "eq. 21",
         verdict: plug_in(-1.0),
-        bound: Bound::NonNegativeBelowContinuous,
+        bound: Bound::MutualInformation,
         flag_name: "I_s",
         target: true,
         followed: Some(0),
@@ -294,7 +301,7 @@ pub const CATALOGUE: [MeasureInfo; Measure::COUNT] = [
         equation: "eq. 21",
         corrects: Some(Measure::MutualInformation),
         verdict: VerdictRule::Corrected,
-        bound: Bound::NonNegativeBelowContinuous,
+        bound: Bound::MutualInformation,
         flag_name: "the corrected I_s",
         target: true,
         followed: Some(1),
@@ -310,7 +317,7 @@ pub const CATALOGUE: [MeasureInfo; Measure::COUNT] = [
         equation: "eq. 27",
         needs: Needs::Kernel,
         verdict: VerdictRule::Mean,
-        bound: Bound::NonNegative,
+        bound: Bound::ContinuousMutualInformation,
         flag_name: "I_s^c",
         target: true,
         followed: Some(4),

@@ -114,23 +114,33 @@ pub fn patch_values(
             .collect(),
         row_entropy,
         row_entropy_corrected,
-        continuous_term: continuous.and_then(|c| continuous_shares(c, a)),
+        continuous_term: continuous.and_then(|c| continuous_shares(c, escapes, a)),
     }
 }
 
 /// Eq. (27)'s share of every patch, `a_i (m_i + delta)` (module documentation), from the area
-/// fractions `a_i`; 0 for a patch no pair reached; `None` without pairs.
-pub fn continuous_shares(c: ContinuousSums<'_>, area_fractions: &[f64]) -> Option<Vec<f64>> {
+/// fractions `a_i` and the segments `lost` from each patch's front side to no front side (escapes and
+/// segments to back sides, which sample its `m_i` with a term 0, as eq. (27)'s estimate counts them:
+/// [`super::visibility::ContinuousValues::from_sum`]); 0 for a patch no segment left; `None` without
+/// pairs.
+pub fn continuous_shares(
+    c: ContinuousSums<'_>,
+    lost: &[u64],
+    area_fractions: &[f64],
+) -> Option<Vec<f64>> {
     let ends: u64 = c.sums.ends.iter().sum();
     if ends == 0 {
         return None;
     }
+    let lost_at = |i: usize| lost.get(i).copied().unwrap_or(0);
+    let samples = |i: usize| c.sums.ends[i] + lost_at(i);
     let offset = (c.total_area / std::f64::consts::PI).log2();
     // Every term of the run once per end: their sum over the ends is twice the sum over the pairs.
     let terms = |i: usize| c.sums.log2_kernel[i].value() + c.sums.ends[i] as f64 * offset;
-    let whole = (0..area_fractions.len()).map(terms).sum::<f64>() / ends as f64;
-    let reached = |i: &usize| c.sums.ends[*i] > 0;
-    let mean = |i: usize| terms(i) / c.sums.ends[i] as f64;
+    let all_samples: u64 = (0..area_fractions.len()).map(samples).sum();
+    let whole = (0..area_fractions.len()).map(terms).sum::<f64>() / all_samples as f64;
+    let reached = |i: &usize| samples(*i) > 0;
+    let mean = |i: usize| terms(i) / samples(i) as f64;
     let stratified: f64 = (0..area_fractions.len())
         .filter(reached)
         .map(|i| area_fractions[i] * mean(i))
@@ -267,6 +277,7 @@ mod tests {
                 sums: &sums,
                 total_area,
             },
+            &[0; 4],
             &a,
         )
         .unwrap();
@@ -278,11 +289,29 @@ mod tests {
         }
         assert_eq!(s[3], 0.0);
         assert!((s.iter().sum::<f64>() - 2.0).abs() < 1e-15);
+        // Two segments lost from patch 0 (escapes or to back sides) sample its mean with a term 0: its
+        // mean is 3 / 4, and the whole is the pairs' terms from both ends over every segment, 12 / 8.
+        let open = continuous_shares(
+            ContinuousSums {
+                sums: &sums,
+                total_area,
+            },
+            &[2, 0, 0, 0],
+            &a,
+        )
+        .unwrap();
+        let delta = (1.5 - 0.25 * (0.75 + 2.0 + 2.5)) / 0.75;
+        let expected = [0.75, 2.0, 2.5].map(|m| 0.25 * (m + delta));
+        for (x, e) in open.iter().zip(expected) {
+            assert!((x - e).abs() < 1e-15, "{open:?}");
+        }
+        assert!((open.iter().sum::<f64>() - 1.5).abs() < 1e-15);
         let none = continuous_shares(
             ContinuousSums {
                 sums: &PatchKernelSums::new(4),
                 total_area,
             },
+            &[0; 4],
             &a,
         );
         assert!(none.is_none(), "no pairs, no shares");

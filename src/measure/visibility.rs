@@ -34,15 +34,26 @@ pub struct DiscreteValues {
 /// The continuous measure of one set of pairs (paper sec. 3.2).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ContinuousValues {
-    /// Eq. (27): I_s^c, the mean over pairs of log2(A_T cos_x cos_y / (pi d^2)).
+    /// Eq. (27): I_s^c, the mean of log2(A_T cos_x cos_y / (pi d^2)) over the segments leaving front
+    /// sides (every pair is two of them, one from each end; a segment that arrives at no front side
+    /// adds 0).
     pub mutual_information: f64,
 }
 
 impl ContinuousValues {
-    /// Eq. (27) from the sum of its terms over `pairs` pairs; `None` without pairs.
-    pub fn from_sum(sum: f64, pairs: u64) -> Option<Self> {
+    /// Eq. (27) from the sum of its terms over `pairs` pairs and the `lost` segments that left a front
+    /// side and arrived at no front side (escapes, segments to back sides); `None` without pairs.
+    ///
+    /// Eq. (25) integrates `F(x, y) log(A_T F(x, y)) / A_T` over every x and y; global lines sample x
+    /// (area-uniform) and the direction (cosine-distributed) of each segment leaving a front side, and a
+    /// direction in which x sees no front side has `F = 0` there. So the estimate is the sum over the
+    /// pairs, each counted from both ends, over all those segments: `2 S / (2 P + L)`. In a closed scene
+    /// `L = 0` and this is eq. (27)'s mean over pairs; in an open one it is on the same footing as the
+    /// discrete measures, whose rows count the lost segments in `N_i` (Proposition 2 holds between the
+    /// two).
+    pub fn from_sum(sum: f64, pairs: u64, lost: u64) -> Option<Self> {
         (pairs > 0).then(|| ContinuousValues {
-            mutual_information: sum / pairs as f64,
+            mutual_information: 2.0 * sum / (2 * pairs + lost) as f64,
         })
     }
 }

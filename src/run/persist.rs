@@ -207,6 +207,8 @@ struct TallyWire {
     counters: Counters,
     /// Non-zero escapes per patch.
     escapes: Sparse,
+    /// Non-zero segments to back sides per front patch.
+    absorbed: Sparse,
     /// Pair counts by pair key.
     counts: Option<Sparse>,
     /// Per object: back sides met from open space, back sides leaving to it, front sides escaping,
@@ -237,6 +239,17 @@ struct Sparse {
 }
 
 impl Sparse {
+    /// The non-zero entries of a dense per-patch list.
+    fn of_dense(per_patch: &[u64]) -> Self {
+        Sparse::of(
+            per_patch
+                .iter()
+                .enumerate()
+                .filter(|(_, &e)| e > 0)
+                .map(|(i, &e)| (i as u64, e)),
+        )
+    }
+
     fn of(entries: impl IntoIterator<Item = (u64, u64)>) -> Self {
         let (mut key_steps, mut values, mut last) = (Vec::new(), Vec::new(), 0u64);
         for (k, v) in entries {
@@ -266,13 +279,8 @@ impl Sparse {
 fn tally_wire(t: &Tally) -> TallyWire {
     TallyWire {
         counters: t.counters,
-        escapes: Sparse::of(
-            t.escapes_by_patch
-                .iter()
-                .enumerate()
-                .filter(|(_, &e)| e > 0)
-                .map(|(i, &e)| (i as u64, e)),
-        ),
+        escapes: Sparse::of_dense(&t.escapes_by_patch),
+        absorbed: Sparse::of_dense(&t.absorbed_by_patch),
         counts: t.counts.as_ref().map(|c| {
             let mut entries = Vec::with_capacity(c.distinct_pairs());
             c.for_each(|i, j, n| entries.push((pair_key(i, j), n)));
@@ -298,6 +306,15 @@ fn tally_of(w: &TallyWire, patches: usize, wanted: Wanted) -> Option<Tally> {
     };
     for (i, e) in w.escapes.entries()? {
         *escapes_by_patch.get_mut(usize::try_from(i).ok()?)? = e;
+    }
+    let absorbed = w.absorbed.entries()?;
+    let mut absorbed_by_patch = if absorbed.is_empty() {
+        Vec::new()
+    } else {
+        vec![0; patches]
+    };
+    for (i, e) in absorbed {
+        *absorbed_by_patch.get_mut(usize::try_from(i).ok()?)? = e;
     }
     let counts = match (&w.counts, wanted.discrete) {
         (Some(c), true) => {
@@ -342,6 +359,7 @@ fn tally_of(w: &TallyWire, patches: usize, wanted: Wanted) -> Option<Tally> {
         counters: w.counters,
         orientation,
         escapes_by_patch,
+        absorbed_by_patch,
         counts,
         kernel_by_patch,
     })

@@ -41,11 +41,14 @@ pub enum Segment {
         /// Whether the segment is the line's first (from the sphere to the first hit), not its last.
         at_start: bool,
     },
-    /// An unpaired segment between a front side and the back side of `patch` (either way along the
-    /// line): that patch is seen from behind.
+    /// An unpaired segment between the front side of `front` and the back side of `patch` (either way
+    /// along the line): that patch is seen from behind, and what leaves `front` that way arrives at no
+    /// front side (it is absorbed, as an escape is lost).
     BackSeen {
         /// The patch whose back side the segment touches.
         patch: u32,
+        /// The patch whose front side the segment leaves.
+        front: u32,
     },
     /// A segment joining no front sides (inside a solid, behind a wall, broken geometry).
     Unpaired,
@@ -279,9 +282,15 @@ fn pair_crossings(
                 cos_to: -next.cos,
             });
         } else if prev.cos > 0.0 && next.cos > 0.0 {
-            visit(Segment::BackSeen { patch: next.patch });
+            visit(Segment::BackSeen {
+                patch: next.patch,
+                front: prev.patch,
+            });
         } else if prev.cos < 0.0 && next.cos < 0.0 {
-            visit(Segment::BackSeen { patch: prev.patch });
+            visit(Segment::BackSeen {
+                patch: prev.patch,
+                front: next.patch,
+            });
         } else {
             visit(Segment::Unpaired);
         }

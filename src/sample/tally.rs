@@ -42,6 +42,10 @@ pub struct Counters {
     pub escapes: u64,
     /// Segments that join no two front sides.
     pub unpaired: u64,
+    /// Of them, the segments from a front side to a back side: what leaves that front side there
+    /// arrives at no front side, and is absorbed (it counts in the row, like an escape).
+    #[serde(default)]
+    pub absorbed: u64,
     /// Pairs whose two points coincide in f64 (touching surfaces): left out of eq. (27).
     pub degenerate_pairs: u64,
     /// Crossings of two coplanar overlapping surfaces facing the same way (only the first is seen there).
@@ -67,6 +71,7 @@ impl Counters {
         self.pairs += other.pairs;
         self.escapes += other.escapes;
         self.unpaired += other.unpaired;
+        self.absorbed += other.absorbed;
         self.degenerate_pairs += other.degenerate_pairs;
         self.coincident_crossings += other.coincident_crossings;
         self.misses += other.misses;
@@ -202,6 +207,9 @@ pub struct Tally {
     pub orientation: Vec<ObjectSides>,
     /// Escapes per patch (empty unless the discrete measures are wanted).
     pub escapes_by_patch: Vec<u64>,
+    /// Segments from each patch's front side to a back side (absorbed), when the discrete measures are
+    /// wanted; empty as long as there are none (most scenes have none).
+    pub absorbed_by_patch: Vec<u64>,
     /// Pair counts (only when the discrete measures are wanted).
     pub counts: Option<PairCounts>,
     /// Eq. (27)'s terms summed per patch (only when [`Wanted::per_patch`]).
@@ -219,6 +227,7 @@ impl Tally {
             } else {
                 Vec::new()
             },
+            absorbed_by_patch: Vec::new(),
             counts: wanted
                 .discrete
                 .then(|| PairCounts::new(scene.patch_count())),
@@ -234,6 +243,7 @@ impl Tally {
             counters: self.counters,
             orientation: self.orientation.clone(),
             escapes_by_patch: self.escapes_by_patch.clone(),
+            absorbed_by_patch: self.absorbed_by_patch.clone(),
             counts: None,
             kernel_by_patch: self.kernel_by_patch.clone(),
         }
@@ -250,6 +260,7 @@ impl Tally {
         {
             *a += b;
         }
+        add_counts(&mut self.absorbed_by_patch, &other.absorbed_by_patch);
         if let (Some(a), Some(b)) = (&mut self.counts, &other.counts) {
             a.merge(b);
         }
@@ -273,6 +284,15 @@ impl Tally {
                 .zip(&part.escapes_by_patch)
                 .map(|(t, p)| t - p)
                 .collect(),
+            absorbed_by_patch: if part.absorbed_by_patch.is_empty() {
+                self.absorbed_by_patch.clone()
+            } else {
+                self.absorbed_by_patch
+                    .iter()
+                    .zip(&part.absorbed_by_patch)
+                    .map(|(t, p)| t - p)
+                    .collect()
+            },
             counts: match (&self.counts, &part.counts) {
                 (Some(t), Some(p)) => Some(t.without(p)),
                 _ => None,
@@ -349,6 +369,7 @@ impl Tally {
             } else {
                 Vec::new()
             },
+            absorbed_by_patch: Vec::new(),
             counts: None,
             kernel_by_patch: wanted
                 .per_patch
@@ -364,9 +385,27 @@ impl Tally {
             for &p in &b.escape_patches {
                 tally.escapes_by_patch[p as usize] += 1;
             }
+            if !b.absorbed_patches.is_empty() && tally.absorbed_by_patch.is_empty() {
+                tally.absorbed_by_patch = vec![0; scene.patch_count()];
+            }
+            for &p in &b.absorbed_patches {
+                tally.absorbed_by_patch[p as usize] += 1;
+            }
             batch_keys.push(b.pair_keys);
         }
         (tally, batch_keys)
+    }
+
+    /// Per patch, the segments leaving its front side that arrive at no front side: its escapes and the
+    /// segments absorbed at back sides. They count in the patch's row `N_i` beside its pairs, so that
+    /// `F_ij = N_ij / N_i` is the geometric form factor whatever else the row loses.
+    pub fn lost_by_patch(&self) -> std::borrow::Cow<'_, [u64]> {
+        if self.absorbed_by_patch.is_empty() {
+            return std::borrow::Cow::Borrowed(&self.escapes_by_patch);
+        }
+        let mut lost = self.escapes_by_patch.clone();
+        add_counts(&mut lost, &self.absorbed_by_patch);
+        std::borrow::Cow::Owned(lost)
     }
 
     /// The environment patch's area in tracing space ([`environment::area`]).
@@ -402,6 +441,9 @@ impl Tally {
             PairCounts::from_entries(n + 1, entries)
         });
         t.escapes_by_patch = vec![0; if self.counts.is_some() { n + 1 } else { 0 }];
+        if !t.absorbed_by_patch.is_empty() {
+            t.absorbed_by_patch.push(0);
+        }
         t.counters.pairs += c.escapes + c.misses;
         t.counters.escapes = 0;
 
@@ -417,6 +459,19 @@ impl Tally {
     }
 }
 
+/// Adds per-patch counts `b` into `a`, which is empty until something is counted (then as long as `b`).
+fn add_counts(a: &mut Vec<u64>, b: &[u64]) {
+    if b.is_empty() {
+        return;
+    }
+    if a.is_empty() {
+        a.resize(b.len(), 0);
+    }
+    for (x, y) in a.iter_mut().zip(b) {
+        *x += y;
+    }
+}
+
 /// One batch's findings, before its pair keys become counts.
 #[derive(Debug, Default)]
 pub struct BatchTally {
@@ -426,6 +481,8 @@ pub struct BatchTally {
     pub pair_keys: Vec<u64>,
     /// The patch of every escape, when the discrete measures are wanted.
     pub escape_patches: Vec<u32>,
+    /// The front patch of every segment to a back side, when the discrete measures are wanted.
+    pub absorbed_patches: Vec<u32>,
     /// How the batch's lines met the objects' sides.
     pub sides: BatchSides,
     /// Beside each pair key, its log kernel ([`PatchKernelSums::pair_term`]), when
@@ -555,8 +612,12 @@ fn tally_batch(prepared: &LineTally, lines: &[Line], hits: &LineHits) -> BatchTa
                     let (cos_product, distance) = environment::escape(scene, line, patch, at_start);
                     env_sum.add(cos_product, distance);
                 }
-                Segment::BackSeen { patch } => {
+                Segment::BackSeen { patch, front } => {
                     c.unpaired += 1;
+                    c.absorbed += 1;
+                    if wanted.discrete {
+                        t.absorbed_patches.push(front);
+                    }
                     sides.count(objects.object(patch), 3);
                 }
                 Segment::Unpaired => c.unpaired += 1,

@@ -612,12 +612,13 @@ fn the_ends_of_a_line_and_back_sides_seen() {
         (seen, ends)
     };
     // Both squares face +z (tracing space: z from -1 to 1 after centring); upwards through both: arrive
-    // at a's back, leave its front, arrive at b's back (BackSeen b), leave b's front into open space.
+    // at a's back, leave its front, arrive at b's back (BackSeen b, from a's front), leave b's front into
+    // open space.
     let (seen, ends) = trace([0.1, 0.2, -2.0], [0.0, 0.0, 1.0]);
     assert_eq!(
         seen,
         [
-            Segment::BackSeen { patch: 1 },
+            Segment::BackSeen { patch: 1, front: 0 },
             Segment::Escape {
                 patch: 1,
                 at_start: false
@@ -626,7 +627,8 @@ fn the_ends_of_a_line_and_back_sides_seen() {
     );
     assert_eq!((ends.back_first, ends.back_last), (Some(0), None));
     // Downwards: arrive at b's front from open space (an escape at the start), leave its back, arrive at
-    // a's front: a segment from a back side to a front side (BackSeen b), and leave a's back.
+    // a's front: a segment from a back side to a front side (BackSeen b, to a's front), and leave a's
+    // back.
     let (seen, ends) = trace([0.1, 0.2, 2.0], [0.0, 0.0, -1.0]);
     assert_eq!(
         seen,
@@ -635,7 +637,7 @@ fn the_ends_of_a_line_and_back_sides_seen() {
                 patch: 1,
                 at_start: true
             },
-            Segment::BackSeen { patch: 1 }
+            Segment::BackSeen { patch: 1, front: 0 }
         ]
     );
     assert_eq!((ends.back_first, ends.back_last), (None, Some(0)));
