@@ -252,7 +252,7 @@ impl AimTargets {
 
     /// Appends the lines of batch `batch` of `plan` for `kind` (and what each is aimed at) to `lines`
     /// and `aims`. Needs targets of that kind ([`AimTargets::count`] > 0).
-    pub fn draw(
+    pub(crate) fn draw(
         &self,
         kind: AimKind,
         seed: u64,
