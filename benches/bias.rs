@@ -6,12 +6,13 @@
 #[path = "../tests/it/support.rs"]
 mod support;
 
-use scene_complexity::measure::bias::corrected;
-use scene_complexity::measure::estimators::EntropyEstimator;
-use scene_complexity::run::Measures;
-use scene_complexity::run::{analyze, AnalysisConfig, RunControl};
-use scene_complexity::scenes;
-use scene_complexity::trace::{make_tracer, Backend, Query};
+use scene_complexity::internals::analysis::analyze;
+use scene_complexity::internals::measure::bias::corrected;
+use scene_complexity::internals::measure::estimators::EntropyEstimator;
+use scene_complexity::internals::run::Measures;
+use scene_complexity::internals::run::{RunControl, RunSpec};
+use scene_complexity::internals::scenes;
+use scene_complexity::internals::trace::{make_tracer, Backend, Query};
 
 fn list(arg: Option<&String>, default: &str) -> Vec<f64> {
     arg.map_or(default, |s| s.as_str())
@@ -40,13 +41,13 @@ fn main() {
         let tracer = make_tracer(Backend::default_available(), &scene, Query::Single).unwrap();
         for &lines in &line_counts {
             for seed in 1..=seeds {
-                let cfg = AnalysisConfig {
+                let cfg = RunSpec {
                     measures: Measures {
                         discrete: true,
                         continuous: false,
                         radiosity: false,
                     },
-                    ..AnalysisConfig::new(lines as u64, seed)
+                    ..RunSpec::new(lines as u64, seed)
                 };
                 let a = analyze(&scene, tracer.as_ref(), &cfg, &RunControl::default()).unwrap();
                 let counts = a.tally.counts.as_ref().unwrap();

@@ -14,14 +14,16 @@
 
 mod common;
 
-use scene_complexity::scenes;
+use scene_complexity::internals::measure::Measure;
+use scene_complexity::internals::scenes;
 use std::time::Instant;
 
-use scene_complexity::measure::Estimate;
-use scene_complexity::run::{analyze, AnalysisConfig, RunControl, VisibilityEstimates};
-use scene_complexity::sample::lines::LineSource;
-use scene_complexity::scene::Scene;
-use scene_complexity::trace::{make_tracer, Backend, Query, Tracer};
+use scene_complexity::internals::analysis::analyze;
+use scene_complexity::internals::measure::Estimate;
+use scene_complexity::internals::run::{RunControl, RunSpec};
+use scene_complexity::internals::sample::lines::LineSource;
+use scene_complexity::internals::scene::Scene;
+use scene_complexity::internals::trace::{make_tracer, Backend, Query, Tracer};
 
 const SEEDS: u64 = 3;
 const GROUPS: usize = 64;
@@ -96,10 +98,10 @@ impl Row {
 
 fn measure(scene: &Scene, tracer: &dyn Tracer, lines: u64, grid: u32) -> Row {
     let source = LineSource::bundles(grid).expect("grids from the list are valid");
-    let cfg = |seed| AnalysisConfig {
+    let cfg = |seed| RunSpec {
         groups: GROUPS,
         source,
-        ..AnalysisConfig::new(lines, seed)
+        ..RunSpec::new(lines, seed)
     };
     let mut row = Row {
         lines: 0.0,
@@ -114,11 +116,11 @@ fn measure(scene: &Scene, tracer: &dyn Tracer, lines: u64, grid: u32) -> Row {
         row.wall += w0.elapsed().as_secs_f64();
         row.cpu += common::cpu_seconds() - c0;
         row.lines += a.lines as f64;
-        let se = |e: Option<scene_complexity::measure::Estimate>| {
+        let se = |e: Option<scene_complexity::internals::measure::Estimate>| {
             e.and_then(|e| e.stderr).unwrap_or(f64::NAN)
         };
-        row.var_cmi += se(a.visibility.continuous_mutual_information).powi(2) / SEEDS as f64;
-        row.var_mi += se(a.visibility.mutual_information).powi(2) / SEEDS as f64;
+        row.var_cmi += se(a.estimate(Measure::ContinuousMutualInformation)).powi(2) / SEEDS as f64;
+        row.var_mi += se(a.estimate(Measure::MutualInformation)).powi(2) / SEEDS as f64;
     }
     row
 }
@@ -138,15 +140,12 @@ fn print_row(spec: &str, query: &str, grid: u32, r: &Row, base: &Row) {
     );
 }
 
-/// Where an analysis keeps one of its estimates.
-type Pick = fn(&VisibilityEstimates) -> Option<Estimate>;
-
-/// The measures the seed-spread mode follows: name, and where an analysis keeps it.
-const FOLLOWED: [(&str, Pick); 4] = [
-    ("I_s^c", |v| v.continuous_mutual_information),
-    ("I_s", |v| v.mutual_information),
-    ("I_s corr.", |v| v.mutual_information_corrected),
-    ("E(MSE)", |v| v.mse_per_line),
+/// The measures the seed-spread mode follows: name, and the measure.
+const FOLLOWED: [(&str, Measure); 4] = [
+    ("I_s^c", Measure::ContinuousMutualInformation),
+    ("I_s", Measure::MutualInformation),
+    ("I_s corr.", Measure::MutualInformationCorrected),
+    ("E(MSE)", Measure::MsePerLine),
 ];
 
 /// Independent lines against 4 x 4 and 8 x 8 bundles over `seeds` seeds each (seed outermost, so that
@@ -169,15 +168,15 @@ fn spread(specs: &[String], lines: u64, seeds: u64) -> anyhow::Result<()> {
         let mut cpu = [0.0; GRIDS.len()];
         for seed in 1..=seeds {
             for (g, &grid) in GRIDS.iter().enumerate() {
-                let cfg = AnalysisConfig {
+                let cfg = RunSpec {
                     source: LineSource::bundles(grid).expect("grids from the list are valid"),
-                    ..AnalysisConfig::new(lines, seed)
+                    ..RunSpec::new(lines, seed)
                 };
                 let c0 = common::cpu_seconds();
                 let a = analyze(&scene, tracer.as_ref(), &cfg, &RunControl::default())?;
                 cpu[g] += common::cpu_seconds() - c0;
                 for (m, (_, of)) in FOLLOWED.iter().enumerate() {
-                    let e = of(&a.visibility).unwrap_or(Estimate {
+                    let e = a.estimate(*of).unwrap_or(Estimate {
                         value: f64::NAN,
                         stderr: None,
                     });

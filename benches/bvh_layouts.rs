@@ -14,7 +14,7 @@
 
 mod common;
 
-use scene_complexity::scenes;
+use scene_complexity::internals::scenes;
 use std::time::Duration;
 
 use glam::Vec3A;
@@ -23,10 +23,10 @@ use obvhs::{
     ray::{Ray, RayHit},
     BvhBuildParams,
 };
-use scene_complexity::sample::lines::batch_lines;
-use scene_complexity::scene::Scene;
-use scene_complexity::trace::rust::{bvh::margin, watertight::ShearedRay, BvhTracer};
-use scene_complexity::trace::{Line, Tracer};
+use scene_complexity::internals::sample::lines::batch_lines;
+use scene_complexity::internals::scene::Scene;
+use scene_complexity::internals::trace::rust::{bvh::margin, watertight::ShearedRay, BvhTracer};
+use scene_complexity::internals::trace::{Line, Tracer};
 
 fn main() -> anyhow::Result<()> {
     let mut specs: Vec<String> = std::env::args()

@@ -8,9 +8,9 @@
 use std::hint::black_box;
 use std::time::Instant;
 
-use scene_complexity::run::BatchPlan;
-use scene_complexity::sample::lines::{batch_lines, batch_rng, global_line};
-use scene_complexity::trace::Line;
+use scene_complexity::internals::run::BatchPlan;
+use scene_complexity::internals::sample::lines::{batch_lines, batch_rng, global_line};
+use scene_complexity::internals::trace::Line;
 
 fn main() {
     let args: Vec<String> = std::env::args()

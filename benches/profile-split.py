@@ -1,5 +1,6 @@
 #!/usr/bin/env python3
-# Groups a `perf report --no-children --sort dso,symbol` listing into the README's profile split:
+# Groups a `perf report --no-children --sort dso,symbol` listing into the profile split of
+# docs/performance.md ("Where the time goes"):
 #   perf record -e cpu-clock -o p.perf target/release/scx analyze @cube:30 --lines 3e7 -q
 #   perf report -i p.perf --no-children --sort dso,symbol | python3 benches/profile-split.py /dev/stdin
 import sys, re, collections

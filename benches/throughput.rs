@@ -1,5 +1,5 @@
-//! A throughput table for notes and the README: million lines per second of the all-hits kernel (canonical
-//! hits of lines drawn beforehand), of first-hit queries, of drawing the lines and tracing them (what an
+//! A throughput table for notes and docs/performance.md: million lines per second of the all-hits kernel
+//! (canonical hits of lines drawn beforehand), of first-hit queries, of drawing the lines and tracing them (what an
 //! analysis does before pairing and counting), and of the whole analysis on the same lines, per tracer
 //! (Embree single lines and native packets, the pure-Rust BVH) and thread count. Best of three runs (the
 //! machine is shared). Then the analysis's share of the kernel's rate, against the kernel alone and
@@ -11,14 +11,15 @@
 
 mod common;
 
-use scene_complexity::scenes;
+use scene_complexity::internals::scenes;
 use std::time::Instant;
 
 use rayon::prelude::*;
-use scene_complexity::run::{analyze, AnalysisConfig, RunControl, DEFAULT_GROUPS};
-use scene_complexity::run::{BatchPlan, Measures};
-use scene_complexity::sample::lines::batch_lines;
-use scene_complexity::trace::{make_tracer, Backend, Line, LineHits, Query, Tracer};
+use scene_complexity::internals::analysis::analyze;
+use scene_complexity::internals::run::{BatchPlan, Measures};
+use scene_complexity::internals::run::{RunControl, RunSpec, DEFAULT_GROUPS};
+use scene_complexity::internals::sample::lines::batch_lines;
+use scene_complexity::internals::trace::{make_tracer, Backend, Line, LineHits, Query, Tracer};
 
 const CHUNK: usize = 4096;
 const REPEATS: usize = 3;
@@ -69,12 +70,12 @@ fn bench_scene(spec: &str, count: u64, pools: &[rayon::ThreadPool]) -> anyhow::R
             &mut lines,
         );
     }
-    let cfg = AnalysisConfig {
+    let cfg = RunSpec {
         groups: DEFAULT_GROUPS,
-        ..AnalysisConfig::new(count, 1)
+        ..RunSpec::new(count, 1)
     };
     // `--measures continuous`: I_s^c alone, no pair counts (what a run needs when it wants only eq. 27).
-    let continuous = AnalysisConfig {
+    let continuous = RunSpec {
         measures: Measures {
             discrete: false,
             continuous: true,

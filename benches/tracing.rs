@@ -7,13 +7,14 @@
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use rayon::prelude::*;
-use scene_complexity::run::Measures;
-use scene_complexity::run::{analyze, AnalysisConfig, RunControl};
-use scene_complexity::sample::lines::LineSource;
-use scene_complexity::scene::Scene;
-use scene_complexity::scenes;
-use scene_complexity::trace::rust::BruteForceTracer;
-use scene_complexity::trace::{make_tracer, Backend, Line, LineHits, Query, Tracer};
+use scene_complexity::internals::analysis::analyze;
+use scene_complexity::internals::run::Measures;
+use scene_complexity::internals::run::{RunControl, RunSpec};
+use scene_complexity::internals::sample::lines::LineSource;
+use scene_complexity::internals::scene::Scene;
+use scene_complexity::internals::scenes;
+use scene_complexity::internals::trace::rust::BruteForceTracer;
+use scene_complexity::internals::trace::{make_tracer, Backend, Line, LineHits, Query, Tracer};
 
 const LINES: usize = 1 << 16;
 const CHUNK: usize = 4096;
@@ -116,13 +117,13 @@ fn bench_analysis(c: &mut Criterion) {
         let mut g = c.benchmark_group(format!("analyze/{spec}"));
         g.throughput(Throughput::Elements(LINES as u64));
         g.sample_size(10);
-        let cfg = AnalysisConfig {
+        let cfg = RunSpec {
             measures: Measures {
                 discrete: true,
                 continuous: true,
                 radiosity: false,
             },
-            ..AnalysisConfig::new(LINES as u64, 1)
+            ..RunSpec::new(LINES as u64, 1)
         };
         for (name, t) in tracers(&scene) {
             g.bench_function(BenchmarkId::from_parameter(&name), |b| {

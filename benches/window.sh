@@ -1,9 +1,10 @@
 #!/usr/bin/env bash
-# The README's throughput table, from one window (the machine's speed drifts 10-20% over minutes, so every
-# figure of a ratio comes from the same run of this script): raw Embree all-hits (the shared yardstick,
-# ../shared/anchors/embree-bench), our kernels (cargo bench --bench throughput, "all-hits" column),
-# `scx analyze` end to end through the CLI with its peak memory, and the same without the discrete
-# measures, on S1 = @cube:30, S3 = @cube:100 (3e7 lines) and @cube:130 (1e8 lines), 2 threads.
+# docs/performance.md's table "Throughput against raw Embree", from one window (the machine's speed drifts
+# 10-20% over minutes, so every figure of a ratio comes from the same run of this script): raw Embree
+# all-hits (the shared yardstick, ../shared/anchors/embree-bench), our kernels (cargo bench --bench
+# throughput, "all-hits" column), `scx analyze` end to end through the CLI with its peak memory, and the
+# same without the discrete measures, on S1 = @cube:30, S3 = @cube:100 (3e7 lines) and @cube:130 (1e8
+# lines), 2 threads.
 #
 #   bash benches/window.sh            # about 20 minutes; needs the yardstick's C file and libembree3
 #   ANCHOR=/path/to/embree-bench bash benches/window.sh

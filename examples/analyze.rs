@@ -6,7 +6,7 @@
 
 use std::error::Error;
 
-use scene_complexity::{analyze, load, make_tracer, AnalysisConfig, Backend, Query, RunControl};
+use scene_complexity::{analyze, load, make_tracer, Backend, Measure, Query, RunControl, RunSpec};
 
 fn main() -> Result<(), Box<dyn Error>> {
     let mut args = std::env::args().skip(1);
@@ -25,7 +25,7 @@ fn main() -> Result<(), Box<dyn Error>> {
     let analysis = analyze(
         &scene,
         tracer.as_ref(),
-        &AnalysisConfig::new(lines, 1),
+        &RunSpec::new(lines, 1),
         &RunControl::default(),
     )?;
     for warning in &analysis.warnings {
@@ -39,15 +39,20 @@ fn main() -> Result<(), Box<dyn Error>> {
         analysis.lines,
         tracer.name()
     );
-    let v = &analysis.visibility;
-    for (name, estimate) in [
-        ("I_s (plug-in, eq. 21)", v.mutual_information),
-        ("I_s (bias-corrected)", v.mutual_information_corrected),
-        ("I_s^c (eq. 27)", v.continuous_mutual_information),
+    for measure in [
+        Measure::MutualInformation,
+        Measure::MutualInformationCorrected,
+        Measure::ContinuousMutualInformation,
     ] {
-        if let Some(e) = estimate {
+        if let Some(e) = analysis.estimate(measure) {
             let se = e.stderr.map_or("n/a".into(), |s| format!("{s:.6}"));
-            println!("{name:<24} {:>10.6} ± {se} bits", e.value);
+            let verdict = analysis.verdict(measure).map_or("", |v| v.name());
+            println!(
+                "{:<38} {:>10.6} ± {se} {}  {verdict}",
+                measure.info().label,
+                e.value,
+                measure.info().unit.name()
+            );
         }
     }
     Ok(())

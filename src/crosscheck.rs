@@ -22,11 +22,11 @@ use std::fmt;
 
 use rayon::prelude::*;
 
+use crate::analysis::{analyze, Analysis, AnalysisError};
 use crate::geom::DVec3;
-use crate::measure::Estimate;
+use crate::measure::{Estimate, Measure};
 use crate::run::{
-    all_batches, analyze, map_batches, Analysis, AnalysisConfig, AnalysisError, BatchPlan,
-    LineStream, Measures, RunControl, TraceBuffers,
+    all_batches, map_batches, BatchPlan, LineStream, Measures, RunControl, RunSpec, TraceBuffers,
 };
 use crate::scene::Scene;
 use crate::trace::rust::bvh::margin;
@@ -279,7 +279,7 @@ pub struct KindComparison {
     /// What each example line was aimed at, in the order of `hits.examples`.
     pub aims: Vec<Aim>,
     /// The first tracer's hits whose point lies outside its triangle's box grown by the tracers' margin
-    /// ([`margin`]): hits of lines that lie in the triangle's plane to within rounding, where the
+    /// (1/65536 of the scene's size): hits of lines that lie in the triangle's plane to within rounding, where the
     /// watertight test's verdict and distance are rounding ([`aimed`], "What agreement means on these
     /// lines").
     pub stray_hits: u64,
@@ -449,7 +449,7 @@ pub fn compare_measures(
     scene: &Scene,
     a: &dyn Tracer,
     b: &dyn Tracer,
-    cfg: &AnalysisConfig,
+    cfg: &RunSpec,
 ) -> Result<Vec<MeasureComparison>, AnalysisError> {
     let control = RunControl::default();
     let ra = analyze(scene, a, cfg, &control)?;
@@ -462,17 +462,31 @@ pub fn compare_measures(
 }
 
 fn measures(r: &Analysis) -> Vec<(&'static str, Option<Estimate>)> {
-    let v = &r.visibility;
     vec![
-        ("visibility entropy H_s (eq. 17)", v.entropy),
-        ("joint entropy H(X,Y) (eq. 7)", v.joint_entropy),
-        ("mutual information I_s (eq. 21)", v.mutual_information),
+        (
+            "visibility entropy H_s (eq. 17)",
+            r.estimate(Measure::Entropy),
+        ),
+        (
+            "joint entropy H(X,Y) (eq. 7)",
+            r.estimate(Measure::JointEntropy),
+        ),
+        (
+            "mutual information I_s (eq. 21)",
+            r.estimate(Measure::MutualInformation),
+        ),
         (
             "continuous mutual information I_s^c (eq. 27)",
-            v.continuous_mutual_information,
+            r.estimate(Measure::ContinuousMutualInformation),
         ),
-        ("accuracy I_s / I_s^c (sec. 3.3)", v.accuracy),
-        ("form-factor E(MSE) per line (eq. 22)", v.mse_per_line),
+        (
+            "accuracy I_s / I_s^c (sec. 3.3)",
+            r.estimate(Measure::Accuracy),
+        ),
+        (
+            "form-factor E(MSE) per line (eq. 22)",
+            r.estimate(Measure::MsePerLine),
+        ),
     ]
 }
 
@@ -499,10 +513,10 @@ pub fn crosscheck(
     groups: usize,
 ) -> Result<CrossCheck, AnalysisError> {
     let hits = compare_hits(scene, a, b, cfg)?;
-    let analysis = AnalysisConfig {
+    let analysis = RunSpec {
         groups,
         measures: Measures::VISIBILITY,
-        ..AnalysisConfig::new(cfg.lines, cfg.seed)
+        ..RunSpec::new(cfg.lines, cfg.seed)
     };
     let measures = compare_measures(scene, a, b, &analysis)?;
     Ok(CrossCheck {

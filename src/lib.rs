@@ -8,64 +8,139 @@
 //! light, the radiosity measures of sec. 4, each with its standard error.
 //!
 //! ```
-//! use scene_complexity::{analyze, load, make_tracer, AnalysisConfig, Backend, Query, RunControl};
+//! use scene_complexity::{analyze, load, make_tracer, Backend, Measure, Query, RunControl, RunSpec};
 //!
 //! // The unit cube cut into 4 x 4 patches per face, whose exact I_s is 1.12257 bits.
 //! let scene = load("@cube:4")?;
 //! let tracer = make_tracer(Backend::Rust, &scene, Query::Single)?;
-//! let config = AnalysisConfig::new(200_000, 1);
-//! let a = analyze(&scene, tracer.as_ref(), &config, &RunControl::default())?;
-//! let is = a.visibility.mutual_information_corrected.expect("counted");
-//! let isc = a.visibility.continuous_mutual_information.expect("summed");
+//! let spec = RunSpec::new(200_000, 1);
+//! let a = analyze(&scene, tracer.as_ref(), &spec, &RunControl::default())?;
+//! let is = a.estimate(Measure::MutualInformationCorrected).expect("counted");
+//! let isc = a.estimate(Measure::ContinuousMutualInformation).expect("summed");
 //! println!("I_s = {:.4} ± {:.4} bits, I_s^c = {:.4} ± {:.4} bits", is.value,
 //!          is.stderr.unwrap(), isc.value, isc.stderr.unwrap());
 //! assert!((is.value - 1.12257).abs() < 5.0 * is.stderr.unwrap());
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 //!
-//! The layers, in the order data flows (each imports only from the layers before it; a test checks it):
+//! The API at a glance:
 //!
-//! * [`geom`]: points, directions, normals and shapes;
-//! * [`scene`]: the scene model (patches, materials), its builder and the file loaders;
-//! * [`scenes`]: the catalogue of built-in scenes (`@cube:10`, `@cornell`, the paper's figures);
-//! * [`trace`]: every intersection along a batch of lines (Embree, or the pure-Rust tracer);
-//! * [`sample`]: global lines, pairing of hits into mutually visible points, tallies and pair counts;
-//! * [`measure`]: the paper's measures from counts and sums (sec. 3 and 4);
-//! * [`run`]: the run engine (batches, rounds, groups and standard errors, budgets) and [`analyze`];
+//! * scenes: [`load`] a file or a built-in ([`CATALOGUE`]), or build one with [`SceneBuilder`]; write it
+//!   with [`write_obj`] or [`write_gltf`];
+//! * a run: [`RunSpec`] says what it is (every setting that determines its numbers), [`analyze`] casts
+//!   it with a [`Tracer`] from [`make_tracer`] and returns an [`Analysis`], whose readings are indexed by
+//!   [`Measure`] (the catalogue of measures, [`MEASURES`]), each an [`Estimate`] with its standard error
+//!   and a [`Verdict`];
+//! * runs in parts: [`start`], [`cast`] and [`finish`] are [`analyze`]'s three steps; a [`RunState`]
+//!   is saved with [`save_state`], read with [`load_state`], and parts of one run merge with
+//!   [`RunState::absorb`];
 //! * the applications: [`reproduce`] (the paper's tables), [`mod@refine`] (meshing strategies),
 //!   [`render`] (pictures of the per-patch results) and [`mod@crosscheck`] (the two tracers, hit for
 //!   hit).
+//!
+//! Inside, the layers in the order data flows (each imports only from the layers before it; a test
+//! checks it): `geom` (points, directions, shapes), `scene` (the scene model, its builder and readers),
+//! `scenes` (the built-in scenes), `trace` (every intersection along a batch of lines, by Embree or the
+//! pure-Rust tracer), `sample` (global lines, the pairing of hits, tallies and pair counts), `measure`
+//! (the paper's measures from counts and sums, and their catalogue), `run` (the run engine: batches,
+//! rounds, groups, budgets, saved states), `analysis` (every measure of a run with its standard error
+//! and verdict), then the applications.
 
 #![deny(missing_docs)]
 #![deny(unsafe_code)]
 #![forbid(unsafe_op_in_unsafe_fn)]
 
+// The layers, private: what a library user needs is re-exported below; scx's own tests, benches and fuzz
+// targets reach the rest through `internals`.
+mod analysis;
+mod geom;
+mod measure;
+mod run;
+mod sample;
+mod scene;
+mod scenes;
+mod trace;
+
+// The applications, public modules of their own.
 pub mod crosscheck;
-pub mod geom;
-pub mod measure;
 pub mod refine;
 pub mod render;
 pub mod reproduce;
-pub mod run;
-pub mod sample;
-pub mod scene;
-pub mod scenes;
-pub mod trace;
+
+// Scenes: loading (files and built-ins), building from arrays, writing.
+pub use geom::{Direction, Normal, Point, Vector};
+pub use scene::{
+    gltf::write as write_gltf, obj::load_text_with as load_obj_text, obj::write as write_obj,
+    Material, Normalization, ObjectSet, Patch, Planarity, Scene, SceneBuilder, SceneError,
+    SceneOptions, DEFAULT_PLANARITY,
+};
+pub use scenes::{load, load_with, Builtin, CATALOGUE};
+
+// Tracing.
+pub use trace::{make_tracer, Backend, Query, QueryError, TraceError, Tracer};
+
+// What a run is, and how it is cast, saved, merged and resumed.
+pub use measure::estimators::EntropyEstimator;
+pub use measure::radiosity::{MaterialError, MaterialProblem, PatchMaterials, SolveOptions};
+pub use run::persist::{load as load_state, save as save_state};
+pub use run::{
+    remaining_lines, start, Budget, CastOptions, ErrorMethod, ExtendError, Measures, MergeError,
+    PersistError, RunControl, RunIdentity, RunSpec, RunState, SavedRun, SceneRef, Scope, Shard,
+    SpecDifference, StopReason, Target, Tracing, DEFAULT_ESTIMATOR, DEFAULT_GROUPS,
+};
+pub use sample::counts::PairCounts;
+pub use sample::lines::{BundleError, LineSource};
+pub use sample::tally::{Tally, Wanted};
+
+// What is computed from a run.
+pub use analysis::{
+    analyze, cast, finish, Analysis, AnalysisError, PatchResult, RadiosityOutcome, RadiositySolve,
+    Reliability, RunWarning, RunWarningKind, SamplingReport, SolveFailure, TargetOutcome, Verdict,
+};
+pub use measure::catalogue::{
+    Bound, ByMeasure, Family, Measure, MeasureInfo, Needs, PatchMeasure, PatchMeasureInfo, Unit,
+    VerdictRule, CATALOGUE as MEASURES, PATCH_CATALOGUE as PATCH_MEASURES,
+};
+pub use measure::Estimate;
 
 pub use crosscheck::{crosscheck, CrossCheck, CrossCheckConfig, Tolerance};
-pub use geom::{Direction, Normal, Point, Vector};
-pub use measure::estimators::EntropyEstimator;
-pub use measure::radiosity::SolveOptions;
-pub use measure::Estimate;
 pub use refine::{refine, RefineConfig, RefineError, Refinement, Strategy};
-pub use run::{
-    analyze, Analysis, AnalysisConfig, AnalysisError, Budget, ErrorMethod, Measures,
-    RadiosityEstimates, RadiosityOutcome, RunControl, RunWarning, RunWarningKind, StopReason,
-    Target, TargetMeasure, VisibilityEstimates,
-};
-pub use sample::lines::LineSource;
-pub use scene::{
-    Material, ObjectSet, Patch, Planarity, Scene, SceneBuilder, SceneError, SceneOptions,
-};
-pub use scenes::{load, load_with};
-pub use trace::{make_tracer, Backend, Query, TraceError, Tracer};
+
+/// The door to the layers below the public API, for scx's own tests, benches and fuzz targets (they
+/// check internals against independent truth: closed forms, brute force, invariants). Not part of the
+/// API: it changes whenever the code does.
+#[doc(hidden)]
+pub mod internals {
+    /// Points, directions and shapes.
+    pub mod geom {
+        pub use crate::geom::*;
+    }
+    /// The scene model, its builder and readers.
+    pub mod scene {
+        pub use crate::scene::*;
+    }
+    /// The built-in scenes.
+    pub mod scenes {
+        pub use crate::scenes::*;
+    }
+    /// The tracers.
+    pub mod trace {
+        pub use crate::trace::*;
+    }
+    /// Lines, pairing, tallies and counts.
+    pub mod sample {
+        pub use crate::sample::*;
+    }
+    /// The measures from counts and sums.
+    pub mod measure {
+        pub use crate::measure::*;
+    }
+    /// The run engine.
+    pub mod run {
+        pub use crate::run::*;
+    }
+    /// What is computed from a run.
+    pub mod analysis {
+        pub use crate::analysis::*;
+    }
+}

@@ -7,10 +7,12 @@
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
-use scene_complexity::run::{analyze, AnalysisConfig, RunControl};
-use scene_complexity::scene::{obj, Scene};
-use scene_complexity::scenes;
-use scene_complexity::trace::{make_tracer, Backend, Query};
+use scene_complexity::internals::measure::Measure;
+use scene_complexity::internals::run::{RunSpec, RunControl};
+use scene_complexity::internals::analysis::analyze;
+use scene_complexity::internals::scene::{obj, Scene};
+use scene_complexity::internals::scenes;
+use scene_complexity::internals::trace::{make_tracer, Backend, Query};
 
 fuzz_target!(|data: &[u8]| {
     let Ok(text) = std::str::from_utf8(data) else {
@@ -37,10 +39,10 @@ fn trace_a_little(scene: &Scene) {
         return;
     }
     let tracer = make_tracer(Backend::Rust, scene, Query::Single).expect("the Rust tracer builds");
-    let cfg = AnalysisConfig {
+    let cfg = RunSpec {
         groups: 2,
         enclose: scene.triangles.len() % 2 == 0,
-        ..AnalysisConfig::new(256, 1)
+        ..RunSpec::new(256, 1)
     };
     let a = match analyze(scene, tracer.as_ref(), &cfg, &RunControl::default()) {
         Ok(a) => a,
@@ -49,10 +51,10 @@ fn trace_a_little(scene: &Scene) {
         Err(e) => panic!("tracing a loaded scene failed: {e}"),
     };
     for e in [
-        a.visibility.positional_entropy,
-        a.visibility.entropy,
-        a.visibility.mutual_information,
-        a.visibility.continuous_mutual_information,
+        a.estimate(Measure::PositionalEntropy),
+        a.estimate(Measure::Entropy),
+        a.estimate(Measure::MutualInformation),
+        a.estimate(Measure::ContinuousMutualInformation),
     ]
     .into_iter()
     .flatten()

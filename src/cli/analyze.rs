@@ -4,20 +4,21 @@ use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use clap::ValueEnum;
-use scene_complexity::run::persist;
-use scene_complexity::run::{
-    cast, finish, plan_of, remaining_lines, start, AnalysisConfig, Budget, CastOptions, Measures,
-    PersistError, RunControl, RunIdentity, RunState, Scope, StopReason, Target, TargetMeasure,
+use scene_complexity::LineSource;
+use scene_complexity::Measure;
+use scene_complexity::Query;
+use scene_complexity::{cast, finish};
+use scene_complexity::{
+    remaining_lines, start, Budget, CastOptions, Measures, PersistError, RunControl, RunIdentity,
+    RunSpec, RunState, SceneRef, Scope, Shard, StopReason, Target,
 };
-use scene_complexity::sample::lines::LineSource;
-use scene_complexity::trace::{Backend, Query};
 
-use super::args::{parse_count, parse_positive, parse_target_measure, ReportOutput, RunOptions};
+use super::args::{parse_count, parse_positive, target_measure_parser, ReportOutput, RunOptions};
+use super::exit::{Exit, Failure};
 use super::output::{self, warn};
-use super::patches::PatchFiles;
+use super::patch_files::PatchFiles;
 use super::report::{self, Format};
 use super::runner::Runner;
-use super::{Exit, Failure};
 
 /// Arguments of `scx analyze`.
 #[derive(clap::Args, Debug)]
@@ -42,10 +43,9 @@ pub struct AnalyzeArgs {
     /// (verdict `ok`); then --lines (and --seconds) only cap the run.
     #[arg(long, value_parser = parse_positive, allow_negative_numbers = true)]
     target_stderr: Option<f64>,
-    /// The measure --target-stderr watches: mutual_information_corrected (default), mutual_information,
-    /// entropy, entropy_corrected, continuous_mutual_information, accuracy, accuracy_corrected.
-    #[arg(long, default_value = "mutual_information_corrected", value_parser = parse_target_measure)]
-    target_measure: TargetMeasure,
+    /// The measure --target-stderr watches.
+    #[arg(long, default_value = Measure::DEFAULT_TARGET.key(), value_parser = target_measure_parser())]
+    target_measure: Measure,
     /// Cast the lines in bundles of G x G parallel lines (jittered grid over the disc, traced as adjacent
     /// packets); 0 casts independent lines. The standard errors include the correlation within a bundle.
     #[arg(long, default_value_t = 0, value_parser = parse_bundle)]
@@ -64,7 +64,7 @@ pub struct AnalyzeArgs {
     #[command(flatten)]
     out: ReportOutput,
     /// Save the run's state to FILE at the end (also when interrupted): `scx merge` reports it,
-    /// `--resume` continues it (README, "Runs beyond one machine and one sitting").
+    /// `--resume` continues it (docs/runs.md, "Runs beyond one machine").
     #[arg(long, value_name = "FILE")]
     save: Option<PathBuf>,
     /// Run only shard K of M of the run's batches (K from 1); needs --save or --checkpoint, and no
@@ -72,7 +72,7 @@ pub struct AnalyzeArgs {
     /// run.
     #[arg(long, value_name = "K/M", value_parser = parse_shard,
           conflicts_with_all = ["seconds", "target_stderr"])]
-    shard: Option<(u32, u32)>,
+    shard: Option<Shard>,
     /// Save the run's state to FILE every --checkpoint-every seconds and at the end (atomically: a
     /// run killed loses only the work since the last checkpoint).
     #[arg(long, value_name = "FILE")]
@@ -81,11 +81,12 @@ pub struct AnalyzeArgs {
     #[arg(long, default_value = "300", value_parser = parse_positive, allow_negative_numbers = true)]
     checkpoint_every: f64,
     /// Continue the run saved in FILE (by --save or --checkpoint) with its own settings, up to --lines
-    /// (more lines than first asked are fine), and save it back to FILE as it goes.
+    /// (more lines than first asked are fine), and save it back to FILE as it goes. --tracer, --query
+    /// and --threads may differ from the first run's: they change no number.
     #[arg(long, value_name = "FILE", conflicts_with_all = [
-        "seed", "tracer", "query", "groups", "estimator", "errors", "measures", "seconds",
-        "target_stderr", "target_measure", "bundle", "enclose", "shard", "planarity",
-        "strict_planarity", "flip_normals", "two_sided"])]
+        "seed", "groups", "estimator", "errors", "measures", "seconds", "target_stderr",
+        "target_measure", "bundle", "enclose", "shard", "planarity", "strict_planarity",
+        "flip_normals", "two_sided"])]
     resume: Option<PathBuf>,
     #[command(flatten)]
     files: PatchFiles,
@@ -99,7 +100,7 @@ enum MeasureArg {
 }
 
 /// A shard `K/M`, 1 <= K <= M.
-fn parse_shard(s: &str) -> Result<(u32, u32), String> {
+fn parse_shard(s: &str) -> Result<Shard, String> {
     let (k, m) = s
         .split_once('/')
         .ok_or_else(|| format!("`{s}`: a shard is K/M, shard K (from 1) of M"))?;
@@ -112,7 +113,7 @@ fn parse_shard(s: &str) -> Result<(u32, u32), String> {
     if !(1..=m).contains(&k) {
         return Err(format!("`{s}`: need 1 <= K <= M"));
     }
-    Ok((k, m))
+    Ok(Shard { index: k, count: m })
 }
 
 /// Checks the per-patch files before any work: their kinds, that they can be written, and that a new
@@ -145,11 +146,11 @@ fn parse_bundle(s: &str) -> Result<u32, String> {
         .trim()
         .parse()
         .map_err(|_| format!("`{s}` is not a whole number"))?;
-    LineSource::bundles(g).map(|_| g)
+    LineSource::bundles(g).map(|_| g).map_err(|e| e.to_string())
 }
 
-/// The settings of a new run from the arguments.
-fn config_of(args: &AnalyzeArgs, runner: &Runner) -> Result<AnalysisConfig, Failure> {
+/// The spec of a new run from the arguments: the command line, parsed once.
+fn spec_of(args: &AnalyzeArgs) -> Result<RunSpec, Failure> {
     let measures = match &args.measures {
         None => Measures::ALL,
         Some(m) => Measures {
@@ -170,65 +171,71 @@ fn config_of(args: &AnalyzeArgs, runner: &Runner) -> Result<AnalysisConfig, Fail
     } else {
         1_000_000
     });
-    Ok(AnalysisConfig {
+    Ok(RunSpec {
         measures,
         budget,
         source: LineSource::bundles(args.bundle).map_err(Failure::bad_input)?,
         enclose: args.enclose,
         per_patch: !args.files.patches.is_empty(),
-        ..runner.config(&args.run, lines, args.run.seed)
+        ..args.run.spec(lines, args.run.seed.value)
     })
 }
 
-/// A run about to be cast: its runner, settings, identity and state, and the seconds it took before.
+/// A run about to be cast: its runner, identity (with its spec) and state, and the seconds it took
+/// before.
 struct Prepared {
     runner: Runner,
-    cfg: AnalysisConfig,
     identity: RunIdentity,
     state: RunState,
     seconds: f64,
 }
 
 /// A new run from the arguments.
-fn new_run(args: &AnalyzeArgs, spec: &str) -> Result<Prepared, Failure> {
-    let runner = Runner::new(spec, &args.run)?;
-    let cfg = config_of(args, &runner)?;
-    if spec == "-" && (args.save.is_some() || args.checkpoint.is_some()) {
+fn new_run(args: &AnalyzeArgs, name: &str) -> Result<Prepared, Failure> {
+    let spec = spec_of(args)?;
+    if name == "-" && (args.save.is_some() || args.checkpoint.is_some()) {
         return Err(Failure::bad_input(
             "a run of a scene read from standard input cannot be saved (a resume or merge could not \
              read it again): save the scene to a file",
         ));
     }
-    let state = start(&runner.scene, &cfg).map_err(Failure::of)?;
-    let identity = RunIdentity::of(
+    let reading = args.run.input.options();
+    let runner = Runner::with(name, &reading, args.run.tracing(), args.run.threads.value)?;
+    let state = start(&runner.scene, &spec).map_err(Failure::bad_input)?;
+    let identity = RunIdentity::new(
+        SceneRef::of(name, &reading, &runner.scene),
         spec,
-        &args.run.input.options(),
-        &runner.scene,
-        &cfg,
-        runner.tracer.name(),
-        &args.run.query.to_string(),
         args.shard,
+        runner.tracing,
     );
     Ok(Prepared {
         runner,
-        cfg,
         identity,
         state,
         seconds: 0.0,
     })
 }
 
-/// A saved run to continue, to `--lines` when given.
+/// A saved run to continue, to `--lines` when given, traced as `--tracer`/`--query` ask or else as it
+/// was.
 fn resumed_run(args: &AnalyzeArgs, file: &Path) -> Result<Prepared, Failure> {
-    let saved = persist::load(file).map_err(persist_failure)?;
+    let saved = scene_complexity::load_state(file).map_err(persist_failure)?;
     let mut identity = saved.identity;
-    let spec = args.scene.clone().unwrap_or_else(|| identity.scene.clone());
-    let backend = match identity.tracer.as_str() {
-        "embree" => Backend::Embree,
-        _ => Backend::Rust,
+    let name = args
+        .scene
+        .clone()
+        .unwrap_or_else(|| identity.scene.name.clone());
+    let tracing = match (args.run.tracer.value, args.run.query) {
+        (None, Query::Single) => identity.tracing,
+        _ => args.run.tracing(),
     };
-    let query = Query::parse(&identity.query).map_err(Failure::bad_input)?;
-    let runner = Runner::with(&spec, &identity.reading, backend, query, args.run.threads)?;
+    let runner = Runner::with(
+        &name,
+        &identity.scene.reading,
+        tracing,
+        args.run.threads.value,
+    )?;
+    identity.tracing = runner.tracing;
     let shown = file.display().to_string();
     check_same_scene(&shown, &identity, &runner)?;
     // A state keeps the per-patch sums when its first run was asked for --patches, and a resumed run
@@ -240,39 +247,16 @@ fn resumed_run(args: &AnalyzeArgs, file: &Path) -> Result<Prepared, Failure> {
         .collect();
     args.files
         .check_saved(&shown, &identity, wanted, &without_sums)?;
-    let mut cfg = identity
-        .config()
-        .map_err(|e| Failure::bad_input(format!("{}: {e}", file.display())))?;
     let mut state = saved.state;
-    if let Some(lines) = args.lines.filter(|&n| n != identity.lines) {
-        let old_plan = plan_of(&cfg);
-        cfg.lines = lines;
-        let plan = plan_of(&cfg);
-        let groups = (cfg.groups.max(2) as u64).min(plan.batches().max(2));
-        if lines < identity.lines {
-            return Err(Failure::bad_input(format!(
-                "{}: a run of {} lines cannot be continued to fewer lines ({lines})",
-                file.display(),
-                identity.lines
-            )));
-        }
-        if plan.batch_size != old_plan.batch_size || groups != state.group_count() {
-            return Err(Failure::bad_input(format!(
-                "{}: a run of {} lines (batches of {}) can be continued to more lines cut the same way: \
-                 {lines} lines would be batches of {} in {groups} groups (from 262144 lines on, every \
-                 run has batches of 4096)",
-                file.display(),
-                identity.lines,
-                old_plan.batch_size,
-                plan.batch_size
-            )));
-        }
-        state = state.extend(plan);
-        identity.lines = lines;
+    if let Some(lines) = args.lines.filter(|&n| n != identity.spec.lines) {
+        identity.spec = identity
+            .spec
+            .extended_to(lines)
+            .map_err(|e| Failure::bad_input(format!("{shown}: {e}")))?;
+        state = state.extend(identity.spec.plan());
     }
     Ok(Prepared {
         runner,
-        cfg,
         identity,
         state,
         seconds: saved.seconds,
@@ -286,11 +270,12 @@ pub fn check_same_scene(
     runner: &Runner,
 ) -> Result<(), Failure> {
     let fingerprint = runner.scene.fingerprint();
-    if fingerprint != identity.fingerprint {
+    let saved = &identity.scene.fingerprint;
+    if &fingerprint != saved {
         return Err(Failure::bad_input(format!(
             "{file}: the state is of another scene than {} (fingerprint {} against {})",
             runner.scene.name,
-            &identity.fingerprint[..12.min(identity.fingerprint.len())],
+            &saved[..12.min(saved.len())],
             &fingerprint[..12]
         )));
     }
@@ -331,7 +316,7 @@ impl Checkpoints<'_> {
         if self.failed.is_some() || self.last.elapsed() < self.every {
             return;
         }
-        match persist::save(path, identity, state, self.seconds()) {
+        match scene_complexity::save_state(path, identity, state, self.seconds()) {
             Ok(()) => self.last = Instant::now(),
             Err(e) => {
                 self.failed = Some(persist_failure(e));
@@ -357,7 +342,6 @@ pub fn run(args: &AnalyzeArgs) -> Result<Exit, Failure> {
     check_patch_files(args)?;
     let Prepared {
         runner,
-        cfg,
         identity,
         mut state,
         seconds: before,
@@ -365,14 +349,13 @@ pub fn run(args: &AnalyzeArgs) -> Result<Exit, Failure> {
         Some(file) => resumed_run(args, file)?,
         None => new_run(args, args.scene.as_deref().unwrap_or("-"))?,
     };
-    let cfg = AnalysisConfig {
+    // The per-patch files asked for now decide what is shared out at the end; what is gathered is what
+    // the state gathers.
+    let cfg = RunSpec {
         per_patch: !args.files.patches.is_empty(),
-        ..cfg
+        ..identity.spec.clone()
     };
-    let scope = match identity.shard {
-        Some((index, count)) => Scope::Shard { index, count },
-        None => Scope::All,
-    };
+    let scope = Scope::of(identity.shard);
     let mut checkpoints = Checkpoints {
         path: checkpoint,
         every: Duration::from_secs_f64(args.checkpoint_every),
@@ -407,7 +390,7 @@ pub fn run(args: &AnalyzeArgs) -> Result<Exit, Failure> {
         return Err(f);
     }
     for path in [args.save.as_deref(), checkpoint].into_iter().flatten() {
-        persist::save(path, &identity, &state, seconds).map_err(persist_failure)?;
+        scene_complexity::save_state(path, &identity, &state, seconds).map_err(persist_failure)?;
         output::wrote(path);
     }
     // In the run's pool: the measures use the threads asked for, like the tracing.
@@ -419,7 +402,6 @@ pub fn run(args: &AnalyzeArgs) -> Result<Exit, Failure> {
         warn(&w.message);
     }
     let run = report::RunInfo {
-        bundle: identity.bundle,
         shard: identity.shard,
         ..runner.info()
     };

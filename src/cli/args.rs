@@ -4,10 +4,13 @@
 use std::path::PathBuf;
 
 use clap::ValueEnum;
-use scene_complexity::measure::estimators::EntropyEstimator;
-use scene_complexity::run::{ErrorMethod, TargetMeasure, DEFAULT_ESTIMATOR, DEFAULT_GROUPS};
-use scene_complexity::scene::{ObjectSet, Planarity, SceneOptions, DEFAULT_PLANARITY};
-use scene_complexity::trace::{Backend, Query};
+use scene_complexity::EntropyEstimator;
+use scene_complexity::Measure;
+use scene_complexity::{Backend, Query};
+use scene_complexity::{
+    ErrorMethod, Measures, RunSpec, Tracing, DEFAULT_ESTIMATOR, DEFAULT_GROUPS,
+};
+use scene_complexity::{ObjectSet, Planarity, SceneOptions, DEFAULT_PLANARITY};
 
 /// How a scene file is read: non-planar polygons, and objects to flip or make two-sided.
 #[derive(clap::Args, Debug, Clone)]
@@ -50,20 +53,46 @@ impl SceneArgs {
     }
 }
 
-/// Options of every command that casts lines.
+/// `--seed`: the seed of the random line streams.
+#[derive(clap::Args, Debug, Clone, Copy)]
+pub struct Seed {
+    /// Seed of the random line streams (a whole number >= 0; accepts `1e3`): the same seed gives the
+    /// same lines, and the same numbers, whatever the threads or the tracer.
+    #[arg(id = "seed", long = "seed", value_name = "SEED", default_value = "1", value_parser = parse_seed,
+          allow_negative_numbers = true)]
+    pub value: u64,
+}
+
+/// `--threads`: how many worker threads.
+#[derive(clap::Args, Debug, Clone, Copy)]
+pub struct Threads {
+    /// Worker threads; 0 or absent: all cores. Results do not depend on it.
+    #[arg(id = "threads", long = "threads", value_name = "THREADS", value_parser = parse_threads,
+          allow_negative_numbers = true)]
+    pub value: Option<usize>,
+}
+
+/// `--tracer`: the tracing backend.
+#[derive(clap::Args, Debug, Clone, Copy)]
+pub struct Tracer {
+    /// Tracing backend (default: rust, the faster; embree when a packet query is asked for). Both give
+    /// the same hits (`scx crosscheck`).
+    #[arg(id = "tracer", long = "tracer", value_name = "TRACER", value_enum)]
+    pub value: Option<TracerArg>,
+}
+
+/// Options of every command that casts lines and measures them: how the scene is read, the seed, how
+/// the run runs, and how its standard errors and corrections are made.
 #[derive(clap::Args, Debug)]
 pub struct RunOptions {
     #[command(flatten)]
     pub input: SceneArgs,
-    /// Seed of the random line streams (a whole number >= 0; accepts `1e3`).
-    #[arg(long, default_value = "1", value_parser = parse_seed, allow_negative_numbers = true)]
-    pub seed: u64,
-    /// Worker threads; 0 or absent: all cores. Results do not depend on it.
-    #[arg(long, value_parser = parse_threads, allow_negative_numbers = true)]
-    pub threads: Option<usize>,
-    /// Tracing backend (default: rust, the faster; embree when a packet query is asked for).
-    #[arg(long, value_enum)]
-    pub tracer: Option<TracerArg>,
+    #[command(flatten)]
+    pub seed: Seed,
+    #[command(flatten)]
+    pub threads: Threads,
+    #[command(flatten)]
+    pub tracer: Tracer,
     /// Ray query: `single`, or `packet4`/`packet8`/`packet16` (Embree, native widths only).
     #[arg(long, default_value = "single", value_parser = parse_query)]
     pub query: Query,
@@ -80,6 +109,28 @@ pub struct RunOptions {
     /// meshes). I_s^c always gets batch means.
     #[arg(long, default_value = "groups", value_parser = parse_errors)]
     pub errors: ErrorMethod,
+}
+
+impl RunOptions {
+    /// The spec of a run of `lines` lines from `seed` with these options: the visibility measures (a
+    /// command that wants others says so).
+    pub fn spec(&self, lines: u64, seed: u64) -> RunSpec {
+        RunSpec {
+            measures: Measures::VISIBILITY,
+            groups: usize::from(self.groups),
+            estimator: self.estimator,
+            errors: self.errors,
+            ..RunSpec::new(lines, seed)
+        }
+    }
+
+    /// The tracer these options ask for.
+    pub fn tracing(&self) -> Tracing {
+        Tracing {
+            backend: TracerArg::backend_for(self.tracer.value, self.query),
+            query: self.query,
+        }
+    }
 }
 
 /// Where a report goes.
@@ -187,16 +238,17 @@ fn parse_errors(s: &str) -> Result<ErrorMethod, String> {
     })
 }
 
-/// A measure a precision target can watch.
-pub fn parse_target_measure(s: &str) -> Result<TargetMeasure, String> {
-    TargetMeasure::from_name(s).ok_or_else(|| {
-        let names: Vec<&str> = TargetMeasure::NAMES.iter().map(|(n, _)| *n).collect();
-        format!("`{s}`: expected one of {}", names.join(", "))
+/// The measures a precision target can watch (`--target-measure`), each with its label in `--help`.
+pub fn target_measure_parser() -> impl clap::builder::TypedValueParser<Value = Measure> {
+    let values =
+        Measure::targets().map(|m| clap::builder::PossibleValue::new(m.key()).help(m.info().label));
+    clap::builder::TypedValueParser::map(clap::builder::PossibleValuesParser::new(values), |key| {
+        Measure::target_named(&key).expect("a possible value names a target")
     })
 }
 
 fn parse_query(s: &str) -> Result<Query, String> {
-    Query::parse(s)
+    Query::parse(s).map_err(|e| e.to_string())
 }
 
 #[cfg(test)]

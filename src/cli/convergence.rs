@@ -5,17 +5,18 @@ use std::fmt::Write as _;
 use std::path::PathBuf;
 
 use clap::ValueEnum;
-use scene_complexity::measure::Estimate;
-use scene_complexity::run::{Analysis, StopReason};
+use scene_complexity::Analysis;
+use scene_complexity::StopReason;
+use scene_complexity::{Estimate, Measure};
 use serde_json::json;
 
 use super::args::{parse_count, ReportOutput, RunOptions};
+use super::exit::{Exit, Failure};
 use super::output::{self, check_all, note};
 use super::plot::{self, Curve, Series};
-use super::report::{self, Row};
+use super::report;
 use super::runner::Runner;
 use super::table::{fixed, Align, Table};
-use super::{Exit, Failure};
 
 /// Arguments of `scx convergence`.
 #[derive(clap::Args, Debug)]
@@ -51,15 +52,22 @@ enum ConvergenceFormat {
     Json,
 }
 
-/// The measures followed, as (JSON key, short name, corrected?). The plot leaves H_s out: I_s = H_p - H_s
-/// with H_p exact, so their errors are the same.
-const FOLLOWED: [(&str, &str, bool); 5] = [
-    ("mutual_information", "I_s", false),
-    ("mutual_information", "I_s corrected", true),
-    ("entropy", "H_s", false),
-    ("entropy", "H_s corrected", true),
-    ("continuous_mutual_information", "I_s^c", false),
-];
+/// The measures followed (the catalogue's, in their column order).
+fn followed() -> Vec<Measure> {
+    let mut all: Vec<Measure> = Measure::ALL
+        .into_iter()
+        .filter(|m| m.info().followed.is_some())
+        .collect();
+    all.sort_by_key(|m| m.info().followed);
+    all
+}
+
+/// Whether the plot shows `m`: not the entropies, since I_s = H_p - H_s with H_p exact, so their errors
+/// are I_s's.
+fn plotted(m: Measure) -> bool {
+    let (plain, corrected) = m.info().family.entropies();
+    m != plain && m != corrected
+}
 
 /// The runs at one line count.
 struct Level {
@@ -73,26 +81,13 @@ impl Level {
     }
 
     /// Mean value and mean standard error of a followed measure over the repeats.
-    fn measure(&self, key: &str, corrected: bool) -> Option<(f64, f64)> {
-        let estimates: Vec<Estimate> = self
-            .runs
-            .iter()
-            .filter_map(|a| pick(a, key, corrected))
-            .collect();
+    fn measure(&self, m: Measure) -> Option<(f64, f64)> {
+        let estimates: Vec<Estimate> = self.runs.iter().filter_map(|a| a.estimate(m)).collect();
         if estimates.len() != self.runs.len() || estimates.is_empty() {
             return None;
         }
         let stderr = mean(estimates.iter().filter_map(|e| e.stderr));
         Some((mean(estimates.iter().map(|e| e.value)), stderr))
-    }
-}
-
-fn pick(a: &Analysis, key: &str, corrected: bool) -> Option<Estimate> {
-    let row: Row = report::measures(a).into_iter().find(|r| r.key == key)?;
-    if corrected {
-        row.corrected
-    } else {
-        row.estimate
     }
 }
 
@@ -129,13 +124,12 @@ pub fn run(args: &ConvergenceArgs) -> Result<Exit, Failure> {
     'counts: for (k, &lines) in counts.iter().enumerate() {
         let mut runs = Vec::new();
         for r in 0..args.repeats {
-            let seed = args.run.seed + u64::from(r);
+            let seed = args.run.seed.value + u64::from(r);
             let label = format!(
                 "run {} of {total_runs}: {lines:.0e} lines, seed {seed}",
                 k as u32 * args.repeats + r + 1
             );
-            let mut a =
-                runner.analyze(&runner.config(&args.run, lines, seed), Some(lines), &label)?;
+            let mut a = runner.analyze(&args.run.spec(lines, seed), Some(lines), &label)?;
             // The counts are not needed any more; keep the measures only.
             a.tally.counts = None;
             let stopped = a.stop_reason != StopReason::Lines;
@@ -207,17 +201,18 @@ fn json_report(info: &report::RunInfo, levels: &[Level], repeats: u32) -> String
         .flat_map(|l| l.runs.iter())
         .map(|a| {
             let mut measures = serde_json::Map::new();
-            for (key, name, corrected) in FOLLOWED {
-                if let Some(e) = pick(a, key, corrected) {
+            for m in followed() {
+                if let Some(e) = a.estimate(m) {
+                    let info = m.info();
                     measures.insert(
-                        name.replace(' ', "_"),
-                        json!({"value": e.value, "stderr": e.stderr, "unit": "bit"}),
+                        info.symbol.replace(' ', "_"),
+                        json!({"value": e.value, "stderr": e.stderr, "unit": info.unit.name()}),
                     );
                 }
             }
             json!({
                 "lines": a.lines,
-                "seed": a.seed,
+                "seed": a.spec.seed,
                 "seconds": a.seconds,
                 "stop_reason": a.stop_reason.name(),
                 "measures": measures,
@@ -230,7 +225,7 @@ fn json_report(info: &report::RunInfo, levels: &[Level], repeats: u32) -> String
         "unit": "bit",
         "scene": info.scene.name,
         "patches": info.scene.patch_count(),
-        "tracer": info.tracer,
+        "tracer": info.tracing.backend.name(),
         "threads": info.threads,
         "repeats": repeats,
         "runs": runs,
@@ -247,27 +242,25 @@ fn curves(levels: &[Level]) -> Vec<Curve> {
     let Some(last) = levels.last() else {
         return out;
     };
-    for (series, &(key, name, corrected)) in
-        FOLLOWED.iter().filter(|f| f.0 != "entropy").enumerate()
-    {
-        let Some((reference, _)) = last.measure(key, corrected) else {
+    for (series, m) in followed().into_iter().filter(|&m| plotted(m)).enumerate() {
+        let Some((reference, _)) = last.measure(m) else {
             continue;
         };
         let label_of = |l: &Level| format!("{:.0e}", l.lines as f64);
         let stderr: Vec<(f64, f64, String)> = levels
             .iter()
-            .filter_map(|l| Some((l.seconds(), l.measure(key, corrected)?.1, label_of(l))))
+            .filter_map(|l| Some((l.seconds(), l.measure(m)?.1, label_of(l))))
             .filter(|&(s, e, _)| s > 0.0 && e > 0.0)
             .collect();
         let distance: Vec<(f64, f64, String)> = levels[..levels.len() - 1]
             .iter()
             .filter_map(|l| {
-                let d = (l.measure(key, corrected)?.0 - reference).abs();
+                let d = (l.measure(m)?.0 - reference).abs();
                 Some((l.seconds(), d, label_of(l)))
             })
             .filter(|&(s, e, _)| s > 0.0 && e > 0.0)
             .collect();
-        let name = plot_name(name);
+        let name = m.info().label;
         out.push(Curve {
             label: format!("{name}: standard error"),
             series: Series(series),
@@ -286,16 +279,6 @@ fn curves(levels: &[Level]) -> Vec<Curve> {
     out
 }
 
-/// A measure's name in words for the plot's legend.
-fn plot_name(short: &str) -> &'static str {
-    match short {
-        "I_s" => "mutual information I(s), plug-in",
-        "I_s corrected" => "mutual information I(s), corrected",
-        "I_s^c" => "continuous mutual information",
-        _ => "entropy",
-    }
-}
-
 fn table(info: &report::RunInfo, levels: &[Level], repeats: u32) -> String {
     let mut s = String::new();
     let _ = writeln!(
@@ -304,16 +287,16 @@ fn table(info: &report::RunInfo, levels: &[Level], repeats: u32) -> String {
          measures in bits\n",
         info.scene.name,
         info.scene.patch_count(),
-        info.tracer,
+        info.tracing.backend.name(),
         info.threads
     );
     let mut header = vec!["lines", "seconds"];
-    header.extend(FOLLOWED.iter().map(|f| f.1));
+    header.extend(followed().into_iter().map(|m| m.info().symbol));
     let mut t = Table::new(&header, &vec![Align::Right; header.len()]);
     for l in levels {
         let mut row = vec![l.lines.to_string(), format!("{:.3}", l.seconds())];
-        for (key, _, corrected) in FOLLOWED {
-            row.push(match l.measure(key, corrected) {
+        for m in followed() {
+            row.push(match l.measure(m) {
                 Some((v, e)) => format!("{} +- {}", fixed(v), fixed(e)),
                 None => "-".into(),
             });

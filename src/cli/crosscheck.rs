@@ -2,16 +2,14 @@
 
 use scene_complexity::crosscheck::aimed::AimKind;
 use scene_complexity::crosscheck::{self, AimedConfig, CrossCheckConfig, Tolerance};
-use scene_complexity::run::{AnalysisError, DEFAULT_GROUPS};
-use scene_complexity::scene::Scene;
-use scene_complexity::trace::{make_tracer, Backend, Query, Tracer};
+use scene_complexity::{make_tracer, AnalysisError, Backend, Query, Scene, Tracer, DEFAULT_GROUPS};
 
 use super::args::SceneArgs;
-use super::args::{parse_count, parse_seed, parse_threads, ReportOutput};
+use super::args::{parse_count, ReportOutput, Seed, Threads};
+use super::exit::{Exit, Failure};
 use super::input::load_scene;
 use super::output::{self, check_all};
 use super::runner::thread_pool;
-use super::{Exit, Failure};
 
 /// Random lines when `--lines` is not given.
 const DEFAULT_RANDOM_LINES: u64 = 1_000_000;
@@ -32,17 +30,15 @@ pub struct CrosscheckArgs {
     lines: Option<u64>,
     /// Instead of random lines, lines aimed where tracers could differ: at vertices, along and across
     /// edges, in and near faces' planes; these kinds (comma separated), or all without a list. `--lines`
-    /// lines of each; the report gives the lines and differing lines per kind. Put it after the scene.
+    /// lines of each, their directions and points drawn from the seed; the report gives the lines and
+    /// differing lines per kind. Put it after the scene.
     #[arg(long, value_enum, value_name = "KIND,...", num_args = 0..=1, value_delimiter = ',',
           default_missing_value = "all")]
     aimed: Option<Vec<AimArg>>,
-    /// Seed of the random line streams (the lines of `scx analyze` with the same seed; with --aimed, the
-    /// random directions and points of the aimed lines).
-    #[arg(long, default_value = "1", value_parser = parse_seed, allow_negative_numbers = true)]
-    seed: u64,
-    /// Worker threads; 0 or absent: all cores. Results do not depend on it.
-    #[arg(long, value_parser = parse_threads, allow_negative_numbers = true)]
-    threads: Option<usize>,
+    #[command(flatten)]
+    seed: Seed,
+    #[command(flatten)]
+    threads: Threads,
     /// Distances agree within this many f32 ulps at max(t, 1).
     #[arg(long, default_value_t = Tolerance::default().ulps, allow_negative_numbers = true)]
     ulps: f32,
@@ -134,10 +130,10 @@ fn run_random(
     scene: &Scene,
     (embree, rust): (&dyn Tracer, &dyn Tracer),
 ) -> Result<Exit, Failure> {
-    let (_, pool) = thread_pool(args.threads)?;
+    let (_, pool) = thread_pool(args.threads.value)?;
     let cfg = CrossCheckConfig {
         lines: args.lines.unwrap_or(DEFAULT_RANDOM_LINES),
-        seed: args.seed,
+        seed: args.seed.value,
         tolerance: Tolerance { ulps: args.ulps },
         examples: args.show,
     };
@@ -158,11 +154,11 @@ fn run_aimed(
     (embree, rust): (&dyn Tracer, &dyn Tracer),
     kinds: Vec<AimKind>,
 ) -> Result<Exit, Failure> {
-    let (_, pool) = thread_pool(args.threads)?;
+    let (_, pool) = thread_pool(args.threads.value)?;
     let cfg = AimedConfig {
         lines_per_kind: args.lines.unwrap_or(DEFAULT_AIMED_LINES),
         kinds,
-        seed: args.seed,
+        seed: args.seed.value,
         tolerance: Tolerance { ulps: args.ulps },
         examples: args.show,
     };

@@ -3,11 +3,10 @@
 
 use std::path::PathBuf;
 
-use clap::CommandFactory;
 use clap_complete::Shell;
 
+use super::exit::{Exit, Failure};
 use super::output::{self, check_all};
-use super::{Cli, Exit, Failure};
 
 /// Arguments of `scx completions`.
 #[derive(clap::Args, Debug)]
@@ -29,19 +28,19 @@ pub struct ManArgs {
     output: Option<PathBuf>,
 }
 
-/// Prints the completion script of a shell.
-pub fn completions(args: &CompletionsArgs) -> Result<Exit, Failure> {
+/// Prints the completion script of a shell for the program `scx` defines.
+pub fn completions(args: &CompletionsArgs, mut scx: clap::Command) -> Result<Exit, Failure> {
     check_all(args.output.as_deref())?;
     let mut script = Vec::new();
-    clap_complete::generate(args.shell, &mut Cli::command(), "scx", &mut script);
+    clap_complete::generate(args.shell, &mut scx, "scx", &mut script);
     output::emit(args.output.as_deref(), &String::from_utf8_lossy(&script))?;
     Ok(Exit::Ok)
 }
 
-/// Prints the manual page of scx (its commands listed) or of one command (`scx-analyze`).
-pub fn man(args: &ManArgs) -> Result<Exit, Failure> {
+/// Prints the manual page of scx, the program `scx` defines (its commands listed), or of one command
+/// (`scx-analyze`).
+pub fn man(args: &ManArgs, scx: clap::Command) -> Result<Exit, Failure> {
     check_all(args.output.as_deref())?;
-    let scx = Cli::command();
     let command = match &args.command {
         None => scx,
         Some(name) => {

@@ -2,12 +2,12 @@
 
 use std::path::PathBuf;
 
-use scene_complexity::scene::{gltf, obj};
+use scene_complexity::{write_gltf, write_obj};
 
 use super::args::SceneArgs;
+use super::exit::{Exit, Failure};
 use super::input::load_scene;
 use super::output::{self, check_all};
-use super::{Exit, Failure};
 
 /// Arguments of `scx export`.
 #[derive(clap::Args, Debug)]
@@ -33,9 +33,9 @@ pub fn run(args: &ExportArgs) -> Result<Exit, Failure> {
     }
     let scene = load_scene(&args.scene, &args.input.options())?;
     let written = if gltf {
-        gltf::write(&scene, &args.output)
+        write_gltf(&scene, &args.output)
     } else {
-        obj::write(&scene, &args.output)
+        write_obj(&scene, &args.output)
     };
     written.map_err(|e| Failure {
         code: Exit::Io,

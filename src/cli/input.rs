@@ -3,11 +3,10 @@
 use std::io::Read;
 use std::path::Path;
 
-use scene_complexity::scene::{obj, Scene, SceneOptions};
-use scene_complexity::scenes;
+use scene_complexity::{load_obj_text, load_with, Scene, SceneOptions};
 
+use super::exit::{Exit, Failure};
 use super::output::warn;
-use super::{Exit, Failure};
 
 /// Loads the scene a command names, read as `options` ask, printing its loading warnings; bad input is
 /// exit code 2.
@@ -15,7 +14,7 @@ pub fn load_scene(spec: &str, options: &SceneOptions) -> Result<Scene, Failure> 
     let scene = if spec == "-" {
         from_stdin(options)?
     } else {
-        scenes::load_with(spec, options).map_err(|e| Failure::bad_input(e.to_string()))?
+        load_with(spec, options).map_err(|e| Failure::bad_input(e.to_string()))?
     };
     for w in &scene.warnings {
         warn(w);
@@ -36,6 +35,6 @@ fn from_stdin(options: &SceneOptions) -> Result<Scene, Failure> {
         let text = std::fs::read_to_string(mtl).map_err(|e| e.to_string())?;
         Ok((mtl.display().to_string(), text))
     };
-    obj::load_text_with("<stdin>", &text, &materials, options)
+    load_obj_text("<stdin>", &text, &materials, options)
         .map_err(|e| Failure::bad_input(e.to_string()))
 }

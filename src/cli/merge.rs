@@ -3,17 +3,17 @@
 
 use std::path::PathBuf;
 
-use scene_complexity::run::persist;
-use scene_complexity::run::{finish, AnalysisConfig, RunState, SavedRun, StopReason};
-use scene_complexity::trace::{Backend, Query};
+use scene_complexity::finish;
+use scene_complexity::{RunSpec, RunState, SavedRun, StopReason};
 
 use super::analyze::{check_same_scene, persist_failure};
-use super::args::{parse_threads, ReportOutput};
+use super::args::{ReportOutput, Threads};
+use super::exit::{Exit, Failure};
 use super::output::{self, check_all, warn};
-use super::patches::PatchFiles;
+use super::patch_files::PatchFiles;
+use super::report;
 use super::report::Format;
 use super::runner::Runner;
-use super::{report, Exit, Failure};
 
 /// Arguments of `scx merge`.
 #[derive(clap::Args, Debug)]
@@ -32,9 +32,8 @@ pub struct MergeArgs {
     /// Also save the merged state to FILE (to continue it with `scx analyze --resume`).
     #[arg(long, value_name = "FILE")]
     save: Option<PathBuf>,
-    /// Worker threads for the measures; 0 or absent: all cores.
-    #[arg(long, value_parser = parse_threads, allow_negative_numbers = true)]
-    threads: Option<usize>,
+    #[command(flatten)]
+    threads: Threads,
     /// Output format, as for `scx analyze`.
     #[arg(long, value_enum, default_value_t = Format::Table)]
     format: Format,
@@ -59,7 +58,7 @@ fn merged(args: &MergeArgs) -> Result<Merged, Failure> {
     for path in &args.states {
         runs.push((
             path.display().to_string(),
-            persist::load(path).map_err(persist_failure)?,
+            scene_complexity::load_state(path).map_err(persist_failure)?,
         ));
     }
     seconds += runs.iter().map(|(_, r)| r.seconds).sum::<f64>();
@@ -72,10 +71,10 @@ fn merged(args: &MergeArgs) -> Result<Merged, Failure> {
     let mut state: RunState = first.state;
     let identity = first.identity;
     for (name, run) in runs {
-        if let Some((setting, ours, theirs)) = identity.difference(&run.identity, false) {
+        if let Some(d) = identity.difference(&run.identity, false) {
             return Err(Failure::bad_input(format!(
-                "{name} and {first_name} are not parts of one run: their {setting} differs ({theirs} \
-                 against {ours})"
+                "{name} and {first_name} are not parts of one run: their {} differs ({} against {})",
+                d.setting, d.theirs, d.ours
             )));
         }
         state
@@ -131,7 +130,7 @@ pub fn run(args: &MergeArgs) -> Result<Exit, Failure> {
             lines.join(", "),
             identity
                 .shard
-                .map(|(_, m)| format!(" (the run was cut into {m} shards)"))
+                .map(|s| format!(" (the run was cut into {} shards)", s.count))
                 .unwrap_or_default()
         );
         if !args.partial {
@@ -141,25 +140,25 @@ pub fn run(args: &MergeArgs) -> Result<Exit, Failure> {
         }
         warn(&message);
     }
-    let spec = args.scene.clone().unwrap_or_else(|| identity.scene.clone());
-    let backend = match identity.tracer.as_str() {
-        "embree" => Backend::Embree,
-        _ => Backend::Rust,
-    };
-    let query = Query::parse(&identity.query).map_err(Failure::bad_input)?;
-    let runner = Runner::with(&spec, &identity.reading, backend, query, args.threads)?;
+    let name = args
+        .scene
+        .clone()
+        .unwrap_or_else(|| identity.scene.name.clone());
+    let runner = Runner::with(
+        &name,
+        &identity.scene.reading,
+        identity.tracing,
+        args.threads.value,
+    )?;
     check_same_scene(&first, &identity, &runner)?;
     args.files
         .check_saved(&first, &identity, state.wanted(), &without_sums)?;
-    let cfg = identity
-        .config()
-        .map_err(|e| Failure::bad_input(format!("{first}: {e}")))?;
-    let cfg = AnalysisConfig {
+    let cfg = RunSpec {
         per_patch: !args.files.patches.is_empty(),
-        ..cfg
+        ..identity.spec.clone()
     };
     if let Some(path) = &args.save {
-        persist::save(path, &identity, &state, seconds).map_err(persist_failure)?;
+        scene_complexity::save_state(path, &identity, &state, seconds).map_err(persist_failure)?;
         output::wrote(path);
     }
     let analysis = runner
@@ -170,11 +169,7 @@ pub fn run(args: &MergeArgs) -> Result<Exit, Failure> {
     for w in &analysis.warnings {
         warn(&w.message);
     }
-    let info = report::RunInfo {
-        bundle: identity.bundle,
-        shard: None,
-        ..runner.info()
-    };
+    let info = runner.info();
     runner
         .pool
         .install(|| args.files.write(&runner.scene, &analysis))?;

@@ -5,7 +5,7 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 
-use super::{Exit, Failure};
+use super::exit::{Exit, Failure};
 
 /// `--quiet`: no progress bars, no "wrote" lines, no warnings on stderr (JSON reports keep them).
 static QUIET: AtomicBool = AtomicBool::new(false);

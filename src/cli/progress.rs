@@ -6,7 +6,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
 use indicatif::{ProgressBar, ProgressStyle};
-use scene_complexity::run::RunControl;
+use scene_complexity::RunControl;
 
 use super::output::quiet;
 

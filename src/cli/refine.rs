@@ -3,19 +3,19 @@
 use std::path::PathBuf;
 
 use clap::ValueEnum;
-use scene_complexity::measure::radiosity::SolveOptions;
 use scene_complexity::refine::{refine, RefineConfig, RefineRound, Strategy};
-use scene_complexity::run::RunControl;
-use scene_complexity::scene::obj;
-use scene_complexity::trace::{make_tracer, Query};
+use scene_complexity::write_obj;
+use scene_complexity::RunControl;
+use scene_complexity::SolveOptions;
+use scene_complexity::{make_tracer, Query};
 use std::sync::Arc;
 
 use super::args::SceneArgs;
-use super::args::{parse_count, parse_positive, parse_seed, parse_threads, TracerArg};
+use super::args::{parse_count, parse_positive, Seed, Threads, Tracer, TracerArg};
+use super::exit::{Exit, Failure};
 use super::input::load_scene;
 use super::output::{self, check_all, note};
 use super::runner::{thread_pool, watch_ctrl_c};
-use super::{Exit, Failure};
 
 /// Arguments of `scx refine`.
 #[derive(clap::Args, Debug)]
@@ -40,15 +40,12 @@ pub struct RefineArgs {
     /// Each round grows the mesh by at most this factor (above 1).
     #[arg(long, default_value_t = 1.5, value_parser = parse_positive, allow_negative_numbers = true)]
     growth: f64,
-    /// Seed of the first round's lines (a whole number >= 0).
-    #[arg(long, default_value = "1", value_parser = parse_seed, allow_negative_numbers = true)]
-    seed: u64,
-    /// Worker threads; 0 or absent: all cores.
-    #[arg(long, value_parser = parse_threads, allow_negative_numbers = true)]
-    threads: Option<usize>,
-    /// Tracing backend.
-    #[arg(long, value_enum)]
-    tracer: Option<TracerArg>,
+    #[command(flatten)]
+    seed: Seed,
+    #[command(flatten)]
+    threads: Threads,
+    #[command(flatten)]
+    tracer: Tracer,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -64,7 +61,7 @@ pub fn run(args: &RefineArgs) -> Result<Exit, Failure> {
     let mtl = args.output.with_extension("mtl");
     check_all([args.output.as_path(), mtl.as_path()])?;
     let scene = load_scene(&args.scene, &args.input.options())?;
-    let backend = TracerArg::backend(args.tracer);
+    let backend = TracerArg::backend(args.tracer.value);
     // Check the backend once up front, so that an unavailable one is a clear input error.
     make_tracer(backend, &scene, Query::Single).map_err(Failure::bad_input)?;
     let strategy = match args.strategy {
@@ -77,11 +74,11 @@ pub fn run(args: &RefineArgs) -> Result<Exit, Failure> {
         strategy,
         target_patches: usize::try_from(args.patches).unwrap_or(usize::MAX),
         lines_per_round: args.lines,
-        seed: args.seed,
+        seed: args.seed.value,
         growth: args.growth,
         solve: SolveOptions::default(),
     };
-    let (_, pool) = thread_pool(args.threads)?;
+    let (_, pool) = thread_pool(args.threads.value)?;
     let control = Arc::new(RunControl::default());
     watch_ctrl_c(&control);
     let started = std::time::Instant::now();
@@ -106,7 +103,7 @@ pub fn run(args: &RefineArgs) -> Result<Exit, Failure> {
             )
         })
         .map_err(Failure::of)?;
-    obj::write(&refined.scene, &args.output).map_err(|e| Failure {
+    write_obj(&refined.scene, &args.output).map_err(|e| Failure {
         code: Exit::Io,
         message: e.to_string(),
     })?;

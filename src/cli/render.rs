@@ -5,30 +5,28 @@ use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 
 use plotters::prelude::*;
-use scene_complexity::geom::{Point, Vector};
-use scene_complexity::measure::radiosity::PatchMaterials;
 use scene_complexity::render::{
     default_camera, trace_view, write_ply, Camera, ColourScale, Quantity, Sample, BACK_SIDE,
     NO_DATA,
 };
-use scene_complexity::run::{AnalysisConfig, Measures, StopReason};
-use scene_complexity::scene::Scene;
+use scene_complexity::PatchMaterials;
+use scene_complexity::Scene;
+use scene_complexity::{Measures, RunSpec, StopReason};
+use scene_complexity::{Point, Vector};
 
 use super::args::{parse_count, RunOptions};
+use super::exit::{Exit, Failure};
 use super::output::{self, io_failure, warn};
 use super::plot::{font_path, register_font};
 use super::runner::Runner;
-use super::{Exit, Failure};
 
 /// Arguments of `scx render`.
 #[derive(clap::Args, Debug)]
 pub struct RenderArgs {
     /// A scene file (OBJ), a built-in scene such as `@cornell`, or `-` for an OBJ on standard input.
     scene: String,
-    /// What colours the patches: row-entropy, row-entropy-corrected, mutual-information (term of I_s),
-    /// continuous-mutual-information (share of I_s^c), lost-information (I_i^c - I_i),
-    /// lost-information-corrected, segments (N_i), radiosity (B_i), incoming-radiosity (B_i^in).
-    #[arg(long, value_parser = parse_quantity)]
+    /// What colours the patches: a per-patch result of the run.
+    #[arg(long, value_parser = quantity_parser())]
     color: Quantity,
     /// The picture to write (.png).
     #[arg(short, long, value_name = "FILE.png")]
@@ -71,10 +69,12 @@ enum ScaleArg {
     Log,
 }
 
-fn parse_quantity(s: &str) -> Result<Quantity, String> {
-    Quantity::from_name(s).ok_or_else(|| {
-        let names: Vec<&str> = Quantity::NAMES.iter().map(|(n, _)| *n).collect();
-        format!("`{s}`: expected one of {}", names.join(", "))
+/// The per-patch quantities `--color` takes, each with its label in `--help`.
+fn quantity_parser() -> impl clap::builder::TypedValueParser<Value = Quantity> {
+    let values =
+        Quantity::all().map(|q| clap::builder::PossibleValue::new(q.name()).help(q.label()));
+    clap::builder::TypedValueParser::map(clap::builder::PossibleValuesParser::new(values), |name| {
+        Quantity::from_name(&name).expect("a possible value names a quantity")
     })
 }
 
@@ -156,10 +156,10 @@ pub fn run(args: &RenderArgs) -> Result<Exit, Failure> {
             args.color.name()
         )));
     }
-    let cfg = AnalysisConfig {
+    let cfg = RunSpec {
         measures: Measures::ALL,
         per_patch: true,
-        ..runner.config(&args.run, args.lines, args.run.seed)
+        ..args.run.spec(args.lines, args.run.seed.value)
     };
     let analysis = runner.analyze(&cfg, Some(args.lines), "")?;
     for w in &analysis.warnings {
@@ -288,7 +288,7 @@ fn tracer_failure(e: impl ToString) -> Failure {
 /// Each patch's value of the quantity, divided by its area fraction when `per_area`.
 fn patch_values(
     scene: &Scene,
-    patches: &[scene_complexity::run::PatchEstimate],
+    patches: &[scene_complexity::PatchResult],
     quantity: Quantity,
     per_area: bool,
 ) -> Vec<Option<f64>> {

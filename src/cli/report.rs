@@ -6,12 +6,12 @@ use std::fmt::Write;
 
 use clap::ValueEnum;
 
-use scene_complexity::measure::Estimate;
-use scene_complexity::run::{
-    Analysis, ErrorMethod, RadiosityEstimates, RadiosityOutcome, Reliability, StopReason,
-    TargetOutcome, Verdict,
-};
-use scene_complexity::scene::Scene;
+use scene_complexity::LineSource;
+use scene_complexity::Scene;
+use scene_complexity::VerdictRule;
+use scene_complexity::{Analysis, RadiosityOutcome, Reliability, TargetOutcome, Verdict};
+use scene_complexity::{ErrorMethod, Shard, StopReason, Tracing};
+use scene_complexity::{Estimate, Family, Measure, Unit};
 use serde_json::{json, Value};
 
 use super::table::{fixed, Align, Table};
@@ -40,36 +40,20 @@ pub fn render(format: Format, run: &RunInfo, a: &Analysis) -> String {
 /// line, CPU).
 pub const SCHEMA_VERSION: u32 = 2;
 
-/// Facts about the run that the analysis itself does not hold.
+/// Facts about the run that the analysis itself does not hold: the scene, how it ran.
 pub struct RunInfo<'a> {
     pub scene: &'a Scene,
-    pub tracer: &'a str,
-    pub query: String,
+    pub tracing: Tracing,
     pub threads: usize,
-    /// Lines per side of a bundle, 0 for independent lines.
-    pub bundle: u32,
-    /// The shard (index from 1, count) when the run was one.
-    pub shard: Option<(u32, u32)>,
+    /// The shard, when the run was one.
+    pub shard: Option<Shard>,
 }
 
-/// A reading's unit.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Unit {
-    /// Entropies and mutual information.
-    Bit,
-    /// Accuracies and relative errors.
-    Ratio,
-    /// E(MSE) of a single line.
-    PerLine,
-}
-
-impl Unit {
-    pub fn name(self) -> &'static str {
-        match self {
-            Unit::Bit => "bit",
-            Unit::Ratio => "ratio",
-            Unit::PerLine => "per line",
-        }
+/// Lines per side of a bundle, 0 for independent lines.
+fn bundle(a: &Analysis) -> u32 {
+    match a.spec.source {
+        LineSource::Independent => 0,
+        LineSource::Bundles { grid } => grid,
     }
 }
 
@@ -86,139 +70,26 @@ pub struct Row<'a> {
     pub corrected_reliability: Option<&'a Reliability>,
 }
 
-/// The visibility measures in report order.
-pub fn measures(a: &Analysis) -> Vec<Row<'_>> {
-    let v = &a.visibility;
-    let r = &a.reliability;
-    let row = |key, label, unit, reference, estimate, corrected, rel, crel| Row {
-        key,
-        label,
-        unit,
-        reference,
-        estimate,
-        corrected,
-        reliability: rel,
-        corrected_reliability: crel,
-    };
-    vec![
-        row(
-            "positional_entropy",
-            "positional entropy H_p",
-            Unit::Bit,
-            "eq. 19",
-            v.positional_entropy,
-            None,
-            None,
-            None,
-        ),
-        row(
-            "entropy",
-            "visibility entropy H_s",
-            Unit::Bit,
-            "eq. 17",
-            v.entropy,
-            v.entropy_corrected,
-            r.entropy.as_ref(),
-            r.entropy_corrected.as_ref(),
-        ),
-        row(
-            "joint_entropy",
-            "joint entropy H(X,Y)",
-            Unit::Bit,
-            "eq. 7",
-            v.joint_entropy,
-            None,
-            r.joint_entropy.as_ref(),
-            None,
-        ),
-        row(
-            "mutual_information",
-            "mutual information I_s",
-            Unit::Bit,
-            "eq. 21",
-            v.mutual_information,
-            v.mutual_information_corrected,
-            r.mutual_information.as_ref(),
-            r.mutual_information_corrected.as_ref(),
-        ),
-        row(
-            "continuous_mutual_information",
-            "continuous mutual information I_s^c",
-            Unit::Bit,
-            "eq. 27",
-            v.continuous_mutual_information,
-            None,
-            r.continuous_mutual_information.as_ref(),
-            None,
-        ),
-        row(
-            "accuracy",
-            "discretisation accuracy I_s/I_s^c",
-            Unit::Ratio,
-            "sec. 3.3",
-            v.accuracy,
-            v.accuracy_corrected,
-            r.accuracy.as_ref(),
-            r.accuracy_corrected.as_ref(),
-        ),
-        row(
-            "relative_error",
-            "discretisation relative error",
-            Unit::Ratio,
-            "sec. 3.3",
-            v.relative_error,
-            None,
-            r.relative_error.as_ref(),
-            None,
-        ),
-        row(
-            "mse_per_line",
-            "form-factor E(MSE)",
-            Unit::PerLine,
-            "eq. 22",
-            v.mse_per_line,
-            None,
-            r.mse_per_line.as_ref(),
-            None,
-        ),
-    ]
-}
-
-/// The radiosity measures in report order.
-fn radiosity_measures(r: &RadiosityEstimates) -> [Row<'_>; 3] {
-    let rel = &r.reliability;
-    [
-        Row {
-            key: "positional_entropy",
-            label: "radiosity positional entropy H_p",
-            unit: Unit::Bit,
-            reference: "eq. 33",
-            estimate: Some(r.positional_entropy),
-            corrected: None,
-            reliability: None,
-            corrected_reliability: None,
-        },
-        Row {
-            key: "entropy",
-            label: "radiosity entropy H_s",
-            unit: Unit::Bit,
-            reference: "eq. 34",
-            estimate: Some(r.entropy),
-            corrected: Some(r.entropy_corrected),
-            reliability: Some(&rel.entropy),
-            corrected_reliability: Some(&rel.entropy_corrected),
-        },
-        Row {
-            key: "mutual_information",
-            label: "radiosity mutual information I_s",
-            unit: Unit::Bit,
-            reference: "eq. 35",
-            estimate: Some(r.mutual_information),
-            corrected: Some(r.mutual_information_corrected),
-            reliability: Some(&rel.mutual_information),
-            corrected_reliability: Some(&rel.mutual_information_corrected),
-        },
-    ]
+/// The rows of `family`'s measures, in the catalogue's order: one per plug-in reading, with its
+/// bias-corrected reading beside it.
+pub fn rows(a: &Analysis, family: Family) -> Vec<Row<'_>> {
+    Measure::of_family(family)
+        .filter(|m| m.info().corrects.is_none())
+        .map(|m| {
+            let info = m.info();
+            let corrected = m.corrected();
+            Row {
+                key: info.key,
+                label: info.label,
+                unit: info.unit,
+                reference: info.equation,
+                estimate: a.estimate(m),
+                corrected: corrected.and_then(|c| a.estimate(c)),
+                reliability: a.reliability.get(m),
+                corrected_reliability: corrected.and_then(|c| a.reliability.get(c)),
+            }
+        })
+        .collect()
 }
 
 /// `-0.0` as `0.0`, so that no report shows a negative zero.
@@ -302,7 +173,7 @@ fn target_json(t: &Option<TargetOutcome>) -> Value {
     match t {
         None => Value::Null,
         Some(t) => json!({
-            "measure": t.measure.name(),
+            "measure": t.measure.key(),
             "stderr_goal": t.stderr_goal,
             "stderr": t.stderr.and_then(finite),
             "verdict": t.verdict.map(Verdict::name),
@@ -314,7 +185,7 @@ fn target_json(t: &Option<TargetOutcome>) -> Value {
 /// The JSON document of `analyze --format json`.
 pub fn json(run: &RunInfo, a: &Analysis) -> String {
     let mut visibility = serde_json::Map::new();
-    for r in measures(a) {
+    for r in rows(a, Family::Visibility) {
         visibility.insert(r.key.into(), row_json(&r));
     }
     let doc = json!({
@@ -327,11 +198,11 @@ pub fn json(run: &RunInfo, a: &Analysis) -> String {
         "patches": run.scene.patch_count(),
         "triangles": run.scene.triangles.len(),
         "area": run.scene.total_area_scene_units(),
-        "tracer": run.tracer,
-        "query": run.query,
-        "bundle": run.bundle,
+        "tracer": run.tracing.backend.name(),
+        "query": run.tracing.query.to_string(),
+        "bundle": bundle(a),
         "lines": a.lines,
-        "seed": a.seed,
+        "seed": a.spec.seed,
         "threads": run.threads,
         "groups": a.groups,
         "seconds": a.seconds,
@@ -339,9 +210,9 @@ pub fn json(run: &RunInfo, a: &Analysis) -> String {
         "interrupted": a.stop_reason == StopReason::Interrupted,
         "complete": a.is_complete(),
         "covered_lines": a.covered_lines().iter().map(|r| [r.start, r.end]).collect::<Vec<_>>(),
-        "shard": run.shard.map(|(k, m)| json!({"index": k, "count": m})),
+        "shard": run.shard.map(|s| json!({"index": s.index, "count": s.count})),
         "target": target_json(&a.target),
-        "estimator": a.estimator.name(),
+        "estimator": a.spec.estimator.name(),
         "errors": a.errors.name(),
         "hits": a.hits,
         "pairs": a.pairs,
@@ -358,7 +229,7 @@ pub fn json(run: &RunInfo, a: &Analysis) -> String {
         "unsampled_area_fraction": a.unsampled.map(|u| u.1),
         "sampling": sampling_json(a),
         "visibility": Value::Object(visibility),
-        "radiosity": radiosity_json(&a.radiosity),
+        "radiosity": radiosity_json(a),
         "radiosity_skipped": skipped_reason(&a.radiosity).map_or(Value::Null, Value::from),
         "warnings": a.warnings.iter().map(|w| w.message.as_str()).collect::<Vec<_>>(),
     });
@@ -377,12 +248,12 @@ fn skipped_reason(outcome: &RadiosityOutcome) -> Option<&str> {
 }
 
 /// The `radiosity` object of the JSON report (`null` when skipped).
-fn radiosity_json(outcome: &RadiosityOutcome) -> Value {
-    let RadiosityOutcome::Computed(r) = outcome else {
+fn radiosity_json(a: &Analysis) -> Value {
+    let RadiosityOutcome::Computed(r) = &a.radiosity else {
         return Value::Null;
     };
     let mut m = serde_json::Map::new();
-    for row in radiosity_measures(r) {
+    for row in rows(a, Family::Radiosity) {
         m.insert(row.key.into(), row_json(&row));
     }
     m.insert("solver_residual".into(), json!(finite(r.solver_residual)));
@@ -417,17 +288,20 @@ pub fn csv(run: &RunInfo, a: &Analysis) -> String {
     w.write_record(header).expect("writing to memory");
     let num = |x: Option<f64>| x.map(|v| positive_zero(v).to_string()).unwrap_or_default();
     let verdict = |r: Option<&Reliability>| r.map_or("", |r| r.verdict.name()).to_string();
-    let mut rows: Vec<(&str, Row)> = measures(a).into_iter().map(|r| ("visibility", r)).collect();
-    if let RadiosityOutcome::Computed(r) = &a.radiosity {
-        rows.extend(radiosity_measures(r).into_iter().map(|r| ("radiosity", r)));
+    let mut families = vec![Family::Visibility];
+    if let RadiosityOutcome::Computed(_) = &a.radiosity {
+        families.push(Family::Radiosity);
     }
-    for (family, r) in rows {
+    let all = families
+        .into_iter()
+        .flat_map(|f| rows(a, f).into_iter().map(move |r| (f.name(), r)));
+    for (family, r) in all {
         let Some(e) = r.estimate else { continue };
         w.write_record([
             run.scene.name.clone(),
             a.lines.to_string(),
-            a.seed.to_string(),
-            run.tracer.to_string(),
+            a.spec.seed.to_string(),
+            run.tracing.backend.name().to_string(),
             family.to_string(),
             r.key.to_string(),
             r.unit.name().to_string(),
@@ -515,14 +389,14 @@ pub fn table(run: &RunInfo, a: &Analysis) -> String {
         s,
         "lines    {}{}  seed {}  tracer {} ({})  threads {}  {:.3} s  ({:.2} M lines/s)",
         a.lines,
-        if run.bundle > 0 {
-            format!(" in bundles of {0} x {0}", run.bundle)
+        if bundle(a) > 0 {
+            format!(" in bundles of {0} x {0}", bundle(a))
         } else {
             String::new()
         },
-        a.seed,
-        run.tracer,
-        run.query,
+        a.spec.seed,
+        run.tracing.backend.name(),
+        run.tracing.query,
         run.threads,
         a.seconds,
         a.lines as f64 / a.seconds.max(1e-12) / 1e6
@@ -571,7 +445,7 @@ pub fn table(run: &RunInfo, a: &Analysis) -> String {
             },
             a.plan.lines,
             run.shard
-                .map(|(k, m)| format!(", shard {k} of {m}"))
+                .map(|s| format!(", shard {} of {}", s.index, s.count))
                 .unwrap_or_default()
         );
     }
@@ -612,10 +486,10 @@ pub fn table(run: &RunInfo, a: &Analysis) -> String {
         ],
     );
     let mut notes = Vec::new();
-    add_rows(&mut t, &measures(a), &mut notes);
-    if let RadiosityOutcome::Computed(r) = &a.radiosity {
+    add_rows(&mut t, &rows(a, Family::Visibility), &mut notes);
+    if let RadiosityOutcome::Computed(_) = &a.radiosity {
         t.separator();
-        add_rows(&mut t, &radiosity_measures(r), &mut notes);
+        add_rows(&mut t, &rows(a, Family::Radiosity), &mut notes);
     }
     s += &t.render();
     for n in &notes {
@@ -644,11 +518,11 @@ pub fn table(run: &RunInfo, a: &Analysis) -> String {
         "\nstandard errors: {errors} (statistical error only).\n\
          corrected: row entropies by the {} estimator; the plug-in H_s and I_s are biased when rows are \
          undersampled.",
-        a.estimator.name()
+        a.spec.estimator.name()
     );
     reliability_summary(&mut s, a);
-    if run.bundle > 0 && a.visibility.mutual_information_corrected.is_some() {
-        // Measured: 8 x 8 bundles moved the corrected I_s of @cube:30 by 7.7 standard errors (README).
+    if bundle(a) > 0 && a.estimate(Measure::MutualInformationCorrected).is_some() {
+        // Measured: 8 x 8 bundles moved the corrected I_s of @cube:30 by 7.7 standard errors (docs/performance.md, "Bundles").
         let _ = writeln!(
             s,
             "bundles: the corrections infer unseen patch pairs as if the lines were independent; the lines \
@@ -689,19 +563,10 @@ fn radiosity_lines(s: &mut String, outcome: &RadiosityOutcome) {
 
 /// One line on what the verdicts mean, when some reading is not ok.
 fn reliability_summary(s: &mut String, a: &Analysis) {
-    let r = &a.reliability;
-    let all = [
-        &r.entropy,
-        &r.entropy_corrected,
-        &r.mutual_information,
-        &r.mutual_information_corrected,
-        &r.continuous_mutual_information,
-        &r.mse_per_line,
-    ];
-    let worst = all
-        .iter()
-        .filter_map(|r| r.as_ref())
-        .map(|r| r.verdict)
+    // The ratios inherit their I_s's verdict: they add nothing here.
+    let worst = Measure::of_family(Family::Visibility)
+        .filter(|m| !matches!(m.info().verdict, VerdictRule::RatioOf { .. }))
+        .filter_map(|m| a.verdict(m))
         .max();
     if worst.is_some_and(|v| v != Verdict::Ok) {
         let needed = a
@@ -719,7 +584,7 @@ fn reliability_summary(s: &mut String, a: &Analysis) {
         let _ = writeln!(
             s,
             "reliability: an `undersampled` reading is biased beyond its standard error, an `unusable` one \
-             cannot be trusted (rows' coverage below 0.5){needed} (README, \"Reading the reliability \
+             cannot be trusted (rows' coverage below 0.5){needed} (docs/results.md, \"Reading the reliability \
              verdict\")."
         );
     }
@@ -735,14 +600,14 @@ fn target_text(t: &TargetOutcome) -> String {
     if t.met() {
         format!(
             "precision target met: {} {se} <= {:.3e}, and the reading is {verdict}",
-            t.measure.name(),
+            t.measure.key(),
             t.stderr_goal
         )
     } else {
         format!(
             "precision target NOT met: {} {se} (goal {:.3e}), reading {verdict}: a target counts only when \
              the standard error is small enough and the reading is ok",
-            t.measure.name(),
+            t.measure.key(),
             t.stderr_goal
         )
     }

@@ -4,12 +4,12 @@
 use std::time::Instant;
 
 use scene_complexity::reproduce::{reproduce, LinePlan, ReproduceConfig, TableReport, TABLES};
-use scene_complexity::trace::Backend;
+use scene_complexity::Backend;
 
-use super::args::{parse_seed, parse_threads, ReportOutput, TracerArg};
+use super::args::{ReportOutput, Seed, Threads, Tracer, TracerArg};
+use super::exit::{Exit, Failure};
 use super::output::{self, check_all};
 use super::runner::thread_pool;
-use super::{Exit, Failure};
 
 /// Arguments of `scx reproduce`.
 #[derive(clap::Args, Debug)]
@@ -21,15 +21,12 @@ pub struct ReproduceArgs {
     /// 1e9 included), a factor on the defaults (`x0.1`), or one count for every run (`1e6`).
     #[arg(long, default_value = "default", value_parser = LinePlan::parse)]
     lines: LinePlan,
-    /// Seed of every run's lines (a whole number >= 0).
-    #[arg(long, default_value = "1", value_parser = parse_seed, allow_negative_numbers = true)]
-    seed: u64,
-    /// Worker threads; 0 or absent: all cores. Results do not depend on it.
-    #[arg(long, value_parser = parse_threads, allow_negative_numbers = true)]
-    threads: Option<usize>,
-    /// Tracing backend (default: rust, the faster; its hits are Embree's to the bit).
-    #[arg(long, value_enum)]
-    tracer: Option<TracerArg>,
+    #[command(flatten)]
+    seed: Seed,
+    #[command(flatten)]
+    threads: Threads,
+    #[command(flatten)]
+    tracer: Tracer,
     #[command(flatten)]
     out: ReportOutput,
 }
@@ -46,10 +43,10 @@ pub fn run(args: &ReproduceArgs) -> Result<Exit, Failure> {
     let cfg = ReproduceConfig {
         tables,
         lines: args.lines,
-        seed: args.seed,
-        backend: TracerArg::backend(args.tracer),
+        seed: args.seed.value,
+        backend: TracerArg::backend(args.tracer.value),
     };
-    let (threads, pool) = thread_pool(args.threads)?;
+    let (threads, pool) = thread_pool(args.threads.value)?;
     let start = Instant::now();
     let mut document = String::new();
     let to_file = args.out.output.is_some();

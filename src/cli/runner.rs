@@ -2,13 +2,15 @@
 
 use std::sync::Arc;
 
-use scene_complexity::run::{analyze, Analysis, AnalysisConfig, Measures, RunControl};
-use scene_complexity::scene::{Scene, SceneOptions};
-use scene_complexity::trace::{make_tracer, Backend, Query, Tracer};
+use scene_complexity::{analyze, Analysis};
+use scene_complexity::{make_tracer, Tracer};
+use scene_complexity::{RunControl, RunSpec, Tracing};
+use scene_complexity::{Scene, SceneOptions};
 
-use super::args::{RunOptions, TracerArg};
+use super::args::RunOptions;
+use super::exit::{Exit, Failure};
 use super::input::load_scene;
-use super::{progress, report, Exit, Failure};
+use super::{progress, report};
 
 /// A scene with its tracer and thread pool, ready to run analyses.
 pub struct Runner {
@@ -16,32 +18,33 @@ pub struct Runner {
     pub tracer: Box<dyn Tracer>,
     pub pool: rayon::ThreadPool,
     pub threads: usize,
-    query: Query,
+    /// The backend and query the tracer was built with.
+    pub tracing: Tracing,
     pub control: Arc<RunControl>,
 }
 
 impl Runner {
     /// Loads the scene and builds its tracer and thread pool.
-    pub fn new(spec: &str, opts: &RunOptions) -> Result<Runner, Failure> {
+    pub fn new(name: &str, opts: &RunOptions) -> Result<Runner, Failure> {
         Runner::with(
-            spec,
+            name,
             &opts.input.options(),
-            TracerArg::backend_for(opts.tracer, opts.query),
-            opts.query,
-            opts.threads,
+            opts.tracing(),
+            opts.threads.value,
         )
     }
 
-    /// Loads the scene and builds the tracer `backend` with `query` and a pool of `threads` threads.
+    /// Loads the scene `name` read as `reading` asks, and builds the tracer `tracing` asks for and a
+    /// pool of `threads` threads.
     pub fn with(
-        spec: &str,
+        name: &str,
         reading: &SceneOptions,
-        backend: Backend,
-        query: Query,
+        tracing: Tracing,
         threads: Option<usize>,
     ) -> Result<Runner, Failure> {
-        let scene = load_scene(spec, reading)?;
-        let tracer = make_tracer(backend, &scene, query).map_err(Failure::bad_input)?;
+        let scene = load_scene(name, reading)?;
+        let tracer =
+            make_tracer(tracing.backend, &scene, tracing.query).map_err(Failure::bad_input)?;
         let (threads, pool) = thread_pool(threads)?;
         let control = Arc::new(RunControl::default());
         watch_ctrl_c(&control);
@@ -50,7 +53,7 @@ impl Runner {
             tracer,
             pool,
             threads,
-            query,
+            tracing,
             control,
         })
     }
@@ -68,7 +71,7 @@ impl Runner {
     /// Runs one analysis with a progress bar (of `total` lines when known; `label` says which run).
     pub fn analyze(
         &self,
-        cfg: &AnalysisConfig,
+        cfg: &RunSpec,
         total: Option<u64>,
         label: &str,
     ) -> Result<Analysis, Failure> {
@@ -83,22 +86,9 @@ impl Runner {
     pub fn info(&self) -> report::RunInfo<'_> {
         report::RunInfo {
             scene: &self.scene,
-            tracer: self.tracer.name(),
-            query: self.query.to_string(),
+            tracing: self.tracing,
             threads: self.threads,
-            bundle: 0,
             shard: None,
-        }
-    }
-
-    /// A config for `lines` lines with these options (the visibility measures).
-    pub fn config(&self, opts: &RunOptions, lines: u64, seed: u64) -> AnalysisConfig {
-        AnalysisConfig {
-            measures: Measures::VISIBILITY,
-            groups: usize::from(opts.groups),
-            estimator: opts.estimator,
-            errors: opts.errors,
-            ..AnalysisConfig::new(lines, seed)
         }
     }
 }

@@ -16,8 +16,8 @@
 //! # What agreement means on these lines
 //!
 //! Both tracers decide every candidate with the same watertight test in the same f32 operations, and
-//! both propose every triangle whose box, grown by [`margin`](crate::trace::rust::bvh::margin) on every
-//! side, the line crosses. So they can only differ on a hit that the test grants to a triangle one of
+//! both propose every triangle whose box, grown on every side by the tracers' margin (1/65536 of the
+//! scene's size), the line crosses. So they can only differ on a hit that the test grants to a triangle one of
 //! them does not propose: a hit far from its triangle. Such hits exist: on a line in a triangle's plane to
 //! within rounding (`in-face`, `edge-in-face`, the smallest `grazing` angles) the projected triangle is a
 //! sliver across which the line's position is rounding, and so are the test's verdict and its distance
@@ -270,7 +270,7 @@ impl AimTargets {
         }
     }
 
-    /// The first `count` lines of `kind` from `seed` (every batch of [`BatchPlan::new`] in turn), with
+    /// The first `count` lines of `kind` from `seed` (the batches of a run of `count` lines in turn), with
     /// their aims; none when the scene has no target of that kind.
     pub fn lines(&self, kind: AimKind, seed: u64, count: u64) -> (Vec<Line>, Vec<Aim>) {
         let (mut lines, mut aims) = (Vec::new(), Vec::new());

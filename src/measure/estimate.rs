@@ -8,7 +8,7 @@
 //! only, not the bias of the plug-in estimate at a finite number of lines, and where form-factor rows are
 //! undersampled it can be far off (a group alone is much sparser than the run). The delete-a-group
 //! jackknife ([`Estimate::from_jackknife`], `--errors jackknife`) uses the values with one group left out
-//! instead, which scatter like the full run's (README, "Standard errors", for measurements of both).
+//! instead, which scatter like the full run's (docs/results.md, "Standard errors" and "The jackknife", for measurements of both).
 
 use serde::Serialize;
 

@@ -3,7 +3,8 @@
 //! [`super::rows`] and [`super::bias`] apply them.
 
 /// An entropy estimator for the form-factor rows.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
 pub enum EntropyEstimator {
     /// The plug-in estimate of eq. (17), uncorrected.
     PlugIn,

@@ -2,18 +2,21 @@
 //!
 //! Logarithms are base 2 (bits). `0 log 0 = 0` everywhere ([`entropy::xlog2x`]).
 //!
-//! [`patches`] shares the visibility measures out among the patches (where the complexity is).
+//! [`catalogue`] lists every measure (key, label, unit, equation, how its reliability is judged);
+//! [`shares`] shares the visibility measures out among the patches (where the complexity is).
 
 pub mod bias;
+pub mod catalogue;
 pub mod channel;
 pub mod entropy;
 pub mod estimate;
 pub mod estimators;
-pub mod patches;
 pub mod radiosity;
 pub mod rows;
 pub mod sampling;
+pub mod shares;
 pub mod visibility;
 
+pub use catalogue::{ByMeasure, Family, Measure, MeasureInfo, PatchMeasure, Unit};
 pub use estimate::Estimate;
 pub use visibility::{ContinuousValues, DiscreteValues};

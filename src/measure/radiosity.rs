@@ -129,7 +129,18 @@ pub struct MaterialError {
     /// The material's name.
     pub material: String,
     /// What is wrong with it.
-    pub problem: String,
+    pub problem: MaterialProblem,
+}
+
+/// What makes a material unfit for the radiosity system.
+#[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
+pub enum MaterialProblem {
+    /// A reflectance outside [0, 1] (or not a number).
+    #[error("reflectance (Kd, mean of RGB) is {0}; the radiosity system needs 0 <= R <= 1")]
+    Reflectance(f64),
+    /// A negative emission (or not a number).
+    #[error("emission (Ke, mean of RGB) is {0}; the radiosity system needs E >= 0")]
+    Emission(f64),
 }
 
 impl PatchMaterials {
@@ -166,22 +177,18 @@ impl PatchMaterials {
     }
 }
 
-fn check_material(emission: f64, reflectance: f64) -> Result<(), String> {
+fn check_material(emission: f64, reflectance: f64) -> Result<(), MaterialProblem> {
     if !reflectance.is_finite() || !(0.0..=1.0).contains(&reflectance) {
-        return Err(format!(
-            "reflectance (Kd, mean of RGB) is {reflectance}; the radiosity system needs 0 <= R <= 1"
-        ));
+        return Err(MaterialProblem::Reflectance(reflectance));
     }
     if !emission.is_finite() || emission < 0.0 {
-        return Err(format!(
-            "emission (Ke, mean of RGB) is {emission}; the radiosity system needs E >= 0"
-        ));
+        return Err(MaterialProblem::Emission(emission));
     }
     Ok(())
 }
 
 /// When the Gauss-Seidel iteration stops.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct SolveOptions {
     /// Stop when `max_i |B_i - E_i - R_i sum_j F_ij B_j| / max_i B_i` is at most this.
     pub tolerance: f64,
@@ -597,9 +604,13 @@ mod tests {
         assert!(check_material(0.0, 0.0).is_ok());
         assert!(check_material(0.0, 1.01)
             .unwrap_err()
+            .to_string()
             .contains("0 <= R <= 1"));
         assert!(check_material(0.0, -0.1).is_err());
-        assert!(check_material(-1.0, 0.5).unwrap_err().contains("E >= 0"));
+        assert!(check_material(-1.0, 0.5)
+            .unwrap_err()
+            .to_string()
+            .contains("E >= 0"));
         assert!(check_material(f64::NAN, 0.5).is_err());
         assert!(check_material(0.0, f64::INFINITY).is_err());
     }

@@ -1,5 +1,5 @@
 //! How well a run's lines sampled the rows of the form-factor matrix: the numbers behind the reliability
-//! verdict of the discrete measures (README, "Reading the reliability verdict").
+//! verdict of the discrete measures (docs/results.md, "Reading the reliability verdict").
 //!
 //! Row i of F is a multinomial sample of its N_i segments over the patches it sees. The plug-in entropy
 //! of an undersampled row reads low and the bias-corrected estimators ([`super::bias`]) close most of

@@ -12,7 +12,7 @@
 //! * [`Strategy::Smoothness`]: largest variation of received radiosity over the patch (a linear trend
 //!   fitted to the radiosity arriving along the lines, [`oracle::smoothness`]).
 //! * [`Strategy::Information`]: largest share of the information transfer lost by the discretisation
-//!   ([`crate::measure::patches::information_loss`], the per-patch module's score).
+//!   ([`crate::measure::shares::information_loss`], the per-patch module's score).
 
 pub mod mesh;
 pub mod oracle;
@@ -20,9 +20,10 @@ pub mod oracle;
 use std::fmt;
 use std::time::Instant;
 
-use crate::measure::patches;
+use crate::analysis::SolveFailure;
 use crate::measure::radiosity::{self, FormFactors, MaterialError, PatchMaterials, SolveOptions};
-use crate::run::{RunControl, SolveFailure};
+use crate::measure::shares;
+use crate::run::RunControl;
 use crate::scene::{Scene, SceneError};
 use crate::trace::{TraceError, Tracer};
 use mesh::Mesh;
@@ -248,7 +249,7 @@ fn measure_round(
             oracle::smoothness(&a, &m)
         }
         (Strategy::Information, s) => {
-            patches::information_loss(&a, &sample, s.as_ref().map(|s| s.radiosity.as_slice()))
+            shares::information_loss(&a, &sample, s.as_ref().map(|s| s.radiosity.as_slice()))
         }
         _ => a.clone(),
     };

@@ -1,17 +1,16 @@
 //! What a refinement round measures: pair counts with the sum of `log2 F(x, y)` per patch pair, and the
 //! per-patch scores of the strategies (the `information` score is the per-patch module's,
-//! [`crate::measure::patches::information_loss`]).
+//! [`crate::measure::shares::information_loss`]).
 
 use rayon::prelude::*;
 
 use crate::geom::{orthonormal_basis, Direction};
-use crate::measure::patches::PairKernelSums;
 use crate::measure::radiosity::{FormFactors, Solution};
+use crate::measure::shares::PairKernelSums;
 use crate::run::{all_batches, map_traced_batches, LineStream};
 use crate::sample::counts::{pair_key, PairCounts};
 use crate::sample::kernel::kernel_without_pi;
-use crate::sample::pairs::{segments, LineF64, Segment};
-use crate::sample::sparse::SparseCounts;
+use crate::sample::pairs::{batch_segments, LineF64, Segment};
 use crate::scene::Scene;
 use crate::trace::{TraceError, Tracer};
 
@@ -34,10 +33,10 @@ fn trace_segments<T: Default + Send>(
         &|_| false,
         |_: &mut (), batch, hits| {
             let mut out = T::default();
-            for (k, line) in batch.lines.iter().enumerate() {
-                let l = LineF64::from(line);
-                segments(scene, line, hits.of_line(k), |seg| visit(&l, seg, &mut out));
-            }
+            let lines: Vec<LineF64> = batch.lines.iter().map(LineF64::from).collect();
+            batch_segments(scene, batch.lines, hits, |k, seg| {
+                visit(&lines[k], seg, &mut out)
+            });
             out
         },
     )?;
@@ -101,7 +100,7 @@ pub fn sample_pairs(
         }
     }
     Ok(PairKernelSums {
-        counts: PairCounts::Sparse(SparseCounts::from_entries(scene.patch_count(), list)),
+        counts: PairCounts::from_entries(scene.patch_count(), list),
         log_kernel_sums: sums,
         log_kernel_pairs: used,
         escapes,

@@ -1,105 +1,64 @@
 //! What a picture colours its patches by, and how: a per-patch quantity of the run mapped through
 //! viridis (perceptually uniform, readable with the common colour-vision deficiencies and in grey).
 
-use crate::run::PatchEstimate;
+use crate::analysis::PatchResult;
+use crate::measure::{PatchMeasure, Unit};
 
-/// A per-patch quantity a picture can show ([`PatchEstimate`]).
+/// A per-patch quantity a picture can show: one of the per-patch catalogue ([`PatchMeasure`]), or the
+/// segments that left the patch.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Quantity {
-    /// `H_i`, the plug-in row entropy (eq. (17)'s inner sum).
-    RowEntropy,
-    /// `H_i` by the run's bias-correcting estimator.
-    RowEntropyCorrected,
-    /// The patch's term of I_s (eq. (21)).
-    MutualInformation,
-    /// The patch's share of I_s^c (eq. (27)).
-    ContinuousMutualInformation,
-    /// `I_i^c - I_i`, the information the discretisation loses at the patch (sec. 3.3).
-    LostInformation,
-    /// The same with the bias-corrected `I_i`.
-    LostInformationCorrected,
+    /// A per-patch estimate.
+    Patch(PatchMeasure),
     /// `N_i`, the segments that left the patch.
     Segments,
-    /// `B_i` (eq. (2)).
-    Radiosity,
-    /// `B_i^in = sum_j F_ij B_j`.
-    IncomingRadiosity,
 }
 
-impl Quantity {
-    /// Every quantity with its command-line name.
-    pub const NAMES: [(&'static str, Quantity); 9] = [
-        ("row-entropy", Quantity::RowEntropy),
-        ("row-entropy-corrected", Quantity::RowEntropyCorrected),
-        ("mutual-information", Quantity::MutualInformation),
-        (
-            "continuous-mutual-information",
-            Quantity::ContinuousMutualInformation,
-        ),
-        ("lost-information", Quantity::LostInformation),
-        (
-            "lost-information-corrected",
-            Quantity::LostInformationCorrected,
-        ),
-        ("segments", Quantity::Segments),
-        ("radiosity", Quantity::Radiosity),
-        ("incoming-radiosity", Quantity::IncomingRadiosity),
-    ];
+/// The name and label of [`Quantity::Segments`].
+const SEGMENTS: (&str, &str) = ("segments", "segments leaving the patch, N_i");
 
-    /// Parses a name of [`Quantity::NAMES`].
+impl Quantity {
+    /// Every quantity, the catalogue's first.
+    pub fn all() -> impl Iterator<Item = Quantity> {
+        PatchMeasure::ALL
+            .into_iter()
+            .map(Quantity::Patch)
+            .chain([Quantity::Segments])
+    }
+
+    /// Parses a command-line name ([`Quantity::name`]).
     pub fn from_name(name: &str) -> Option<Self> {
-        Self::NAMES
-            .iter()
-            .find(|(n, _)| *n == name)
-            .map(|&(_, q)| q)
+        Quantity::all().find(|q| q.name() == name)
     }
 
     /// The command-line name.
     pub fn name(self) -> &'static str {
-        Self::NAMES
-            .iter()
-            .find(|(_, q)| *q == self)
-            .map(|(n, _)| *n)
-            .expect("every quantity is named")
+        match self {
+            Quantity::Patch(m) => m.info().colour,
+            Quantity::Segments => SEGMENTS.0,
+        }
     }
 
     /// What the colour bar says the colours mean.
     pub fn label(self) -> &'static str {
         match self {
-            Quantity::RowEntropy => "row entropy H_i (plug-in)",
-            Quantity::RowEntropyCorrected => "row entropy H_i (bias-corrected)",
-            Quantity::MutualInformation => "term of I_s, a_i sum_j F_ij log2(F_ij/a_j)",
-            Quantity::ContinuousMutualInformation => "share of I_s^c (eq. 27)",
-            Quantity::LostInformation => "information lost, I_i^c - I_i",
-            Quantity::LostInformationCorrected => "information lost, I_i^c - I_i (corrected)",
-            Quantity::Segments => "segments leaving the patch, N_i",
-            Quantity::Radiosity => "radiosity B_i",
-            Quantity::IncomingRadiosity => "incoming radiosity B_i^in",
+            Quantity::Patch(m) => m.info().label,
+            Quantity::Segments => SEGMENTS.1,
         }
     }
 
     /// The unit of the values (of the values per unit area fraction when `per_area`).
     pub fn unit(self, per_area: bool) -> &'static str {
-        match (self, per_area) {
-            (Quantity::RowEntropy | Quantity::RowEntropyCorrected, _) => "bit",
-            (Quantity::Segments, _) => "segments",
-            (Quantity::Radiosity | Quantity::IncomingRadiosity, _) => {
-                "same units as the emission Ke"
-            }
-            (_, false) => "bit",
-            (_, true) => "bit per unit area fraction",
+        match self {
+            Quantity::Segments => Unit::Segments.name(),
+            Quantity::Patch(m) if per_area && m.info().share => "bit per unit area fraction",
+            Quantity::Patch(m) => m.info().unit.name(),
         }
     }
 
     /// Whether dividing by the patch's area fraction makes sense (the terms of a sum over patches).
     pub fn is_share(self) -> bool {
-        matches!(
-            self,
-            Quantity::MutualInformation
-                | Quantity::ContinuousMutualInformation
-                | Quantity::LostInformation
-                | Quantity::LostInformationCorrected
-        )
+        matches!(self, Quantity::Patch(m) if m.info().share)
     }
 
     /// Whether a logarithmic colour scale suits the quantity by default (it spans orders of magnitude).
@@ -109,24 +68,15 @@ impl Quantity {
 
     /// Whether the run must have light for the quantity.
     pub fn needs_light(self) -> bool {
-        matches!(self, Quantity::Radiosity | Quantity::IncomingRadiosity)
+        matches!(self, Quantity::Patch(m) if m.info().unit == Unit::Radiosity)
     }
 
     /// The patch's value; `None` when the run has none (an unsampled patch, no light, no I_s^c).
-    pub fn of(self, p: &PatchEstimate) -> Option<f64> {
-        if !p.sampled() && self != Quantity::Segments {
-            return None;
-        }
+    pub fn of(self, p: &PatchResult) -> Option<f64> {
         match self {
-            Quantity::RowEntropy => Some(p.row_entropy.value),
-            Quantity::RowEntropyCorrected => Some(p.row_entropy_corrected.value),
-            Quantity::MutualInformation => Some(p.mutual_information_term.value),
-            Quantity::ContinuousMutualInformation => p.continuous_term.map(|e| e.value),
-            Quantity::LostInformation => p.lost_information.map(|e| e.value),
-            Quantity::LostInformationCorrected => p.lost_information_corrected.map(|e| e.value),
             Quantity::Segments => Some(p.segments as f64),
-            Quantity::Radiosity => p.radiosity.map(|e| e.value),
-            Quantity::IncomingRadiosity => p.incoming_radiosity.map(|e| e.value),
+            Quantity::Patch(_) if !p.sampled() => None,
+            Quantity::Patch(m) => p.get(m).map(|e| e.value),
         }
     }
 }
@@ -238,9 +188,8 @@ mod tests {
 
     #[test]
     fn quantity_names_round_trip() {
-        for (name, q) in Quantity::NAMES {
-            assert_eq!(Quantity::from_name(name), Some(q));
-            assert_eq!(q.name(), name);
+        for q in Quantity::all() {
+            assert_eq!(Quantity::from_name(q.name()), Some(q));
         }
         assert_eq!(Quantity::from_name("entropy"), None);
     }

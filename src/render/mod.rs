@@ -1,5 +1,5 @@
 //! Pictures of where the complexity is: the scene drawn from a camera with each patch coloured by a
-//! per-patch quantity of a run ([`crate::run::PatchEstimate`]), and the coloured mesh as PLY.
+//! per-patch quantity of a run ([`crate::PatchResult`]), and the coloured mesh as PLY.
 //!
 //! * [`camera`]: the pinhole camera and the default view (inside a room when the scene is one);
 //! * [`image`]: first-hit rays through the camera, traced by the run's own tracer, and the picture's

@@ -17,12 +17,10 @@ use std::collections::HashMap;
 use std::fmt::Write as _;
 use std::time::Instant;
 
-use crate::measure::Estimate;
+use crate::analysis::{analyze, AnalysisError, RadiosityOutcome};
+use crate::measure::{ByMeasure, Estimate};
 use crate::refine::RefineError;
-use crate::run::{
-    analyze, AnalysisConfig, AnalysisError, Measures, RadiosityEstimates, RadiosityOutcome,
-    RunControl, VisibilityEstimates,
-};
+use crate::run::{Measures, RunControl, RunSpec};
 use crate::scene::{Scene, SceneError};
 use crate::trace::{make_tracer, Backend, Query, TraceError};
 
@@ -65,9 +63,22 @@ pub enum LinePlan {
     Fixed(u64),
 }
 
+/// A `--lines` of `scx reproduce` that is not one ([`LinePlan::parse`]).
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum LinePlanError {
+    /// A factor out of range.
+    #[error("`{0}`: a factor must be a number above 0 and at most 1e6, as in x0.1")]
+    Factor(String),
+    /// Neither a name, a factor nor a count.
+    #[error(
+        "`{0}`: expected default, paper, a factor such as x0.1, or a whole line count such as 1e6"
+    )]
+    Unknown(String),
+}
+
 impl LinePlan {
     /// Reads `default`, `paper`, `xF` (a factor on the defaults, `x0.1`) or a count (`1e6`).
-    pub fn parse(s: &str) -> Result<Self, String> {
+    pub fn parse(s: &str) -> Result<Self, LinePlanError> {
         let s = s.trim();
         let positive = |v: f64| v.is_finite() && v > 0.0;
         match s {
@@ -75,15 +86,13 @@ impl LinePlan {
             "paper" => Ok(LinePlan::Paper),
             _ if s.starts_with('x') => match s[1..].parse::<f64>() {
                 Ok(f) if positive(f) && f <= 1e6 => Ok(LinePlan::Scale(f)),
-                _ => Err(format!("`{s}`: a factor must be a number above 0 and at most 1e6, as in x0.1")),
+                _ => Err(LinePlanError::Factor(s.into())),
             },
             _ => match s.parse::<f64>() {
                 Ok(n) if (1.0..=1e15).contains(&n) && n.fract() == 0.0 => {
                     Ok(LinePlan::Fixed(n as u64))
                 }
-                _ => Err(format!(
-                    "`{s}`: expected default, paper, a factor such as x0.1, or a whole line count such as 1e6"
-                )),
+                _ => Err(LinePlanError::Unknown(s.into())),
             },
         }
     }
@@ -256,8 +265,10 @@ struct Run {
     patches: usize,
     lines: u64,
     seconds: f64,
-    v: VisibilityEstimates,
-    radiosity: Option<RadiosityEstimates>,
+    /// The visibility readings.
+    v: ByMeasure<Estimate>,
+    /// The radiosity readings, when computed.
+    radiosity: Option<ByMeasure<Estimate>>,
     /// Segments leaving a front side out of the scene (0 in a closed scene but for grazing hits).
     escapes: u64,
     /// Segments joining two patches.
@@ -300,17 +311,17 @@ impl Session<'_> {
     fn run_scene(&mut self, scene: &Scene, lines: u64, want: Want) -> Result<Run, ReproduceError> {
         let start = Instant::now();
         let tracer = make_tracer(self.cfg.backend, scene, Query::Single)?;
-        let cfg = AnalysisConfig {
+        let cfg = RunSpec {
             measures: Measures {
                 discrete: want != Want::Continuous,
                 continuous: true,
                 radiosity: want == Want::Radiosity,
             },
-            ..AnalysisConfig::new(lines, self.cfg.seed)
+            ..RunSpec::new(lines, self.cfg.seed)
         };
         let a = analyze(scene, tracer.as_ref(), &cfg, &RunControl::default())?;
         let radiosity = match &a.radiosity {
-            RadiosityOutcome::Computed(r) => Some((**r).clone()),
+            RadiosityOutcome::Computed(_) => Some(a.estimates.clone()),
             _ => None,
         };
         let seconds = start.elapsed().as_secs_f64();
@@ -324,7 +335,7 @@ impl Session<'_> {
             patches: scene.patch_count(),
             lines: a.lines,
             seconds,
-            v: a.visibility,
+            v: a.estimates,
             radiosity,
             escapes: a.escapes,
             pairs: a.pairs,

@@ -6,8 +6,8 @@ use std::time::Instant;
 use super::{est, lines_text, published, Finding, ReproduceError, Run, Session, TableReport, Want};
 use crate::measure::radiosity::SolveOptions;
 use crate::measure::Estimate;
+use crate::measure::{ByMeasure, Measure};
 use crate::refine::{refine, RefineConfig, Strategy};
-use crate::run::VisibilityEstimates;
 use crate::scene::Scene;
 use crate::trace::{make_tracer, Query};
 
@@ -50,7 +50,7 @@ fn finding(claim: &str, holds: bool, detail: String) -> Finding {
 }
 
 /// Picks one measure of a run.
-type Pick = fn(&VisibilityEstimates) -> Option<Estimate>;
+type Pick = fn(&ByMeasure<Estimate>) -> Option<Estimate>;
 
 /// A fig. 2 run of Table 1: placement, the paper's line count, the paper's E(MSE), the run.
 type Fig2Run = (char, u64, f64, Run);
@@ -161,19 +161,19 @@ fn table1(s: &mut Session) -> Result<TableReport, ReproduceError> {
             format!("Fig.2{p}"),
             lines_text(r.lines),
             secs(&r),
-            est(v.entropy, 3),
-            est(v.entropy_corrected, 3),
+            est(v.of(Measure::Entropy), 3),
+            est(v.of(Measure::EntropyCorrected), 3),
             hs.into(),
-            est(v.mutual_information, 3),
-            est(v.mutual_information_corrected, 3),
+            est(v.of(Measure::MutualInformation), 3),
+            est(v.of(Measure::MutualInformationCorrected), 3),
             is.into(),
-            est(v.mse_per_line, 1),
-            est(scaled(v.mse_per_line, r.area_weight), 1),
+            est(v.of(Measure::MsePerLine), 1),
+            est(scaled(v.of(Measure::MsePerLine), r.area_weight), 1),
             mse.into(),
         ]);
         runs.push((p, lines, mse.parse::<f64>().unwrap_or(f64::NAN), r));
     }
-    let hp = runs[0].3.v.positional_entropy;
+    let hp = runs[0].3.v.of(Measure::PositionalEntropy);
     t.notes.push(format!(
         "H_p (eq. 19, exact from the areas) = {} for all three (paper: {}).",
         est(hp, 4),
@@ -182,7 +182,7 @@ fn table1(s: &mut Session) -> Result<TableReport, ReproduceError> {
     let ratios: Vec<String> = runs
         .iter()
         .map(|(p, l, m, r)| {
-            let ours = val(scaled(r.v.mse_per_line, r.area_weight));
+            let ours = val(scaled(r.v.of(Measure::MsePerLine), r.area_weight));
             format!("{p} {}: {:.3}", lines_text(*l), m / ours)
         })
         .collect();
@@ -206,16 +206,19 @@ fn table1_findings(s: &Session, runs: &[Fig2Run]) -> Vec<Finding> {
     for &l in &counts {
         let [a, b, c] = ['a', 'b', 'c'].map(|p| &at(p, l).v);
         let h = |f: Pick| [f(a), f(b), f(c)].map(val);
-        let (hs, is) = (h(|v| v.entropy), h(|v| v.mutual_information));
+        let (hs, is) = (
+            h(|v| v.of(Measure::Entropy)),
+            h(|v| v.of(Measure::MutualInformation)),
+        );
         let (hc, ic) = (
-            h(|v| v.entropy_corrected),
-            h(|v| v.mutual_information_corrected),
+            h(|v| v.of(Measure::EntropyCorrected)),
+            h(|v| v.of(Measure::MutualInformationCorrected)),
         );
         let clustered_lower =
             |x: [f64; 3], y: [f64; 3]| x[1] < x[0] && x[2] < x[0] && y[1] > y[0] && y[2] > y[0];
         plug &= clustered_lower(hs, is);
         corr &= clustered_lower(hc, ic);
-        let mse = h(|v| v.mse_per_line);
+        let mse = h(|v| v.of(Measure::MsePerLine));
         mse_order &= same_order(&hs, &mse);
         detail.push(format!(
             "{}: H_s a/b/c {} (corrected {}), I_s {} ({}), E(MSE) {}",
@@ -248,8 +251,8 @@ fn table1_findings(s: &Session, runs: &[Fig2Run]) -> Vec<Finding> {
     if counts.len() > 1 && s.lines(counts[0]) != s.lines(counts[1]) {
         let more = ['a', 'b', 'c'].iter().all(|&p| {
             let (lo, hi) = (&at(p, counts[0]).v, &at(p, counts[1]).v);
-            val(hi.entropy) > val(lo.entropy)
-                && val(hi.mutual_information) < val(lo.mutual_information)
+            val(hi.of(Measure::Entropy)) > val(lo.of(Measure::Entropy))
+                && val(hi.of(Measure::MutualInformation)) < val(lo.of(Measure::MutualInformation))
         });
         findings.push(finding(
             "more lines increase the (plug-in) H_s and decrease I_s",
@@ -287,13 +290,13 @@ fn table2(s: &mut Session) -> Result<TableReport, ReproduceError> {
             format!("Fig.{fig} ({n}x{n})"),
             lines_text(r.lines),
             secs(&r),
-            est(v.entropy, 3),
-            est(v.entropy_corrected, 3),
+            est(v.of(Measure::Entropy), 3),
+            est(v.of(Measure::EntropyCorrected), 3),
             hs.into(),
-            est(v.mutual_information, 3),
-            est(v.mutual_information_corrected, 3),
+            est(v.of(Measure::MutualInformation), 3),
+            est(v.of(Measure::MutualInformationCorrected), 3),
             is.into(),
-            est(v.continuous_mutual_information, 3),
+            est(v.of(Measure::ContinuousMutualInformation), 3),
             isc.into(),
         ]);
         runs.push((n, lines, r));
@@ -310,7 +313,7 @@ fn table2_findings(s: &Session, runs: &[(usize, u64, Run)]) -> Vec<Finding> {
     let counts = distinct(runs.iter().map(|x| x.1));
     let at = |n: usize, l: u64| &runs.iter().find(|x| x.0 == n && x.1 == l).expect("ran").2.v;
     let same_isc = counts.iter().all(|&l| {
-        let c = [10, 20, 30].map(|n| at(n, l).continuous_mutual_information);
+        let c = [10, 20, 30].map(|n| at(n, l).of(Measure::ContinuousMutualInformation));
         agree(c[0], c[1]) && agree(c[1], c[2]) && agree(c[0], c[2])
     });
     findings.push(finding(
@@ -325,20 +328,20 @@ fn table2_findings(s: &Session, runs: &[(usize, u64, Run)]) -> Vec<Finding> {
             let v = at(n, last);
             format!(
                 "{n}x{n}: I_s {:.3} (corrected {:.3}) vs I_s^c {:.3}",
-                val(v.mutual_information),
-                val(v.mutual_information_corrected),
-                val(v.continuous_mutual_information)
+                val(v.of(Measure::MutualInformation)),
+                val(v.of(Measure::MutualInformationCorrected)),
+                val(v.of(Measure::ContinuousMutualInformation))
             )
         })
         .collect();
     let below = |f: Pick| {
-        [10, 20, 30]
-            .iter()
-            .all(|&n| val(f(at(n, last))) < val(at(n, last).continuous_mutual_information))
+        [10, 20, 30].iter().all(|&n| {
+            val(f(at(n, last))) < val(at(n, last).of(Measure::ContinuousMutualInformation))
+        })
     };
     let (plug, corr) = (
-        below(|v| v.mutual_information),
-        below(|v| v.mutual_information_corrected),
+        below(|v| v.of(Measure::MutualInformation)),
+        below(|v| v.of(Measure::MutualInformationCorrected)),
     );
     findings.push(finding(
         "I_s^c is an upper bound of I_s (Proposition 2), checked at the most lines",
@@ -353,10 +356,13 @@ fn table2_findings(s: &Session, runs: &[(usize, u64, Run)]) -> Vec<Finding> {
     // Only meaningful when the line counts still differ after `--lines`.
     if distinct(counts.iter().map(|&l| s.lines(l))).len() == counts.len() {
         let more = [10, 20, 30].iter().all(|&n| {
-            let h: Vec<f64> = counts.iter().map(|&l| val(at(n, l).entropy)).collect();
+            let h: Vec<f64> = counts
+                .iter()
+                .map(|&l| val(at(n, l).of(Measure::Entropy)))
+                .collect();
             let i: Vec<f64> = counts
                 .iter()
-                .map(|&l| val(at(n, l).mutual_information))
+                .map(|&l| val(at(n, l).of(Measure::MutualInformation)))
                 .collect();
             decreasing(&i) && h.windows(2).all(|w| w[0] < w[1])
         });
@@ -390,10 +396,10 @@ fn table3(s: &mut Session) -> Result<TableReport, ReproduceError> {
         t.rows.push(vec![
             lines_text(r.lines),
             secs(&r),
-            est(v.mutual_information, 3),
-            est(v.mutual_information_corrected, 3),
+            est(v.of(Measure::MutualInformation), 3),
+            est(v.of(Measure::MutualInformationCorrected), 3),
             is.into(),
-            est(v.continuous_mutual_information, 3),
+            est(v.of(Measure::ContinuousMutualInformation), 3),
             isc.into(),
         ]);
         runs.push(r);
@@ -404,10 +410,10 @@ fn table3(s: &mut Session) -> Result<TableReport, ReproduceError> {
         .last()
         .expect("four runs")
         .v
-        .continuous_mutual_information;
+        .of(Measure::ContinuousMutualInformation);
     let cheap = runs
         .iter()
-        .all(|r| agree(r.v.continuous_mutual_information, last));
+        .all(|r| agree(r.v.of(Measure::ContinuousMutualInformation), last));
     t.findings.push(finding(
         "I_s^c is cheap: every line count gives it within 3 standard errors of the largest run",
         cheap,
@@ -416,12 +422,15 @@ fn table3(s: &mut Session) -> Result<TableReport, ReproduceError> {
             slash(
                 &runs
                     .iter()
-                    .map(|r| val(r.v.continuous_mutual_information))
+                    .map(|r| val(r.v.of(Measure::ContinuousMutualInformation)))
                     .collect::<Vec<_>>()
             )
         ),
     ));
-    let is: Vec<f64> = runs.iter().map(|r| val(r.v.mutual_information)).collect();
+    let is: Vec<f64> = runs
+        .iter()
+        .map(|r| val(r.v.of(Measure::MutualInformation)))
+        .collect();
     if distinct(runs.iter().map(|r| r.lines)).len() == runs.len() {
         t.findings.push(finding(
             "I_s is expensive: the plug-in I_s keeps falling as lines are added",
@@ -452,7 +461,7 @@ fn table4(s: &mut Session) -> Result<TableReport, ReproduceError> {
     let mut isc = Vec::new();
     for (&(name, value), spec) in published::TABLE4.iter().zip(TABLE4_SCENES) {
         let r = s.run(spec, published::TABLE45_LINES, Want::Continuous)?;
-        let c = r.v.continuous_mutual_information;
+        let c = r.v.of(Measure::ContinuousMutualInformation);
         t.rows.push(vec![
             name.into(),
             format!("`{spec}`"),
@@ -497,7 +506,7 @@ fn table5(s: &mut Session) -> Result<TableReport, ReproduceError> {
             published::TABLE45_LINES,
             Want::Continuous,
         )?;
-        let c = r.v.continuous_mutual_information;
+        let c = r.v.of(Measure::ContinuousMutualInformation);
         t.rows.push(vec![
             format!("4{p}"),
             lines_text(r.lines),
@@ -587,13 +596,13 @@ fn table67(s: &mut Session, number: u8) -> Result<TableReport, ReproduceError> {
             format!("Fig.{fig}{stage}"),
             lines_text(r.lines),
             secs(&r),
-            est(v.mutual_information, 3),
-            est(v.mutual_information_corrected, 3),
+            est(v.of(Measure::MutualInformation), 3),
+            est(v.of(Measure::MutualInformationCorrected), 3),
             is.into(),
-            est(v.continuous_mutual_information, 3),
+            est(v.of(Measure::ContinuousMutualInformation), 3),
             isc.into(),
-            est(v.accuracy, 3),
-            est(v.accuracy_corrected, 3),
+            est(v.of(Measure::Accuracy), 3),
+            est(v.of(Measure::AccuracyCorrected), 3),
             acc.into(),
         ]);
         runs.push(r);
@@ -601,7 +610,7 @@ fn table67(s: &mut Session, number: u8) -> Result<TableReport, ReproduceError> {
     t.notes.extend(capped_note(s, &[published::TABLE67_LINES]));
     let isc: Vec<f64> = runs
         .iter()
-        .map(|r| val(r.v.continuous_mutual_information))
+        .map(|r| val(r.v.of(Measure::ContinuousMutualInformation)))
         .collect();
     let extremes_complex = isc[1..5].iter().all(|&m| m < isc[0] && m < isc[5]);
     t.findings.push(finding(
@@ -613,8 +622,14 @@ fn table67(s: &mut Session, number: u8) -> Result<TableReport, ReproduceError> {
         let worst_middle = acc[1..5].iter().cloned().fold(f64::INFINITY, f64::min);
         worst_middle > acc[0] && worst_middle > acc[5]
     };
-    let acc: Vec<f64> = runs.iter().map(|r| val(r.v.accuracy)).collect();
-    let acc_c: Vec<f64> = runs.iter().map(|r| val(r.v.accuracy_corrected)).collect();
+    let acc: Vec<f64> = runs
+        .iter()
+        .map(|r| val(r.v.of(Measure::Accuracy)))
+        .collect();
+    let acc_c: Vec<f64> = runs
+        .iter()
+        .map(|r| val(r.v.of(Measure::AccuracyCorrected)))
+        .collect();
     let (plug, corr) = (middle_best(&acc), middle_best(&acc_c));
     t.findings.push(finding(
         "the middle stages (b-e) have the highest accuracy I_s/I_s^c and the extreme ones (a, f) the lowest",
@@ -639,7 +654,10 @@ fn compare_meshes(s: &mut Session, fig6: &[Run]) -> Result<Finding, ReproduceErr
     let a5 = s.run("@fig5:a", published::TABLE67_LINES, Want::Visibility)?;
     let f5 = s.run("@fig5:f", published::TABLE67_LINES, Want::Visibility)?;
     let wins = |f: Pick| val(f(&a5.v)) > val(f(&fig6[0].v)) && val(f(&fig6[5].v)) > val(f(&f5.v));
-    let (plug, corr) = (wins(|v| v.accuracy), wins(|v| v.accuracy_corrected));
+    let (plug, corr) = (
+        wins(|v| v.of(Measure::Accuracy)),
+        wins(|v| v.of(Measure::AccuracyCorrected)),
+    );
     Ok(finding(
         "5a (cubes finer) is more accurate than 6a, and 6f (walls finer) more accurate than 5f",
         plug && corr,
@@ -647,10 +665,10 @@ fn compare_meshes(s: &mut Session, fig6: &[Run]) -> Result<Finding, ReproduceErr
             "plug-in: {}, corrected: {}; accuracy 5a {:.3} 6a {:.3}, 5f {:.3} 6f {:.3}",
             yes(plug),
             yes(corr),
-            val(a5.v.accuracy),
-            val(fig6[0].v.accuracy),
-            val(f5.v.accuracy),
-            val(fig6[5].v.accuracy)
+            val(a5.v.of(Measure::Accuracy)),
+            val(fig6[0].v.of(Measure::Accuracy)),
+            val(f5.v.of(Measure::Accuracy)),
+            val(fig6[5].v.of(Measure::Accuracy))
         ),
     ))
 }
@@ -680,13 +698,13 @@ fn table8(s: &mut Session) -> Result<TableReport, ReproduceError> {
         "Visibility".into(),
         lines_text(r.lines),
         secs(&r),
-        est(v.positional_entropy, 4),
+        est(v.of(Measure::PositionalEntropy), 4),
         ph.into(),
-        est(v.entropy, 5),
-        est(v.entropy_corrected, 5),
+        est(v.of(Measure::Entropy), 5),
+        est(v.of(Measure::EntropyCorrected), 5),
         ps.into(),
-        est(v.mutual_information, 5),
-        est(v.mutual_information_corrected, 5),
+        est(v.of(Measure::MutualInformation), 5),
+        est(v.of(Measure::MutualInformationCorrected), 5),
         pi.into(),
     ]);
     let Some(rad) = &r.radiosity else {
@@ -699,13 +717,13 @@ fn table8(s: &mut Session) -> Result<TableReport, ReproduceError> {
         "Radiosity".into(),
         lines_text(r.lines),
         "(same run)".into(),
-        est(Some(rad.positional_entropy), 4),
+        est(rad.of(Measure::RadiosityPositionalEntropy), 4),
         qh.into(),
-        est(Some(rad.entropy), 5),
-        est(Some(rad.entropy_corrected), 5),
+        est(rad.of(Measure::RadiosityEntropy), 5),
+        est(rad.of(Measure::RadiosityEntropyCorrected), 5),
         qs.into(),
-        est(Some(rad.mutual_information), 5),
-        est(Some(rad.mutual_information_corrected), 5),
+        est(rad.of(Measure::RadiosityMutualInformation), 5),
+        est(rad.of(Measure::RadiosityMutualInformationCorrected), 5),
         qi.into(),
     ]);
     t.notes.push(format!(
@@ -716,18 +734,27 @@ fn table8(s: &mut Session) -> Result<TableReport, ReproduceError> {
         r.patches
     ));
     let pairs = [
-        (v.positional_entropy, rad.positional_entropy),
-        (v.entropy, rad.entropy),
-        (v.entropy_corrected, rad.entropy_corrected),
-        (v.mutual_information, rad.mutual_information),
         (
-            v.mutual_information_corrected,
-            rad.mutual_information_corrected,
+            v.of(Measure::PositionalEntropy),
+            rad.of(Measure::RadiosityPositionalEntropy),
+        ),
+        (v.of(Measure::Entropy), rad.of(Measure::RadiosityEntropy)),
+        (
+            v.of(Measure::EntropyCorrected),
+            rad.of(Measure::RadiosityEntropyCorrected),
+        ),
+        (
+            v.of(Measure::MutualInformation),
+            rad.of(Measure::RadiosityMutualInformation),
+        ),
+        (
+            v.of(Measure::MutualInformationCorrected),
+            rad.of(Measure::RadiosityMutualInformationCorrected),
         ),
     ];
     let gap = pairs
         .iter()
-        .map(|(a, b)| (val(*a) - b.value).abs())
+        .map(|(a, b)| (val(*a) - val(*b)).abs())
         .fold(0.0, f64::max);
     // The identity is exact when every form-factor row sums to 1; a segment escaping through a grazing
     // hit (a line exactly through an edge) leaves its row short and B a hair below 1. The paper's own
@@ -789,19 +816,19 @@ fn table9(s: &mut Session) -> Result<TableReport, ReproduceError> {
             format!("{refine_s:.2}"),
             lines_text(r.lines),
             secs(&r),
-            est(Some(rad.positional_entropy), 2),
+            est(rad.of(Measure::RadiosityPositionalEntropy), 2),
             hp.into(),
-            est(Some(rad.entropy), 2),
-            est(Some(rad.entropy_corrected), 2),
+            est(rad.of(Measure::RadiosityEntropy), 2),
+            est(rad.of(Measure::RadiosityEntropyCorrected), 2),
             hs.into(),
-            est(Some(rad.mutual_information), 3),
-            est(Some(rad.mutual_information_corrected), 3),
+            est(rad.of(Measure::RadiosityMutualInformation), 3),
+            est(rad.of(Measure::RadiosityMutualInformationCorrected), 3),
             is.into(),
         ]);
         mi.push((
             mesh,
-            rad.mutual_information.value,
-            rad.mutual_information_corrected.value,
+            val(rad.of(Measure::RadiosityMutualInformation)),
+            val(rad.of(Measure::RadiosityMutualInformationCorrected)),
         ));
     }
     t.notes.push(format!(

@@ -3,8 +3,10 @@
 
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 
+use crate::measure::Measure;
+
 /// Limits that end a run before its line count.
-#[derive(Clone, Copy, Debug, Default)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Budget {
     /// Stop when this much wall-clock time is spent.
     pub seconds: Option<f64>,
@@ -20,66 +22,12 @@ impl Budget {
 }
 
 /// A precision target: run until `measure`'s standard error is at most `stderr`.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Target {
-    /// The measure watched.
-    pub measure: TargetMeasure,
+    /// The measure watched (one of [`Measure::targets`]).
+    pub measure: Measure,
     /// The standard error to reach.
     pub stderr: f64,
-}
-
-/// A measure a precision target can watch (named as in the JSON report).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum TargetMeasure {
-    /// H_s, eq. (17), plug-in.
-    Entropy,
-    /// H_s with bias-corrected rows.
-    EntropyCorrected,
-    /// I_s, eq. (21), plug-in.
-    MutualInformation,
-    /// I_s with bias-corrected rows: the default, the better reading of I_s.
-    MutualInformationCorrected,
-    /// I_s^c, eq. (27).
-    ContinuousMutualInformation,
-    /// I_s / I_s^c, plug-in.
-    Accuracy,
-    /// I_s / I_s^c with the corrected I_s.
-    AccuracyCorrected,
-}
-
-impl TargetMeasure {
-    /// Every target measure with its name.
-    pub const NAMES: [(&'static str, TargetMeasure); 7] = [
-        ("entropy", TargetMeasure::Entropy),
-        ("entropy_corrected", TargetMeasure::EntropyCorrected),
-        ("mutual_information", TargetMeasure::MutualInformation),
-        (
-            "mutual_information_corrected",
-            TargetMeasure::MutualInformationCorrected,
-        ),
-        (
-            "continuous_mutual_information",
-            TargetMeasure::ContinuousMutualInformation,
-        ),
-        ("accuracy", TargetMeasure::Accuracy),
-        ("accuracy_corrected", TargetMeasure::AccuracyCorrected),
-    ];
-
-    /// The name as in the JSON report.
-    pub fn name(self) -> &'static str {
-        Self::NAMES
-            .iter()
-            .find(|(_, m)| *m == self)
-            .map_or("", |(n, _)| n)
-    }
-
-    /// Parses a name as in the JSON report (`mutual_information`).
-    pub fn from_name(name: &str) -> Option<Self> {
-        Self::NAMES
-            .iter()
-            .find(|(n, _)| *n == name)
-            .map(|&(_, m)| m)
-    }
 }
 
 /// Shared between a run and whoever watches it: a stop request (Ctrl-C) and a progress counter.

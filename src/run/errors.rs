@@ -1,4 +1,4 @@
-//! Standard errors from the groups of a run (README, "Standard errors").
+//! Standard errors from the groups of a run (docs/results.md, "Standard errors").
 //!
 //! Batch `b` of a run belongs to group `b mod G`; every batch has its own random stream, so the groups
 //! are independent. Every measure is computed on the whole run, on each group alone, and (for the
@@ -10,7 +10,8 @@ use crate::measure::Estimate;
 /// How the standard errors of the measures built from pair counts (H_s, I_s, H(X, Y), E(MSE), the
 /// corrected values, the accuracies and the radiosity measures) are estimated. I_s^c, a mean, always
 /// gets batch means, which are exact for it.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
 pub enum ErrorMethod {
     /// Batch means: the spread of the G groups' own values / sqrt(G). Cheap, and conservative where the
     /// form-factor rows are undersampled (each group has 1/G of the lines).

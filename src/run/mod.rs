@@ -1,44 +1,35 @@
 //! The run engine: one way to cast a run's lines, for every kind of run.
 //!
+//! * [`spec`]: what a run is (the settings that determine its numbers);
 //! * [`plan`]: how lines are cut into batches (a function of the line count, never of the threads) and
 //!   batches into rounds;
 //! * [`batches`]: the one parallel loop over batches, whose results come back in batch order (analyses,
 //!   refinement rounds and cross-checks all use it);
 //! * [`state`]: a run's groups as they fill up, a value ([`RunState`]);
+//! * [`cast`](mod@cast): the rounds that fill a state until the line count, a budget or a stop request ends
+//!   the run;
 //! * [`errors`]: standard errors from the groups (batch means, the delete-a-group jackknife);
 //! * [`control`]: budgets, stop reasons and the handle that watches and stops a run;
-//! * [`analysis`]: the analysis of a scene, [`analyze`], with [`radiosity`], [`warnings`] and the
-//!   per-patch results ([`patches`]).
+//! * [`persist`]: run states saved to files, to resume or merge.
+//!
+//! What is computed from a run is [`crate::analysis`]'s.
 
-pub mod analysis;
 pub mod batches;
+pub mod cast;
 pub mod control;
 pub mod errors;
-mod orientation;
-pub mod patches;
 pub mod persist;
 pub mod plan;
-pub mod radiosity;
-pub mod readings;
-pub mod reliability;
+pub mod spec;
 pub mod state;
-pub mod warnings;
 
-pub use analysis::TargetOutcome;
-pub use analysis::{
-    analyze, cast, finish, plan_of, remaining_lines, start, Analysis, AnalysisConfig,
-    AnalysisError, CastOptions, Measures, Scope, DEFAULT_ESTIMATOR, DEFAULT_GROUPS,
-};
 pub use batches::{all_batches, map_batches, map_traced_batches, Batch, LineStream, TraceBuffers};
-pub use control::{Budget, RunControl, StopReason, Target, TargetMeasure};
-pub use errors::{ErrorMethod, Spread};
-pub use patches::{PatchEstimate, PatchLight};
-pub use persist::{PersistError, RunIdentity, SavedRun};
-pub use plan::{BatchPlan, BatchSet};
-pub use radiosity::{
-    RadiosityEstimates, RadiosityOutcome, RadiosityReliability, SolveFailure, NOTHING_EMITS,
+pub use cast::{
+    cast, remaining_lines, start, CastHooks, CastOptions, Scope, Shard, TargetReading, TargetWatch,
 };
-pub use readings::VisibilityEstimates;
-pub use reliability::{Reliability, SamplingReport, Verdict, VisibilityReliability};
+pub use control::{Budget, RunControl, StopReason, Target};
+pub use errors::{ErrorMethod, Spread};
+pub use persist::{PersistError, RunIdentity, SavedRun, SceneRef, Tracing};
+pub use plan::{BatchPlan, BatchSet};
+pub use spec::{ExtendError, Measures, RunSpec, SpecDifference, DEFAULT_ESTIMATOR, DEFAULT_GROUPS};
 pub use state::{FinishedRun, MergeError, RunState, StateParts, TracedBatches};
-pub use warnings::{RunWarning, RunWarningKind};

@@ -20,210 +20,127 @@ use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
-use super::analysis::{AnalysisConfig, Measures};
-use super::control::{Budget, Target, TargetMeasure};
-use super::errors::ErrorMethod;
+use super::cast::Shard;
 use super::plan::{BatchPlan, BatchSet};
+use super::spec::{RunSpec, SpecDifference};
 use super::state::RunState;
-use crate::measure::estimators::EntropyEstimator;
 use crate::sample::counts::{pair_key, split_key, PairCounts};
 use crate::sample::exact::ExactSum;
-use crate::sample::lines::LineSource;
-use crate::sample::patch_sums::PatchKernelSums;
+use crate::sample::kernel_sums::PatchKernelSums;
 use crate::sample::tally::{Counters, ObjectSides, Tally, Wanted};
 use crate::scene::{Scene, SceneOptions};
+use crate::trace::{Backend, Query};
 
-/// The format version this scx writes and reads.
-pub const FORMAT_VERSION: u32 = 1;
+/// The format version this scx writes and reads. Format 1 (before the run's spec was stored typed) is
+/// refused with a message saying so.
+pub const FORMAT_VERSION: u32 = 2;
 
 const MAGIC: &[u8; 8] = b"SCXSTATE";
 const HEADER: usize = 8 + 4 + 8 + 4;
 
-/// What a run is: two states can be merged, or one resumed, only when these agree (the shard and the
-/// line count aside).
+/// The scene a saved run is of: as named, as read, and its fingerprint.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct RunIdentity {
-    /// The scx version that wrote the state.
-    pub scx_version: String,
+pub struct SceneRef {
     /// The scene as named on the command line (a file path or a built-in).
-    pub scene: String,
+    pub name: String,
     /// How the scene file was read (planarity, flipped and two-sided objects), so that a resume or a
     /// merge reads it the same way.
-    #[serde(default)]
     pub reading: SceneOptions,
     /// [`crate::scene::Scene::fingerprint`] of the loaded scene.
     pub fingerprint: String,
     /// Its patches.
     pub patches: u64,
-    /// Seed of the line streams.
-    pub seed: u64,
-    /// Lines per side of a bundle, 0 for independent lines.
-    pub bundle: u32,
-    /// The tracer's name.
-    pub tracer: String,
-    /// The ray query.
-    pub query: String,
-    /// Lines asked for (the plan's; a cap when a budget is set).
-    pub lines: u64,
-    /// Standard-error groups asked for.
-    pub groups: u64,
-    /// Which measures: discrete, continuous, radiosity.
-    pub measures: [bool; 3],
-    /// `--enclose`.
-    pub enclose: bool,
-    /// The estimator of the corrected readings.
-    pub estimator: String,
-    /// The standard-error method.
-    pub errors: String,
-    /// `--seconds`, when given.
-    pub seconds: Option<f64>,
-    /// `--target-stderr` and its measure, when given.
-    pub target: Option<(String, f64)>,
-    /// The shard (index from 1, count), when the run was one.
-    pub shard: Option<(u32, u32)>,
 }
 
-impl RunIdentity {
-    /// The identity of a run of `cfg` on `scene` (named `spec` on the command line) with the tracer
-    /// `tracer` and query `query`, as shard `shard` when it is one.
-    pub fn of(
-        spec: &str,
-        reading: &SceneOptions,
-        scene: &Scene,
-        cfg: &AnalysisConfig,
-        tracer: &str,
-        query: &str,
-        shard: Option<(u32, u32)>,
-    ) -> Self {
-        RunIdentity {
-            scx_version: env!("CARGO_PKG_VERSION").into(),
-            scene: spec.into(),
+impl SceneRef {
+    /// The scene `scene`, named `name` and read with `reading`.
+    pub fn of(name: &str, reading: &SceneOptions, scene: &Scene) -> Self {
+        SceneRef {
+            name: name.into(),
             reading: reading.clone(),
             fingerprint: scene.fingerprint(),
             patches: scene.patch_count() as u64,
-            seed: cfg.seed,
-            bundle: match cfg.source {
-                LineSource::Independent => 0,
-                LineSource::Bundles { grid } => grid,
-            },
-            tracer: tracer.into(),
-            query: query.into(),
-            lines: cfg.lines,
-            groups: cfg.groups as u64,
-            measures: [
-                cfg.measures.discrete,
-                cfg.measures.continuous,
-                cfg.measures.radiosity,
-            ],
-            enclose: cfg.enclose,
-            estimator: cfg.estimator.name().into(),
-            errors: cfg.errors.name().into(),
-            seconds: cfg.budget.seconds,
-            target: cfg
-                .budget
-                .target
-                .map(|t| (t.measure.name().to_string(), t.stderr)),
+        }
+    }
+}
+
+/// How a run's lines were traced. Not part of what the run is ([`RunSpec`]): both tracers give the same
+/// hits by design, so parts of one run may be traced by either.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Tracing {
+    /// The backend.
+    pub backend: Backend,
+    /// Its ray query.
+    pub query: Query,
+}
+
+/// What a saved state is of: the scx that wrote it, the scene, the run's spec, its shard, and how its
+/// lines were traced. Two states can be merged, or one resumed, only when these agree
+/// ([`RunIdentity::difference`]).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RunIdentity {
+    /// The scx version that wrote the state.
+    pub scx_version: String,
+    /// The scene.
+    pub scene: SceneRef,
+    /// What the run is.
+    pub spec: RunSpec,
+    /// The shard, when the run was one.
+    pub shard: Option<Shard>,
+    /// How its lines were traced.
+    pub tracing: Tracing,
+}
+
+impl RunIdentity {
+    /// The identity of a run of `spec` on `scene`, traced with `tracing`, as shard `shard` when it is
+    /// one, written by this scx.
+    pub fn new(scene: SceneRef, spec: RunSpec, shard: Option<Shard>, tracing: Tracing) -> Self {
+        RunIdentity {
+            scx_version: env!("CARGO_PKG_VERSION").into(),
+            scene,
+            spec,
             shard,
+            tracing,
         }
     }
 
-    /// The configuration of the run (its radiosity solve the default one).
-    pub fn config(&self) -> Result<AnalysisConfig, String> {
-        let target = match &self.target {
-            Some((name, stderr)) => Some(Target {
-                measure: TargetMeasure::from_name(name)
-                    .ok_or_else(|| format!("unknown target measure `{name}`"))?,
-                stderr: *stderr,
-            }),
-            None => None,
-        };
-        Ok(AnalysisConfig {
-            measures: Measures {
-                discrete: self.measures[0],
-                continuous: self.measures[1],
-                radiosity: self.measures[2],
-            },
-            groups: self.groups as usize,
-            estimator: EntropyEstimator::from_name(&self.estimator)
-                .ok_or_else(|| format!("unknown estimator `{}`", self.estimator))?,
-            errors: ErrorMethod::from_name(&self.errors)
-                .ok_or_else(|| format!("unknown error method `{}`", self.errors))?,
-            budget: Budget {
-                seconds: self.seconds,
-                target,
-            },
-            source: LineSource::bundles(self.bundle)?,
-            enclose: self.enclose,
-            ..AnalysisConfig::new(self.lines, self.seed)
-        })
-    }
-
-    /// The first setting in which two runs differ (the shard and, when `lines_may_differ`, the line
-    /// count aside), as `(setting, ours, theirs)`.
+    /// The first setting in which two runs differ that must agree for them to be parts of one run:
+    /// the scx version, the scene, the spec ([`RunSpec::difference`]; the line counts only unless
+    /// `lines_may_differ`) and the shard count.
     pub fn difference(
         &self,
         other: &RunIdentity,
         lines_may_differ: bool,
-    ) -> Option<(&'static str, String, String)> {
-        let pairs: [(&'static str, String, String); 16] = [
-            (
-                "scx version",
-                self.scx_version.clone(),
-                other.scx_version.clone(),
-            ),
-            (
+    ) -> Option<SpecDifference> {
+        let differ = |setting: &str, ours: String, theirs: String| {
+            (ours != theirs).then(|| SpecDifference {
+                setting: setting.into(),
+                ours,
+                theirs,
+            })
+        };
+        let shards = |s: &RunIdentity| s.shard.map_or("none".into(), |s| s.count.to_string());
+        differ(
+            "scx version",
+            self.scx_version.clone(),
+            other.scx_version.clone(),
+        )
+        .or_else(|| {
+            differ(
                 "scene fingerprint",
-                self.fingerprint.clone(),
-                other.fingerprint.clone(),
-            ),
-            (
+                self.scene.fingerprint.clone(),
+                other.scene.fingerprint.clone(),
+            )
+        })
+        .or_else(|| {
+            differ(
                 "patches",
-                self.patches.to_string(),
-                other.patches.to_string(),
-            ),
-            ("seed", self.seed.to_string(), other.seed.to_string()),
-            ("bundle", self.bundle.to_string(), other.bundle.to_string()),
-            ("tracer", self.tracer.clone(), other.tracer.clone()),
-            ("query", self.query.clone(), other.query.clone()),
-            (
-                "lines",
-                self.lines.to_string(),
-                if lines_may_differ {
-                    self.lines.to_string()
-                } else {
-                    other.lines.to_string()
-                },
-            ),
-            ("groups", self.groups.to_string(), other.groups.to_string()),
-            (
-                "measures",
-                format!("{:?}", self.measures),
-                format!("{:?}", other.measures),
-            ),
-            (
-                "enclose",
-                self.enclose.to_string(),
-                other.enclose.to_string(),
-            ),
-            ("estimator", self.estimator.clone(), other.estimator.clone()),
-            ("errors", self.errors.clone(), other.errors.clone()),
-            (
-                "seconds",
-                format!("{:?}", self.seconds),
-                format!("{:?}", other.seconds),
-            ),
-            (
-                "target",
-                format!("{:?}", self.target),
-                format!("{:?}", other.target),
-            ),
-            (
-                "shard count",
-                format!("{:?}", self.shard.map(|s| s.1)),
-                format!("{:?}", other.shard.map(|s| s.1)),
-            ),
-        ];
-        pairs.into_iter().find(|(_, a, b)| a != b)
+                self.scene.patches.to_string(),
+                other.scene.patches.to_string(),
+            )
+        })
+        .or_else(|| self.spec.difference(&other.spec, lines_may_differ))
+        .or_else(|| differ("shard count", shards(self), shards(other)))
     }
 }
 
@@ -478,8 +395,13 @@ pub fn decode(path: &str, bytes: &[u8]) -> Result<SavedRun, PersistError> {
     }
     let version = u32::from_le_bytes(bytes[8..12].try_into().expect("4 bytes"));
     if version != FORMAT_VERSION {
+        let hint = if version < FORMAT_VERSION {
+            ": it was written by an earlier scx; finish the run with that scx, or start it again"
+        } else {
+            ": it was written by a later scx"
+        };
         return Err(bad(format!(
-            "written in run-state format {version}; this scx reads format {FORMAT_VERSION}"
+            "written in run-state format {version}; this scx reads format {FORMAT_VERSION}{hint}"
         )));
     }
     let length = u64::from_le_bytes(bytes[12..20].try_into().expect("8 bytes"));
@@ -518,7 +440,7 @@ fn state_of(w: Wire) -> Option<SavedRun> {
         continuous: w.continuous,
         per_patch: w.per_patch,
     };
-    let patches = usize::try_from(w.identity.patches).ok()?;
+    let patches = usize::try_from(w.identity.scene.patches).ok()?;
     let groups = w
         .groups
         .iter()
@@ -601,8 +523,8 @@ pub fn load(path: &Path) -> Result<SavedRun, PersistError> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::run::analysis::{cast, start, CastOptions};
     use crate::run::control::RunControl;
+    use crate::run::{cast, start, CastHooks, CastOptions};
     use crate::trace::{make_tracer, Backend, Query};
 
     /// A state saved and read back reports the same numbers, bit for bit; a truncated file, a flipped
@@ -612,7 +534,7 @@ mod tests {
         for spec in ["@cube:2", "@cubes512"] {
             let scene = crate::scenes::load(spec).unwrap();
             let tracer = make_tracer(Backend::Rust, &scene, Query::Single).unwrap();
-            let cfg = AnalysisConfig::new(20_000, 3);
+            let cfg = RunSpec::new(20_000, 3);
             let mut state = start(&scene, &cfg).unwrap();
             cast(
                 &scene,
@@ -621,17 +543,20 @@ mod tests {
                 &mut state,
                 CastOptions::default(),
                 &RunControl::default(),
-                &mut |_| {},
+                CastHooks {
+                    target: None,
+                    after_round: &mut |_| {},
+                },
             )
             .unwrap();
-            let identity = RunIdentity::of(
-                spec,
-                &SceneOptions::default(),
-                &scene,
-                &cfg,
-                "rust",
-                "single",
+            let identity = RunIdentity::new(
+                SceneRef::of(spec, &SceneOptions::default(), &scene),
+                cfg.clone(),
                 None,
+                Tracing {
+                    backend: Backend::Rust,
+                    query: Query::Single,
+                },
             );
             let bytes = encode(&identity, &state, 1.5);
             let back = decode("s.scx", &bytes).unwrap();
@@ -661,7 +586,7 @@ mod tests {
     }
 
     /// A run of `cfg` on `@cube:3`, cast at once, its scene and state.
-    fn cube_run(cfg: &AnalysisConfig) -> (Scene, RunState) {
+    fn cube_run(cfg: &RunSpec) -> (Scene, RunState) {
         let scene = crate::scenes::load("@cube:3").unwrap();
         let tracer = make_tracer(Backend::Rust, &scene, Query::Single).unwrap();
         let mut state = start(&scene, cfg).unwrap();
@@ -672,7 +597,10 @@ mod tests {
             &mut state,
             CastOptions::default(),
             &RunControl::default(),
-            &mut |_| {},
+            CastHooks {
+                target: None,
+                after_round: &mut |_| {},
+            },
         )
         .unwrap();
         (scene, state)
@@ -694,20 +622,20 @@ mod tests {
     fn per_patch_sums_round_trip() {
         // 70 000 lines: batches of 1024 and a partial last one, kept apart in the state.
         for per_patch in [true, false] {
-            let cfg = AnalysisConfig {
+            let cfg = RunSpec {
                 per_patch,
-                ..AnalysisConfig::new(70_000, 5)
+                ..RunSpec::new(70_000, 5)
             };
             let (scene, state) = cube_run(&cfg);
             assert!(state.parts().tail.is_some(), "the run has a partial batch");
-            let identity = RunIdentity::of(
-                "@cube:3",
-                &SceneOptions::default(),
-                &scene,
-                &cfg,
-                "rust",
-                "single",
+            let identity = RunIdentity::new(
+                SceneRef::of("@cube:3", &SceneOptions::default(), &scene),
+                cfg.clone(),
                 None,
+                Tracing {
+                    backend: Backend::Rust,
+                    query: Query::Single,
+                },
             );
             let back = decode("s.scx", &encode(&identity, &state, 0.5))
                 .unwrap()
@@ -738,20 +666,20 @@ mod tests {
     /// is refused.
     #[test]
     fn states_without_the_per_patch_fields_load() {
-        let cfg = AnalysisConfig {
+        let cfg = RunSpec {
             per_patch: true,
-            ..AnalysisConfig::new(20_000, 2)
+            ..RunSpec::new(20_000, 2)
         };
         let (scene, state) = cube_run(&cfg);
         assert!(state.parts().tail.is_some(), "the run has a partial batch");
-        let identity = RunIdentity::of(
-            "@cube:3",
-            &SceneOptions::default(),
-            &scene,
-            &cfg,
-            "rust",
-            "single",
+        let identity = RunIdentity::new(
+            SceneRef::of("@cube:3", &SceneOptions::default(), &scene),
+            cfg.clone(),
             None,
+            Tracing {
+                backend: Backend::Rust,
+                query: Query::Single,
+            },
         );
         let bytes = encode(&identity, &state, 1.0);
         let mut doc: ciborium::Value = ciborium::from_reader(&bytes[HEADER..]).unwrap();

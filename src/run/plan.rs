@@ -22,10 +22,23 @@ pub struct BatchPlan {
 }
 
 impl BatchPlan {
-    /// Batches of at most 4096 lines, and at least 64 batches when there are enough lines, so that the
-    /// work spreads over threads and the standard-error groups each get several batches.
+    /// The most lines in a batch.
+    pub const MAX_BATCH: u64 = 4096;
+
+    /// The fewest lines in a batch (but the last).
+    pub const MIN_BATCH: u64 = 256;
+
+    /// The batches a run has at least, when it has the lines for them.
+    pub const MIN_BATCHES: u64 = 64;
+
+    /// From this many lines on, every run has batches of [`BatchPlan::MAX_BATCH`] lines.
+    pub const FULL_FROM: u64 = BatchPlan::MIN_BATCHES * BatchPlan::MAX_BATCH;
+
+    /// Batches of at most [`BatchPlan::MAX_BATCH`] lines, and at least [`BatchPlan::MIN_BATCHES`]
+    /// batches when there are enough lines, so that the work spreads over threads and the standard-error
+    /// groups each get several batches.
     pub fn new(lines: u64) -> Self {
-        let batch_size = (lines / 64).clamp(256, 4096);
+        let batch_size = (lines / Self::MIN_BATCHES).clamp(Self::MIN_BATCH, Self::MAX_BATCH);
         BatchPlan { lines, batch_size }
     }
 
@@ -45,7 +58,7 @@ impl BatchPlan {
     /// are the same whatever the budget.
     pub fn open_ended(lines: u64, source: LineSource) -> Self {
         let unit = source.lines_per_unit();
-        let batch_size = (4096 / unit).max(1) * unit;
+        let batch_size = (Self::MAX_BATCH / unit).max(1) * unit;
         BatchPlan {
             lines: lines.div_ceil(unit) * unit,
             batch_size,

@@ -12,7 +12,7 @@ use rayon::prelude::*;
 
 use super::batches::{map_traced_batches, LineStream};
 use super::plan::{BatchPlan, BatchSet};
-use crate::sample::counts::{count_by_group, PairCounts, DENSE_MAX_PATCHES};
+use crate::sample::counts::PairCounts;
 use crate::sample::tally::{BatchTally, LineTally, Tally, Wanted};
 use crate::scene::Scene;
 use crate::trace::{TraceError, Tracer};
@@ -68,44 +68,9 @@ impl TracedBatches {
         out
     }
 
-    /// Deals the batches into `groups` groups and tallies each (`None` for a group without batches);
-    /// sparse counts come from one sort of every group's keys ([`count_by_group`]).
+    /// Deals the batches into `groups` groups and tallies each (`None` for a group without batches).
     fn into_group_tallies(self, scene: &Scene, wanted: Wanted, groups: u64) -> Vec<Option<Tally>> {
-        let patches = scene.patch_count();
-        if !wanted.discrete || patches <= DENSE_MAX_PATCHES {
-            return self
-                .split_into_groups(groups)
-                .into_par_iter()
-                .map(|piece| (!piece.is_empty()).then(|| Tally::from_batches(scene, wanted, piece)))
-                .collect();
-        }
-        // The counters (and per-patch sums) first, then the keys are counted: the sort frees them as it
-        // deals them.
-        type GroupKeys = Vec<(usize, Vec<u64>)>;
-        let (sums, keyed): (Vec<Option<Tally>>, Vec<GroupKeys>) = self
-            .split_into_groups(groups)
-            .into_par_iter()
-            .enumerate()
-            .map(|(g, piece)| {
-                if piece.is_empty() {
-                    return (None, Vec::new());
-                }
-                let (tally, keys) = Tally::sum_batches(scene, wanted, piece);
-                (Some(tally), keys.into_iter().map(|k| (g, k)).collect())
-            })
-            .unzip();
-        // Moved, not cloned (`concat` would copy every batch's keys).
-        let keyed: GroupKeys = keyed.into_iter().flatten().collect();
-        let counted = count_by_group(patches, groups as usize, keyed);
-        sums.into_iter()
-            .zip(counted)
-            .map(|(tally, counts)| {
-                tally.map(|mut tally| {
-                    tally.counts = Some(PairCounts::Sparse(counts));
-                    tally
-                })
-            })
-            .collect()
+        Tally::of_groups(scene, wanted, self.split_into_groups(groups))
     }
 }
 

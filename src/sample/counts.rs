@@ -2,7 +2,7 @@
 //!
 //! Counts are symmetric (every pair counts once i -> j and once j -> i), so only the entry with `i <= j`
 //! is stored. Memory follows the number of distinct visible pairs, not n_p^2: a dense ndarray while the
-//! scene has at most [`DENSE_MAX_PATCHES`] patches, a sorted sparse list otherwise.
+//! scene has at most `DENSE_MAX_PATCHES` patches, a sorted sparse list otherwise.
 
 use ndarray::Array2;
 use rayon::prelude::*;
@@ -11,38 +11,49 @@ pub use super::sparse::{pair_key, split_key};
 use super::sparse::{Packing, SparseCounts};
 
 /// Scenes with at most this many patches keep their counts in a dense matrix (32 MiB at most).
-pub const DENSE_MAX_PATCHES: usize = 2048;
+const DENSE_MAX_PATCHES: usize = 2048;
 
-/// Symmetric pair counts, dense or sparse.
+/// Symmetric pair counts. How they are stored is theirs to decide, by the scene's size: a dense matrix
+/// while it is small, a sorted sparse list of eight-byte entries otherwise ([`SparseCounts`]).
 #[derive(Clone, Debug)]
-pub enum PairCounts {
+pub struct PairCounts(Layout);
+
+#[derive(Clone, Debug)]
+enum Layout {
     /// Upper triangle of an n_p x n_p matrix.
     Dense(Array2<u64>),
-    /// Sorted `(pair, count)` entries, eight bytes each ([`SparseCounts`]).
+    /// Sorted `(pair, count)` entries.
     Sparse(SparseCounts),
 }
 
 impl PairCounts {
-    /// Empty counts for `patches` patches, dense or sparse by size.
+    /// Empty counts for `patches` patches.
     pub fn new(patches: usize) -> Self {
-        if patches <= DENSE_MAX_PATCHES {
-            PairCounts::Dense(Array2::zeros((patches, patches)))
+        PairCounts(if patches <= DENSE_MAX_PATCHES {
+            Layout::Dense(Array2::zeros((patches, patches)))
         } else {
-            PairCounts::Sparse(SparseCounts::new(patches))
-        }
+            Layout::Sparse(SparseCounts::new(patches))
+        })
+    }
+
+    /// Whether the counts of a scene of `patches` patches come from sorting their pair keys (which is
+    /// best done for many groups at once, [`count_by_group`]), rather than from adding them up one by
+    /// one.
+    pub fn counted_by_sorting(patches: usize) -> bool {
+        patches > DENSE_MAX_PATCHES
     }
 
     /// Counts built from a list of pair keys (sorted in place).
     pub fn from_keys(patches: usize, keys: &mut [u64]) -> Self {
         let mut counts = PairCounts::new(patches);
-        match &mut counts {
-            PairCounts::Dense(m) => {
+        match &mut counts.0 {
+            Layout::Dense(m) => {
                 for &k in keys.iter() {
                     let (i, j) = split_key(k);
                     m[[i as usize, j as usize]] += 1;
                 }
             }
-            PairCounts::Sparse(list) => {
+            Layout::Sparse(list) => {
                 sort_keys(patches, keys);
                 *list = SparseCounts::from_sorted_keys(patches, keys);
             }
@@ -53,13 +64,11 @@ impl PairCounts {
     /// Counts for `patches` patches from the pair keys of several batches, in any order (integer sums do
     /// not depend on it). Sparse counts radix-sort all the keys at once.
     pub fn from_batches(patches: usize, batches: Vec<Vec<u64>>) -> Self {
-        if patches <= DENSE_MAX_PATCHES {
-            let mut counts = PairCounts::new(patches);
-            if let PairCounts::Dense(m) = &mut counts {
-                for &k in batches.iter().flatten() {
-                    let (i, j) = split_key(k);
-                    m[[i as usize, j as usize]] += 1;
-                }
+        let mut counts = PairCounts::new(patches);
+        if let Layout::Dense(m) = &mut counts.0 {
+            for &k in batches.iter().flatten() {
+                let (i, j) = split_key(k);
+                m[[i as usize, j as usize]] += 1;
             }
             return counts;
         }
@@ -69,51 +78,49 @@ impl PairCounts {
 
     /// Counts of `patches` patches from `(key, count)` entries, each key once, in any order.
     pub fn from_entries(patches: usize, entries: Vec<(u64, u64)>) -> Self {
-        match PairCounts::new(patches) {
-            PairCounts::Dense(mut m) => {
+        match PairCounts::new(patches).0 {
+            Layout::Dense(mut m) => {
                 for (k, c) in entries {
                     let (i, j) = split_key(k);
                     m[[i as usize, j as usize]] += c;
                 }
-                PairCounts::Dense(m)
+                PairCounts(Layout::Dense(m))
             }
-            PairCounts::Sparse(_) => {
-                PairCounts::Sparse(SparseCounts::from_entries(patches, entries))
+            Layout::Sparse(_) => {
+                PairCounts(Layout::Sparse(SparseCounts::from_entries(patches, entries)))
             }
         }
     }
 
     /// These counts without `part` (counts of the same scene that these include).
     pub fn without(&self, part: &PairCounts) -> PairCounts {
-        match (self, part) {
-            (PairCounts::Dense(a), PairCounts::Dense(b)) => PairCounts::Dense(a - b),
-            (PairCounts::Sparse(total), PairCounts::Sparse(part)) => {
-                PairCounts::Sparse(total.without(part))
-            }
+        PairCounts(match (&self.0, &part.0) {
+            (Layout::Dense(a), Layout::Dense(b)) => Layout::Dense(a - b),
+            (Layout::Sparse(total), Layout::Sparse(part)) => Layout::Sparse(total.without(part)),
             _ => unreachable!("counts of one scene always share a layout"),
-        }
+        })
     }
 
-    /// Adds `other` (of the same size and layout) into `self`.
+    /// Adds `other` (of the same scene) into `self`.
     pub fn merge(&mut self, other: &PairCounts) {
-        match (self, other) {
-            (PairCounts::Dense(a), PairCounts::Dense(b)) => *a += b,
-            (PairCounts::Sparse(a), PairCounts::Sparse(b)) => a.merge(b),
+        match (&mut self.0, &other.0) {
+            (Layout::Dense(a), Layout::Dense(b)) => *a += b,
+            (Layout::Sparse(a), Layout::Sparse(b)) => a.merge(b),
             _ => unreachable!("counts of one scene always share a layout"),
         }
     }
 
-    /// Visits every non-zero entry `(i, j, N_ij)` with `i <= j`.
+    /// Visits every non-zero entry `(i, j, N_ij)` with `i <= j`, in pair-key order (`i`, then `j`).
     pub fn for_each(&self, mut f: impl FnMut(u32, u32, u64)) {
-        match self {
-            PairCounts::Dense(m) => {
+        match &self.0 {
+            Layout::Dense(m) => {
                 for ((i, j), &c) in m.indexed_iter() {
                     if c > 0 {
                         f(i as u32, j as u32, c);
                     }
                 }
             }
-            PairCounts::Sparse(list) => list.for_each(f),
+            Layout::Sparse(list) => list.for_each(f),
         }
     }
 
@@ -121,44 +128,44 @@ impl PairCounts {
     /// the entry of `total`, counts of the same scene that include these (every pair here is in
     /// `total`, with at least the same count).
     pub fn for_each_with_total(&self, total: &PairCounts, mut f: impl FnMut(u32, u32, u64, u64)) {
-        match (self, total) {
-            (PairCounts::Dense(_), PairCounts::Dense(t)) => {
+        match (&self.0, &total.0) {
+            (Layout::Dense(_), Layout::Dense(t)) => {
                 self.for_each(|i, j, c| f(i, j, c, t[[i as usize, j as usize]]));
             }
-            (PairCounts::Sparse(list), PairCounts::Sparse(t)) => list.for_each_with_total(t, f),
+            (Layout::Sparse(list), Layout::Sparse(t)) => list.for_each_with_total(t, f),
             _ => unreachable!("counts of one scene always share a layout"),
         }
     }
 
-    /// The sum of counts of one scene (all dense or all sparse); `None` without any.
+    /// The sum of counts of one scene; `None` without any.
     pub fn sum_of(parts: &[&PairCounts]) -> Option<PairCounts> {
         let first = *parts.first()?;
-        if first.is_dense() {
+        if let Layout::Dense(_) = first.0 {
             let mut total = first.clone();
             parts[1..].iter().for_each(|p| total.merge(p));
             return Some(total);
         }
         let lists: Vec<&SparseCounts> = parts
             .iter()
-            .map(|p| match p {
-                PairCounts::Sparse(list) => list,
-                PairCounts::Dense(_) => unreachable!("counts of one scene always share a layout"),
+            .map(|p| match &p.0 {
+                Layout::Sparse(list) => list,
+                Layout::Dense(_) => unreachable!("counts of one scene always share a layout"),
             })
             .collect();
-        Some(PairCounts::Sparse(SparseCounts::sum_of(&lists)))
+        Some(PairCounts(Layout::Sparse(SparseCounts::sum_of(&lists))))
     }
 
     /// Number of distinct unordered pairs seen.
     pub fn distinct_pairs(&self) -> usize {
-        match self {
-            PairCounts::Dense(m) => m.iter().filter(|&&c| c > 0).count(),
-            PairCounts::Sparse(list) => list.len(),
+        match &self.0 {
+            Layout::Dense(m) => m.iter().filter(|&&c| c > 0).count(),
+            Layout::Sparse(list) => list.len(),
         }
     }
 
-    /// Whether the dense layout is in use.
+    /// Whether the dense layout is in use (for tests of both layouts).
     pub fn is_dense(&self) -> bool {
-        matches!(self, PairCounts::Dense(_))
+        matches!(self.0, Layout::Dense(_))
     }
 }
 
@@ -189,7 +196,7 @@ pub fn count_by_group(
     patches: usize,
     groups: usize,
     batches: Vec<(usize, Vec<u64>)>,
-) -> Vec<SparseCounts> {
+) -> Vec<PairCounts> {
     let layout = TagLayout::new(patches, groups);
     let keys: usize = batches.iter().map(|(_, k)| k.len()).sum();
     // Buckets of ~4096 keys on average.
@@ -286,7 +293,11 @@ pub fn count_by_group(
                 .iter()
                 .flat_map(|w| w[l].iter().copied())
                 .collect();
-            SparseCounts::from_parts(layout.packing, entries, wide)
+            PairCounts(Layout::Sparse(SparseCounts::from_parts(
+                layout.packing,
+                entries,
+                wide,
+            )))
         })
         .collect()
 }
@@ -460,6 +471,14 @@ fn radix_sort(values: &mut [u64], bits: u32, scratch: &mut Vec<u64>) {
 mod tests {
     use super::*;
 
+    /// The entries of sparse counts as stored (in their own order, not sorted here).
+    fn sparse_entries(c: &PairCounts) -> Vec<(u64, u64)> {
+        match &c.0 {
+            Layout::Sparse(list) => list.to_entries(),
+            Layout::Dense(_) => panic!("counted by sorting: sparse"),
+        }
+    }
+
     fn entries(c: &PairCounts) -> Vec<(u32, u32, u64)> {
         let mut v = Vec::new();
         c.for_each(|i, j, n| v.push((i, j, n)));
@@ -476,7 +495,7 @@ mod tests {
         let dense = PairCounts::from_keys(8, &mut keys.clone());
         let mut sorted = keys.clone();
         sorted.sort_unstable();
-        let sparse = PairCounts::Sparse(SparseCounts::from_sorted_keys(8, &sorted));
+        let sparse = PairCounts(Layout::Sparse(SparseCounts::from_sorted_keys(8, &sorted)));
         assert!(dense.is_dense() && !sparse.is_dense());
         assert_eq!(entries(&dense), vec![(0, 0, 1), (1, 3, 2), (2, 5, 3)]);
         assert_eq!(entries(&dense), entries(&sparse));
@@ -574,7 +593,6 @@ mod tests {
             })
             .collect();
         let counted = count_by_group(patches as usize, groups, batches.clone());
-        let sparse = |list: &SparseCounts| PairCounts::Sparse(list.clone());
         assert_eq!(counted.len(), groups);
         for (g, counted_g) in counted.iter().enumerate() {
             let mut keys: Vec<u64> = batches
@@ -583,16 +601,16 @@ mod tests {
                 .flat_map(|b| b.1.iter().copied())
                 .collect();
             let alone = PairCounts::from_keys(patches as usize, &mut keys);
-            assert_eq!(entries(&sparse(counted_g)), entries(&alone), "group {g}");
-            let keys = counted_g.to_entries();
+            assert_eq!(entries(counted_g), entries(&alone), "group {g}");
+            let keys = sparse_entries(counted_g);
             assert!(keys.windows(2).all(|w| w[0].0 < w[1].0));
         }
-        assert!(counted[3].is_empty());
+        assert_eq!(counted[3].distinct_pairs(), 0);
         let mut all: Vec<u64> = batches.iter().flat_map(|b| b.1.iter().copied()).collect();
         let total = PairCounts::from_keys(patches as usize, &mut all);
-        let parts: Vec<&SparseCounts> = counted.iter().collect();
+        let parts: Vec<&PairCounts> = counted.iter().collect();
         assert_eq!(
-            entries(&sparse(&SparseCounts::sum_of(&parts))),
+            entries(&PairCounts::sum_of(&parts).unwrap()),
             entries(&total)
         );
 
@@ -608,7 +626,7 @@ mod tests {
         let counted = count_by_group(3, 5, tiny.clone());
         let sum: u64 = counted
             .iter()
-            .flat_map(|g| g.to_entries())
+            .flat_map(sparse_entries)
             .map(|(_, c)| c)
             .sum();
         assert_eq!(sum, 9000);
@@ -619,11 +637,7 @@ mod tests {
                 .flat_map(|b| b.1.clone())
                 .collect();
             let alone = PairCounts::from_keys(3, &mut alone);
-            assert_eq!(
-                entries(&sparse(counted_g)),
-                entries(&alone),
-                "tiny group {g}"
-            );
+            assert_eq!(entries(counted_g), entries(&alone), "tiny group {g}");
         }
     }
 }

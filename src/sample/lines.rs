@@ -145,7 +145,8 @@ impl DiscPoints {
 /// measure), so every estimate stays unbiased; bundles make the lines of one bundle correlated, which the
 /// standard errors see because a batch always holds whole bundles (see [`LineSource::lines_per_unit`]) and
 /// the standard-error groups are made of whole batches.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
 pub enum LineSource {
     /// Every line drawn on its own ([`global_line`]).
     #[default]
@@ -157,19 +158,28 @@ pub enum LineSource {
     },
 }
 
+/// A bundle grid beyond [`MAX_BUNDLE_GRID`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, thiserror::Error)]
+#[error(
+    "a bundle grid of {grid} x {grid} lines: need 0 (independent lines) to {}",
+    MAX_BUNDLE_GRID
+)]
+pub struct BundleError {
+    /// The grid asked for.
+    pub grid: u32,
+}
+
 /// The largest bundle grid: 64 x 64 = 4096 lines, the largest batch.
 pub const MAX_BUNDLE_GRID: u32 = 64;
 
 impl LineSource {
     /// Bundles of `grid x grid` lines, or independent lines for `grid == 0`; errors beyond
     /// [`MAX_BUNDLE_GRID`].
-    pub fn bundles(grid: u32) -> Result<Self, String> {
+    pub fn bundles(grid: u32) -> Result<Self, BundleError> {
         match grid {
             0 => Ok(LineSource::Independent),
             1..=MAX_BUNDLE_GRID => Ok(LineSource::Bundles { grid }),
-            _ => Err(format!(
-                "a bundle grid of {grid} x {grid} lines: need 0 (independent lines) to {MAX_BUNDLE_GRID}"
-            )),
+            _ => Err(BundleError { grid }),
         }
     }
 

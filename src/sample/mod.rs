@@ -3,7 +3,7 @@
 //!
 //! Inside the layer, data flows: [`lines`] draws the lines; [`pairs`] (with `order`) turns a line's
 //! canonical hits into segments; [`kernel`] and [`environment`] give a segment's eq. (27) term;
-//! [`tally`] adds segments up, with f64 sums kept [`exact`]ly ([`patch_sums`] per patch, when asked);
+//! [`tally`] adds segments up, with f64 sums kept [`exact`]ly ([`kernel_sums`] per patch, when asked);
 //! [`counts`] turns pair keys into the counts N_ij, which [`sparse`] packs eight bytes a pair on large
 //! scenes.
 
@@ -11,9 +11,9 @@ pub mod counts;
 pub mod environment;
 pub mod exact;
 pub mod kernel;
+pub mod kernel_sums;
 pub mod lines;
 mod order;
 pub mod pairs;
-pub mod patch_sums;
 pub mod sparse;
 pub mod tally;

@@ -15,7 +15,7 @@
 use super::order::{self, Crossing};
 use crate::geom::{unit_vector, DVec3, Direction, Normal, Point};
 use crate::scene::Scene;
-use crate::trace::{Hit, Line};
+use crate::trace::{Hit, Line, LineHits};
 
 /// Where a segment of a line leads.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -84,6 +84,18 @@ impl From<&Line> for LineF64 {
 /// Calls `visit` for every segment of a line's canonical hit list, in order along the line.
 pub fn segments(scene: &Scene, line: &Line, hits: &[Hit], visit: impl FnMut(Segment)) {
     segments_counting_overlaps(scene, line, hits, visit);
+}
+
+/// Every segment of every line of a batch ([`segments`]), with the index of its line in the batch.
+pub fn batch_segments(
+    scene: &Scene,
+    lines: &[Line],
+    hits: &LineHits,
+    mut visit: impl FnMut(usize, Segment),
+) {
+    for (k, line) in lines.iter().enumerate() {
+        segments(scene, line, hits.of_line(k), |seg| visit(k, seg));
+    }
 }
 
 /// [`segments`], also returning how many crossings met two coplanar overlapping surfaces facing the same

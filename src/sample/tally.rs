@@ -3,14 +3,16 @@
 //! [`tally_lines`] turns one batch of traced lines into a [`BatchTally`]: its [`Counters`], the keys of
 //! its visible pairs and the patches its escapes left. Batches are added up into a [`Tally`] in batch
 //! order, so that even the f64 sums are bit-identical whatever the number of threads that traced them.
-//! The hot loop knows nothing of I/O, threads or scheduling (that is the run engine's, [`crate::run`]).
+//! The hot loop knows nothing of I/O, threads or scheduling (that is the run engine's, `run`).
 
-use super::counts::{pair_key, PairCounts};
+use rayon::prelude::*;
+
+use super::counts::{count_by_group, pair_key, PairCounts};
 use super::environment;
 use super::exact::ExactSum;
 use super::kernel::Log2Sum;
+use super::kernel_sums::PatchKernelSums;
 use super::pairs::{PatchPlanes, Segment};
-use super::patch_sums::PatchKernelSums;
 use crate::scene::Scene;
 use crate::trace::{Line, LineHits};
 
@@ -289,9 +291,52 @@ impl Tally {
         tally
     }
 
+    /// The tallies of groups of batches (`None` for a group without batches). Small scenes count each
+    /// group on its own; the pair keys of large ones are counted in one sort of every group's keys
+    /// ([`count_by_group`]), which frees them as it deals them.
+    pub fn of_groups(
+        scene: &Scene,
+        wanted: Wanted,
+        groups: Vec<Vec<BatchTally>>,
+    ) -> Vec<Option<Tally>> {
+        let patches = scene.patch_count();
+        if !wanted.discrete || !PairCounts::counted_by_sorting(patches) {
+            return groups
+                .into_par_iter()
+                .map(|piece| (!piece.is_empty()).then(|| Tally::from_batches(scene, wanted, piece)))
+                .collect();
+        }
+        // The counters (and per-patch sums) first, then the keys are counted.
+        type GroupKeys = Vec<(usize, Vec<u64>)>;
+        let (sums, keyed): (Vec<Option<Tally>>, Vec<GroupKeys>) = groups
+            .into_par_iter()
+            .enumerate()
+            .map(|(g, piece)| {
+                if piece.is_empty() {
+                    return (None, Vec::new());
+                }
+                let (tally, keys) = Tally::sum_batches(scene, wanted, piece);
+                (Some(tally), keys.into_iter().map(|k| (g, k)).collect())
+            })
+            .unzip();
+        // Moved, not cloned (`concat` would copy every batch's keys).
+        let count = sums.len();
+        let keyed: GroupKeys = keyed.into_iter().flatten().collect();
+        let counted = count_by_group(patches, count, keyed);
+        sums.into_iter()
+            .zip(counted)
+            .map(|(tally, counts)| {
+                tally.map(|mut tally| {
+                    tally.counts = Some(counts);
+                    tally
+                })
+            })
+            .collect()
+    }
+
     /// Everything but the pair counts, added up in batch order; and the batches' pair keys, for the
     /// caller to count.
-    pub fn sum_batches(
+    fn sum_batches(
         scene: &Scene,
         wanted: Wanted,
         batches: Vec<BatchTally>,

@@ -8,7 +8,7 @@
 //! neighbours and 1/128 to the walls), and every line crossing the room meets a handful of them.
 //! The positions come from PCG-64 with a fixed seed: the scene is the same on every machine and version.
 //!
-//! 6 + 512 * 6 = 3078 patches (more than [`crate::sample::counts::DENSE_MAX_PATCHES`], so its pair counts
+//! 6 + 512 * 6 = 3078 patches (more than the 2048 patches whose counts are dense, so its pair counts
 //! use the sparse layout), 6156 triangles.
 
 use rand_pcg::Pcg64;

@@ -110,8 +110,9 @@ impl LineHits {
     }
 }
 
-/// Which kind of Embree query drives a batch of lines.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+/// Which kind of Embree query drives a batch of lines (saved as its name, `single`, `packet8`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(into = "String", try_from = "String")]
 pub enum Query {
     /// One line per query (`rtcIntersect1`).
     Single,
@@ -121,18 +122,35 @@ pub enum Query {
 
 impl Query {
     /// Parses a query as [`Query`]'s `Display` writes it (`single`, `packet4`, `packet8`, `packet16`).
-    pub fn parse(s: &str) -> Result<Query, String> {
+    pub fn parse(s: &str) -> Result<Query, QueryError> {
         match s {
             "single" => Ok(Query::Single),
             "packet4" => Ok(Query::Packet(4)),
             "packet8" => Ok(Query::Packet(8)),
             "packet16" => Ok(Query::Packet(16)),
-            _ => Err(format!(
-                "`{s}`: expected single, packet4, packet8 or packet16"
-            )),
+            _ => Err(QueryError(s.into())),
         }
     }
 }
+
+impl From<Query> for String {
+    fn from(q: Query) -> String {
+        q.to_string()
+    }
+}
+
+impl TryFrom<String> for Query {
+    type Error = QueryError;
+
+    fn try_from(s: String) -> Result<Query, QueryError> {
+        Query::parse(&s)
+    }
+}
+
+/// A ray query's name that is not one ([`Query::parse`]).
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("`{0}`: expected single, packet4, packet8 or packet16")]
+pub struct QueryError(pub String);
 
 impl fmt::Display for Query {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
@@ -201,7 +219,8 @@ pub trait Tracer: Send + Sync {
 }
 
 /// The tracing backends a user can choose.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
 pub enum Backend {
     /// Embree (needs the `embree` feature).
     Embree,
@@ -210,9 +229,17 @@ pub enum Backend {
 }
 
 impl Backend {
+    /// The name on the command line and in reports (`embree`, `rust`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Backend::Embree => "embree",
+            Backend::Rust => "rust",
+        }
+    }
+
     /// The backend used when none is named: the pure-Rust tracer, in every build. Its hits are
     /// Embree's to the bit (`scx crosscheck`) and it is the faster of the two end to end on every scene
-    /// size measured (README, "Packets, bundles and throughput"); Embree stays one flag away.
+    /// size measured (docs/performance.md, "The two tracers: throughput and packets"); Embree stays one flag away.
     pub fn default_available() -> Self {
         Backend::Rust
     }

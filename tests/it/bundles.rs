@@ -4,13 +4,15 @@
 //! for a scene with sparse pair counts.
 
 use crate::support;
-use scene_complexity::scenes;
+use scene_complexity::internals::measure::Measure;
+use scene_complexity::internals::scenes;
 
-use scene_complexity::run::{analyze, Analysis, AnalysisConfig, RunControl};
-use scene_complexity::run::{BatchPlan, Measures};
-use scene_complexity::sample::lines::LineSource;
-use scene_complexity::scene::Scene;
-use scene_complexity::trace::{make_tracer, Backend, LineHits, Query, Tracer};
+use scene_complexity::internals::analysis::{analyze, Analysis};
+use scene_complexity::internals::run::{BatchPlan, Measures};
+use scene_complexity::internals::run::{RunControl, RunSpec};
+use scene_complexity::internals::sample::lines::LineSource;
+use scene_complexity::internals::scene::Scene;
+use scene_complexity::internals::trace::{make_tracer, Backend, LineHits, Query, Tracer};
 use support::{count_entries, ff_parallel_rectangles, ff_perpendicular_rectangles};
 
 const ALL: Measures = Measures::VISIBILITY;
@@ -20,10 +22,10 @@ fn rust_tracer(scene: &Scene) -> Box<dyn Tracer> {
 }
 
 fn run(scene: &Scene, tracer: &dyn Tracer, lines: u64, seed: u64, grid: u32) -> Analysis {
-    let cfg = AnalysisConfig {
+    let cfg = RunSpec {
         measures: ALL,
         source: LineSource::bundles(grid).unwrap(),
-        ..AnalysisConfig::new(lines, seed)
+        ..RunSpec::new(lines, seed)
     };
     analyze(scene, tracer, &cfg, &RunControl::default()).unwrap()
 }
@@ -75,7 +77,7 @@ fn unit_cube_mutual_information_matches_closed_form_with_bundles() {
     let exact_is = f_par * (6.0 * f_par).log2() + 4.0 * f_perp * (6.0 * f_perp).log2();
     for grid in [4, 16] {
         let a = run(&scene, tracer.as_ref(), 200_000, 3, grid);
-        let is = a.visibility.mutual_information.unwrap();
+        let is = a.estimate(Measure::MutualInformation).unwrap();
         let se = is.stderr.unwrap();
         assert!(
             (is.value - exact_is).abs() < 4.5 * se + 1e-4,
@@ -114,7 +116,7 @@ fn standard_errors_match_the_spread_between_runs() {
     let runs: Vec<(f64, f64)> = (0..24)
         .map(|seed| {
             let a = run(&scene, tracer.as_ref(), 1 << 15, 100 + seed, 16);
-            let e = a.visibility.continuous_mutual_information.unwrap();
+            let e = a.estimate(Measure::ContinuousMutualInformation).unwrap();
             (e.value, e.stderr.unwrap())
         })
         .collect();
@@ -155,11 +157,10 @@ fn results_do_not_depend_on_the_thread_count() {
             two.tally.counters.cmi_sum.value().to_bits()
         );
         let bits = |a: &Analysis| {
-            let v = &a.visibility;
             [
-                v.mutual_information,
-                v.continuous_mutual_information,
-                v.entropy,
+                a.estimate(Measure::MutualInformation),
+                a.estimate(Measure::ContinuousMutualInformation),
+                a.estimate(Measure::Entropy),
             ]
             .map(|e| e.map(|e| (e.value.to_bits(), e.stderr.map(f64::to_bits))))
         };

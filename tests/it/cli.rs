@@ -305,8 +305,8 @@ fn convergence_writes_a_table_a_csv_and_a_plot() {
 }
 
 /// With bundles the table says that the bias corrections assume independent lines (8 x 8 bundles moved
-/// the corrected I_s of `@cube:30` by 7.7 standard errors over 200 seeds: README, Bundles); without
-/// bundles, or without corrected values, it does not.
+/// the corrected I_s of `@cube:30` by 7.7 standard errors over 200 seeds: docs/performance.md, Bundles);
+/// without bundles, or without corrected values, it does not.
 #[test]
 fn bundled_runs_warn_that_the_corrections_assume_independent_lines() {
     let table = |extra: &[&str]| {

@@ -4,7 +4,7 @@
 //! the scene's own.
 
 use crate::support::{area_form_factor, scx, AxisRect};
-use scene_complexity::scenes;
+use scene_complexity::internals::scenes;
 
 /// Reads a CSV without quoted fields (the numeric files) into its header and rows.
 fn read_csv(path: &std::path::Path) -> (Vec<String>, Vec<Vec<String>>) {

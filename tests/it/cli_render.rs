@@ -2,7 +2,7 @@
 //! coloured face per patch whose corners are the patch's, and bad requests fail before any line is cast.
 
 use crate::support::scx;
-use scene_complexity::scenes;
+use scene_complexity::internals::scenes;
 
 /// A careful ASCII PLY reader for the files `scx render` writes: the header's elements and properties,
 /// then the vertices `(x, y, z, r, g, b)` and the faces `(indices, r, g, b, value)`.

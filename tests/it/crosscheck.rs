@@ -3,16 +3,16 @@
 //! exactly the lines it spoils, by the right kind; the `scx crosscheck` command exits accordingly.
 
 use crate::support;
-use scene_complexity::scenes;
+use scene_complexity::internals::scenes;
 #[cfg(feature = "cli")]
 use support::scx;
 
 use scene_complexity::crosscheck::{
     compare_hits, crosscheck, CrossCheckConfig, DifferenceKind, Tolerance,
 };
-use scene_complexity::scene::Scene;
-use scene_complexity::trace::rust::{BruteForceTracer, BvhTracer};
-use scene_complexity::trace::{HitRules, Line, RawHit, TraceError, Tracer};
+use scene_complexity::internals::scene::Scene;
+use scene_complexity::internals::trace::rust::{BruteForceTracer, BvhTracer};
+use scene_complexity::internals::trace::{HitRules, Line, RawHit, TraceError, Tracer};
 
 fn config(lines: u64) -> CrossCheckConfig {
     CrossCheckConfig {
@@ -73,7 +73,7 @@ fn planted_faults_are_found_on_their_lines_and_by_kind() {
     assert_eq!(c.lines, lines);
     assert!(!c.agrees());
     // 2000 lines are at most a few batches; each batch holds lines 3, 5 and 7 of its own.
-    let batches = scene_complexity::run::BatchPlan::new(lines).batches();
+    let batches = scene_complexity::internals::run::BatchPlan::new(lines).batches();
     // A line that misses the cube (about 1 in 4 within the unit sphere) has nothing to spoil.
     let [count, patch, distance] = c.differing;
     assert!(count <= batches && patch <= batches && distance <= batches);
@@ -99,7 +99,7 @@ struct BatchPlanSize;
 
 impl BatchPlanSize {
     fn of(lines: u64) -> u64 {
-        scene_complexity::run::BatchPlan::new(lines).batch_size
+        scene_complexity::internals::run::BatchPlan::new(lines).batch_size
     }
 }
 
@@ -127,7 +127,7 @@ fn the_bvh_and_brute_force_agree_line_for_line() {
 #[cfg(feature = "embree")]
 #[test]
 fn embree_and_the_rust_bvh_agree_on_small_scenes() {
-    use scene_complexity::trace::{make_tracer, Backend, Query};
+    use scene_complexity::internals::trace::{make_tracer, Backend, Query};
     let dir = tempfile::tempdir().unwrap();
     let room = dir.path().join("room.obj");
     std::fs::write(&room, support::room_with_box_obj(1.0)).unwrap();
@@ -191,7 +191,7 @@ fn bad_arguments_are_clear_errors() {
 
 use scene_complexity::crosscheck::aimed::{Aim, AimKind, AimTargets, GRAZING_ANGLES};
 use scene_complexity::crosscheck::{compare_aimed, AimedCheck, AimedConfig};
-use scene_complexity::geom::DVec3;
+use scene_complexity::internals::geom::DVec3;
 
 fn aimed_config(lines_per_kind: u64) -> AimedConfig {
     AimedConfig {
@@ -446,7 +446,7 @@ fn a_tracer_wrong_only_at_vertices_passes_random_lines_and_fails_aimed_ones() {
 #[cfg(feature = "embree")]
 #[test]
 fn embree_and_the_rust_bvh_agree_on_aimed_lines_of_built_in_scenes() {
-    use scene_complexity::trace::{make_tracer, Backend, Query};
+    use scene_complexity::internals::trace::{make_tracer, Backend, Query};
     for spec in [
         "@cube:4",
         "@sphere:3",
@@ -479,7 +479,7 @@ fn embree_and_the_rust_bvh_agree_on_aimed_lines_of_built_in_scenes() {
 #[cfg(feature = "embree")]
 #[test]
 fn embree_and_the_rust_bvh_agree_on_aimed_lines_of_real_scenes() {
-    use scene_complexity::trace::{make_tracer, Backend, Query};
+    use scene_complexity::internals::trace::{make_tracer, Backend, Query};
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/real-scenes");
     let Ok(folders) = std::fs::read_dir(&root) else {
         eprintln!("skipped: {} is not there", root.display());
@@ -575,8 +575,8 @@ fn the_command_casts_aimed_lines_and_reports_each_kind() {
 /// operations. The report's `stray` column counts these hits.
 #[test]
 fn stray_hits_lie_on_lines_through_their_triangle() {
-    use scene_complexity::trace::rust::bvh::margin;
-    use scene_complexity::trace::LineHits;
+    use scene_complexity::internals::trace::rust::bvh::margin;
+    use scene_complexity::internals::trace::LineHits;
     for spec in ["@cornell", "@dodecahedron:3"] {
         let scene = scenes::load(spec).unwrap();
         let targets = AimTargets::new(&scene);
@@ -627,7 +627,7 @@ fn stray_hits_lie_on_lines_through_their_triangle() {
 /// line, from the line's point to the projected triangle.
 fn line_triangle_distance(o: DVec3, d: DVec3, tri: [DVec3; 3]) -> f64 {
     let d = d / d.length();
-    let (u, w) = scene_complexity::geom::orthonormal_basis(d);
+    let (u, w) = scene_complexity::internals::geom::orthonormal_basis(d);
     let proj = |p: DVec3| {
         let v = p - o;
         (v.dot(u), v.dot(w))

@@ -7,11 +7,11 @@ use std::sync::Arc;
 
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
-use scene_complexity::scene::Scene;
-use scene_complexity::scenes::solids;
-use scene_complexity::trace::embree::{header_version, layout_checks, EmbreeTracer};
-use scene_complexity::trace::rust::BruteForceTracer;
-use scene_complexity::trace::{Hit, Line, LineHits, Query, RawHit, TraceError, Tracer};
+use scene_complexity::internals::scene::Scene;
+use scene_complexity::internals::scenes::solids;
+use scene_complexity::internals::trace::embree::{header_version, layout_checks, EmbreeTracer};
+use scene_complexity::internals::trace::rust::BruteForceTracer;
+use scene_complexity::internals::trace::{Hit, Line, LineHits, Query, RawHit, TraceError, Tracer};
 
 /// Half the side of the cube in tracing space: the unit cube scaled so that its half-diagonal is 1.
 const H: f64 = 0.577_350_269_189_625_8; // 1 / sqrt(3)

@@ -2,12 +2,14 @@
 //! the bias-corrected I_s is closer to the exact value than the plug-in.
 
 use crate::support;
-use scene_complexity::scenes;
+use scene_complexity::internals::measure::Measure;
+use scene_complexity::internals::scenes;
 
-use scene_complexity::measure::Estimate;
-use scene_complexity::run::{analyze, Analysis, AnalysisConfig, RunControl};
-use scene_complexity::scene::Scene;
-use scene_complexity::trace::Tracer;
+use scene_complexity::internals::analysis::{analyze, Analysis};
+use scene_complexity::internals::measure::Estimate;
+use scene_complexity::internals::run::{RunControl, RunSpec};
+use scene_complexity::internals::scene::Scene;
+use scene_complexity::internals::trace::Tracer;
 use support::{all_tracers, cube_exact_measures};
 
 fn fastest_tracer(scene: &Scene) -> Box<dyn Tracer> {
@@ -18,14 +20,14 @@ fn run(scene: &Scene, tracer: &dyn Tracer, lines: u64, seed: u64) -> Analysis {
     analyze(
         scene,
         tracer,
-        &AnalysisConfig::new(lines, seed),
+        &RunSpec::new(lines, seed),
         &RunControl::default(),
     )
     .unwrap()
 }
 
 fn cmi(a: &Analysis) -> Estimate {
-    a.visibility.continuous_mutual_information.unwrap()
+    a.estimate(Measure::ContinuousMutualInformation).unwrap()
 }
 
 #[test]
@@ -87,8 +89,11 @@ fn corrected_mutual_information_beats_the_plug_in_on_a_small_cube() {
     let scene = scenes::load("@cube:4").unwrap();
     let tracer = fastest_tracer(&scene);
     let a = run(&scene, tracer.as_ref(), 100_000, 7);
-    let plug = a.visibility.mutual_information.unwrap().value;
-    let corrected = a.visibility.mutual_information_corrected.unwrap().value;
+    let plug = a.estimate(Measure::MutualInformation).unwrap().value;
+    let corrected = a
+        .estimate(Measure::MutualInformationCorrected)
+        .unwrap()
+        .value;
     assert!(
         (corrected - exact).abs() < (plug - exact).abs(),
         "exact {exact}: corrected {corrected} vs plug-in {plug}"

@@ -4,36 +4,36 @@
 //! figs. 5/6 are the best discretised (Tables 6, 7); constant radiosity leaves the measures unchanged
 //! (fig. 9, Table 8).
 
-use scene_complexity::geom::DVec3;
-use scene_complexity::run::{
-    analyze, Analysis, AnalysisConfig, Measures, RadiosityOutcome, RunControl,
-};
-use scene_complexity::scene::Scene;
-use scene_complexity::scenes;
-use scene_complexity::scenes::cube_clusters::{fig2_corners, Fig2Placement};
-use scene_complexity::scenes::cube_lattice::fig56_corners;
-use scene_complexity::trace::{make_tracer, Backend, Query};
+use scene_complexity::internals::analysis::{analyze, Analysis, RadiosityOutcome};
+use scene_complexity::internals::geom::DVec3;
+use scene_complexity::internals::measure::Measure;
+use scene_complexity::internals::run::{Measures, RunControl, RunSpec};
+use scene_complexity::internals::scene::Scene;
+use scene_complexity::internals::scenes;
+use scene_complexity::internals::scenes::cube_clusters::{fig2_corners, Fig2Placement};
+use scene_complexity::internals::scenes::cube_lattice::fig56_corners;
+use scene_complexity::internals::trace::{make_tracer, Backend, Query};
 
 /// An analysis with the pure-Rust tracer; 2 groups, since these tests compare values, not errors (every
 /// group's own measures cost as much as the run's on scenes of ~2000 patches).
 fn run(spec: &str, lines: u64, discrete: bool) -> Analysis {
     let scene = scenes::load(spec).unwrap();
     let tracer = make_tracer(Backend::Rust, &scene, Query::Single).unwrap();
-    let cfg = AnalysisConfig {
+    let cfg = RunSpec {
         measures: Measures {
             discrete,
             continuous: true,
             radiosity: false,
         },
         groups: 2,
-        ..AnalysisConfig::new(lines, 7)
+        ..RunSpec::new(lines, 7)
     };
     let a = analyze(&scene, tracer.as_ref(), &cfg, &RunControl::default()).unwrap();
     assert_eq!(a.escapes, 0, "{spec}: a closed scene");
     a
 }
 
-fn value(e: Option<scene_complexity::measure::Estimate>) -> f64 {
+fn value(e: Option<scene_complexity::internals::measure::Estimate>) -> f64 {
     e.expect("computed").value
 }
 
@@ -95,17 +95,17 @@ fn fig2_has_table_1s_positional_entropy_and_no_touching_cubes() {
 /// have lower H_s and higher I_s than the random one (a), for the plug-in and the corrected estimates.
 #[test]
 fn clustering_lowers_entropy_and_raises_mutual_information() {
-    let [a, b, c] = ["a", "b", "c"].map(|v| run(&format!("@fig2:{v}"), 200_000, true).visibility);
+    let [a, b, c] = ["a", "b", "c"].map(|v| run(&format!("@fig2:{v}"), 200_000, true));
     for (name, h, i) in [
         (
             "plug-in",
-            [&a, &b, &c].map(|v| value(v.entropy)),
-            [&a, &b, &c].map(|v| value(v.mutual_information)),
+            [&a, &b, &c].map(|v| value(v.estimate(Measure::Entropy))),
+            [&a, &b, &c].map(|v| value(v.estimate(Measure::MutualInformation))),
         ),
         (
             "corrected",
-            [&a, &b, &c].map(|v| value(v.entropy_corrected)),
-            [&a, &b, &c].map(|v| value(v.mutual_information_corrected)),
+            [&a, &b, &c].map(|v| value(v.estimate(Measure::EntropyCorrected))),
+            [&a, &b, &c].map(|v| value(v.estimate(Measure::MutualInformationCorrected))),
         ),
     ] {
         assert!(h[1] < h[0] && h[2] < h[0], "{name} H_s a/b/c {h:?}");
@@ -126,13 +126,7 @@ fn continuous_mutual_information_ranks_the_regular_solids() {
     ];
     let isc: Vec<f64> = order
         .iter()
-        .map(|s| {
-            value(
-                run(s, 100_000, false)
-                    .visibility
-                    .continuous_mutual_information,
-            )
-        })
+        .map(|s| value(run(s, 100_000, false).estimate(Measure::ContinuousMutualInformation)))
         .collect();
     assert!(isc.windows(2).all(|w| w[0] < w[1]), "I_s^c {isc:?}");
 }
@@ -145,7 +139,7 @@ fn objects_and_objects_near_the_walls_raise_continuous_mutual_information() {
         .chars()
         .map(|v| {
             let a = run(&format!("@fig4:{v}"), 200_000, false);
-            value(a.visibility.continuous_mutual_information)
+            value(a.estimate(Measure::ContinuousMutualInformation))
         })
         .collect();
     assert!(isc[0] < isc[1] && isc[1] < isc[2], "a/b/c {isc:?}");
@@ -192,8 +186,7 @@ fn middle_stages_are_discretised_most_accurately() {
             .map(|s| {
                 value(
                     run(&format!("@fig{fig}:{s}"), 500_000, true)
-                        .visibility
-                        .accuracy_corrected,
+                        .estimate(Measure::AccuracyCorrected),
                 )
             })
             .collect();
@@ -238,24 +231,34 @@ fn labyrinth_radiosity_measures_equal_visibility_measures() {
         );
     }
     let tracer = make_tracer(Backend::Rust, &s, Query::Single).unwrap();
-    let cfg = AnalysisConfig::new(100_000, 3);
+    let cfg = RunSpec::new(100_000, 3);
     let a = analyze(&s, tracer.as_ref(), &cfg, &RunControl::default()).unwrap();
     let r = a.radiosity.clone();
-    let RadiosityOutcome::Computed(r) = r else {
+    let RadiosityOutcome::Computed(_) = r else {
         panic!("the labyrinth emits");
     };
-    let v = &a.visibility;
-    assert!((value(v.positional_entropy) - 1634f64.log2()).abs() < 1e-9);
+    let v = |m| a.estimate(m);
+    assert!((value(v(Measure::PositionalEntropy)) - 1634f64.log2()).abs() < 1e-9);
     for (vis, rad) in [
-        (v.positional_entropy, r.positional_entropy),
-        (v.entropy, r.entropy),
-        (v.mutual_information, r.mutual_information),
-        (v.entropy_corrected, r.entropy_corrected),
         (
-            v.mutual_information_corrected,
-            r.mutual_information_corrected,
+            Measure::PositionalEntropy,
+            Measure::RadiosityPositionalEntropy,
+        ),
+        (Measure::Entropy, Measure::RadiosityEntropy),
+        (
+            Measure::MutualInformation,
+            Measure::RadiosityMutualInformation,
+        ),
+        (
+            Measure::EntropyCorrected,
+            Measure::RadiosityEntropyCorrected,
+        ),
+        (
+            Measure::MutualInformationCorrected,
+            Measure::RadiosityMutualInformationCorrected,
         ),
     ] {
-        assert!((value(vis) - rad.value).abs() < 1e-8, "{vis:?} vs {rad:?}");
+        let (vis, rad) = (v(vis), v(rad));
+        assert!((value(vis) - value(rad)).abs() < 1e-8, "{vis:?} vs {rad:?}");
     }
 }

@@ -20,7 +20,8 @@ const LAYERS: &[(&str, &[&str])] = &[
     ("trace", &["trace"]),
     ("sample", &["sample"]),
     ("measure", &["measure"]),
-    ("run", &["run", "analysis", "radiosity"]),
+    ("run", &["run"]),
+    ("analysis", &["analysis"]),
     (
         "applications",
         &["reproduce", "refine", "crosscheck", "render"],

@@ -2,13 +2,13 @@
 //! through edges and vertices of a closed mesh, and Crofton's formula for the uniformity of the lines.
 
 use crate::support;
-use scene_complexity::scenes;
+use scene_complexity::internals::scenes;
 
 use rand::{Rng, SeedableRng};
-use scene_complexity::sample::lines::batch_lines;
-use scene_complexity::sample::pairs::{segments, Segment};
-use scene_complexity::scene::Scene;
-use scene_complexity::trace::{Line, LineHits, Tracer};
+use scene_complexity::internals::sample::lines::batch_lines;
+use scene_complexity::internals::sample::pairs::{segments, Segment};
+use scene_complexity::internals::scene::Scene;
+use scene_complexity::internals::trace::{Line, LineHits, Tracer};
 use support::all_tracers;
 
 fn trace(tracer: &dyn Tracer, lines: &[Line]) -> LineHits {
@@ -124,7 +124,8 @@ fn lines_through_edges_and_vertices_have_even_parity() {
                 .map(f64::from);
             [0, 1, 2].map(|a| 0.5 * (v[a] + w[a]))
         };
-        let d = scene_complexity::geom::uniform_direction(rng.gen(), rng.gen()).to_array();
+        let d =
+            scene_complexity::internals::geom::uniform_direction(rng.gen(), rng.gen()).to_array();
         lines.push(Line {
             origin: [0, 1, 2].map(|a| (through[a] - 2.0 * d[a]) as f32),
             dir: d.map(|c| c as f32),
@@ -209,7 +210,7 @@ fn hits_per_patch_follow_crofton() {
 /// themselves, to the bit, line by line.
 #[test]
 fn the_plane_table_pairs_every_line_as_the_patch_records_do() {
-    use scene_complexity::sample::pairs::{segments_and_ends, PatchPlanes};
+    use scene_complexity::internals::sample::pairs::{segments_and_ends, PatchPlanes};
     for name in ["@cube:60", "@sphere:5", "@cornell"] {
         let scene = scenes::load(name).unwrap();
         let planes = PatchPlanes::of(&scene);

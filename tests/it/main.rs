@@ -42,6 +42,9 @@ mod runs;
 // The source's structure.
 mod layers;
 
+// The README's and the guide's links (docs/).
+mod docs;
+
 // The system-package setup script (`.ci/setup`), a bash script.
 #[cfg(unix)]
 mod setup;

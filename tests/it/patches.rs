@@ -1,11 +1,13 @@
 //! The per-patch results against invariants: the per-patch terms add up to the scene's measures, and
 //! the radiosity columns solve eq. (2). (`cli_patches` checks the files `scx analyze` writes.)
 
-use scene_complexity::measure::patches::information_loss;
+use scene_complexity::internals::analysis::{analyze, Analysis};
+use scene_complexity::internals::measure::shares::information_loss;
+use scene_complexity::internals::measure::{Measure, PatchMeasure};
+use scene_complexity::internals::run::{RunControl, RunSpec};
+use scene_complexity::internals::scenes;
+use scene_complexity::internals::trace::{make_tracer, Backend, Query};
 use scene_complexity::refine::oracle;
-use scene_complexity::run::{analyze, Analysis, AnalysisConfig, RunControl};
-use scene_complexity::scenes;
-use scene_complexity::trace::{make_tracer, Backend, Query};
 use scene_complexity::EntropyEstimator;
 
 fn run_with_patches(
@@ -15,10 +17,10 @@ fn run_with_patches(
 ) -> (scene_complexity::Scene, Analysis) {
     let scene = scenes::load(spec).unwrap();
     let tracer = make_tracer(Backend::Rust, &scene, Query::Single).unwrap();
-    let cfg = AnalysisConfig {
+    let cfg = RunSpec {
         per_patch: true,
         estimator,
-        ..AnalysisConfig::new(lines, 7)
+        ..RunSpec::new(lines, 7)
     };
     let a = analyze(&scene, tracer.as_ref(), &cfg, &RunControl::default()).unwrap();
     (scene, a)
@@ -42,41 +44,50 @@ fn per_patch_terms_add_up_to_the_scene_measures() {
         let (scene, a) = run_with_patches(spec, lines, estimator);
         let p = a.patches.as_ref().expect("asked for");
         assert_eq!(p.len(), scene.patch_count());
-        let v = &a.visibility;
         let total_area = scene.total_area();
         let a_i = |i: usize| scene.patches[i].area / total_area;
         let sum = |f: &dyn Fn(usize) -> f64| (0..p.len()).map(f).sum::<f64>();
         let checks = [
             (
                 "H_s",
-                sum(&|i| a_i(i) * p[i].row_entropy.value),
-                v.entropy.unwrap().value,
+                sum(&|i| a_i(i) * p[i].get(PatchMeasure::RowEntropy).unwrap().value),
+                a.estimate(Measure::Entropy).unwrap().value,
             ),
             (
                 "H_s corrected",
-                sum(&|i| a_i(i) * p[i].row_entropy_corrected.value),
-                v.entropy_corrected.unwrap().value,
+                sum(&|i| a_i(i) * p[i].get(PatchMeasure::RowEntropyCorrected).unwrap().value),
+                a.estimate(Measure::EntropyCorrected).unwrap().value,
             ),
             (
                 "I_s",
-                sum(&|i| p[i].mutual_information_term.value),
-                v.mutual_information.unwrap().value,
+                sum(&|i| p[i].get(PatchMeasure::MutualInformationTerm).unwrap().value),
+                a.estimate(Measure::MutualInformation).unwrap().value,
             ),
             (
                 "I_s corrected",
-                sum(&|i| p[i].mutual_information_term_corrected.value),
-                v.mutual_information_corrected.unwrap().value,
+                sum(&|i| {
+                    p[i].get(PatchMeasure::MutualInformationTermCorrected)
+                        .unwrap()
+                        .value
+                }),
+                a.estimate(Measure::MutualInformationCorrected)
+                    .unwrap()
+                    .value,
             ),
             (
                 "I_s^c",
-                sum(&|i| p[i].continuous_term.unwrap().value),
-                v.continuous_mutual_information.unwrap().value,
+                sum(&|i| p[i].get(PatchMeasure::ContinuousTerm).unwrap().value),
+                a.estimate(Measure::ContinuousMutualInformation)
+                    .unwrap()
+                    .value,
             ),
             (
                 "I_s^c - I_s",
-                sum(&|i| p[i].lost_information.unwrap().value),
-                v.continuous_mutual_information.unwrap().value
-                    - v.mutual_information.unwrap().value,
+                sum(&|i| p[i].get(PatchMeasure::LostInformation).unwrap().value),
+                a.estimate(Measure::ContinuousMutualInformation)
+                    .unwrap()
+                    .value
+                    - a.estimate(Measure::MutualInformation).unwrap().value,
             ),
         ];
         for (name, parts, whole) in checks {
@@ -88,9 +99,9 @@ fn per_patch_terms_add_up_to_the_scene_measures() {
         // Every value with a standard error, no NaN from an unsampled patch.
         for (i, e) in p.iter().enumerate() {
             for x in [
-                e.row_entropy,
-                e.mutual_information_term,
-                e.continuous_term.unwrap(),
+                e.get(PatchMeasure::RowEntropy).unwrap(),
+                e.get(PatchMeasure::MutualInformationTerm).unwrap(),
+                e.get(PatchMeasure::ContinuousTerm).unwrap(),
             ] {
                 assert!(
                     x.value.is_finite() && x.stderr.is_some_and(f64::is_finite),
@@ -98,7 +109,7 @@ fn per_patch_terms_add_up_to_the_scene_measures() {
                 );
             }
             assert_eq!(
-                e.radiosity.is_some(),
+                e.get(PatchMeasure::Radiosity).is_some(),
                 spec == "@cornell" || spec == "@cornell-open"
             );
         }
@@ -117,7 +128,10 @@ fn per_patch_radiosities_solve_the_radiosity_equation() {
     let (scene, a) = run_with_patches("@cornell", 300_000, EntropyEstimator::ChaoWangJost);
     for (i, e) in a.patches.as_ref().unwrap().iter().enumerate() {
         let m = &scene.materials[scene.patches[i].material as usize];
-        let (b, b_in) = (e.radiosity.unwrap(), e.incoming_radiosity.unwrap());
+        let (b, b_in) = (
+            e.get(PatchMeasure::Radiosity).unwrap(),
+            e.get(PatchMeasure::IncomingRadiosity).unwrap(),
+        );
         let residual = b.value - m.emission - m.reflectance * b_in.value;
         assert!(
             residual.abs() <= 1e-8 * m.emission.max(b.value),
@@ -135,7 +149,7 @@ fn refines_information_scores_are_the_tables_lost_information() {
     let (lines, seed) = (300_000, 7);
     for spec in ["@cube:4", "@cornell:2"] {
         let (scene, a) = run_with_patches(spec, lines, EntropyEstimator::PlugIn);
-        assert_eq!(a.seed, seed);
+        assert_eq!(a.spec.seed, seed);
         let tracer = make_tracer(Backend::Rust, &scene, Query::Single).unwrap();
         let sample = oracle::sample_pairs(&scene, tracer.as_ref(), lines, seed).unwrap();
         let areas: Vec<f64> = scene.patches.iter().map(|p| p.area).collect();
@@ -145,7 +159,7 @@ fn refines_information_scores_are_the_tables_lost_information() {
         let delta: Vec<f64> = (0..p.len())
             .map(|i| {
                 let a_i = areas[i] / total;
-                (p[i].lost_information.unwrap().value - scores[i] / total) / a_i
+                (p[i].get(PatchMeasure::LostInformation).unwrap().value - scores[i] / total) / a_i
             })
             .collect();
         for d in &delta {
@@ -161,9 +175,9 @@ fn refines_information_scores_are_the_tables_lost_information() {
 fn per_patch_results_do_not_depend_on_the_threads() {
     let scene = scenes::load("@cube:30").unwrap();
     let tracer = make_tracer(Backend::Rust, &scene, Query::Single).unwrap();
-    let cfg = AnalysisConfig {
+    let cfg = RunSpec {
         per_patch: true,
-        ..AnalysisConfig::new(60_000, 3)
+        ..RunSpec::new(60_000, 3)
     };
     let run = |threads: usize| {
         let pool = rayon::ThreadPoolBuilder::new()

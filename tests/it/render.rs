@@ -2,11 +2,11 @@
 //! (every sample sees the front of a wall) and outside an object (background around it, no back side
 //! seen); a camera behind a wall sees its back side.
 
-use scene_complexity::geom::{Point, Vector};
+use scene_complexity::internals::geom::{Point, Vector};
+use scene_complexity::internals::scene::{obj, Scene};
+use scene_complexity::internals::scenes;
+use scene_complexity::internals::trace::{make_tracer, Backend, Query};
 use scene_complexity::render::{default_camera, trace_view, Camera, Sample};
-use scene_complexity::scene::{obj, Scene};
-use scene_complexity::scenes;
-use scene_complexity::trace::{make_tracer, Backend, Query};
 
 fn samples(scene: &Scene, camera: Option<Camera>) -> Vec<Sample> {
     let tracer = make_tracer(Backend::Rust, scene, Query::Single).unwrap();

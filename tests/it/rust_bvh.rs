@@ -4,15 +4,17 @@
 //! first hits equal to the first of the reference's hit lists.
 
 use crate::support;
-use scene_complexity::scenes;
+use scene_complexity::internals::scenes;
 
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
-use scene_complexity::geom::uniform_direction;
-use scene_complexity::sample::lines::batch_lines;
-use scene_complexity::scene::Scene;
-use scene_complexity::trace::rust::{BruteForceTracer, BvhTracer};
-use scene_complexity::trace::{make_tracer, Backend, Line, LineHits, Query, TraceError, Tracer};
+use scene_complexity::internals::geom::uniform_direction;
+use scene_complexity::internals::sample::lines::batch_lines;
+use scene_complexity::internals::scene::Scene;
+use scene_complexity::internals::trace::rust::{BruteForceTracer, BvhTracer};
+use scene_complexity::internals::trace::{
+    make_tracer, Backend, Line, LineHits, Query, TraceError, Tracer,
+};
 
 fn trace(tracer: &dyn Tracer, lines: &[Line]) -> LineHits {
     let mut raw = Vec::new();

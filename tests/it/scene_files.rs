@@ -2,14 +2,14 @@
 //! `w`, objects flipped or two-sided, the orientation diagnosis, glTF with node transforms, PLY and STL
 //! in ASCII and binary, materials in RGB, and I_s^c the same whatever the format and the triangulation.
 
+use scene_complexity::internals::measure::Measure;
 use std::path::{Path, PathBuf};
 
-use scene_complexity::run::RunWarningKind;
-use scene_complexity::scene::{ObjectSet, Planarity, SceneOptions};
-use scene_complexity::scenes::load_with;
+use scene_complexity::internals::analysis::RunWarningKind;
+use scene_complexity::internals::scene::{ObjectSet, Planarity, SceneOptions};
+use scene_complexity::internals::scenes::load_with;
 use scene_complexity::{
-    analyze, load, make_tracer, Analysis, AnalysisConfig, Backend, Measures, Query, RunControl,
-    Scene,
+    analyze, load, make_tracer, Analysis, Backend, Measures, Query, RunControl, RunSpec, Scene,
 };
 
 use crate::support::room_with_box_obj;
@@ -26,9 +26,9 @@ fn load_file(path: &Path, options: &SceneOptions) -> Scene {
 
 fn run(scene: &Scene, lines: u64, seed: u64, measures: Measures) -> Analysis {
     let tracer = make_tracer(Backend::Rust, scene, Query::Single).unwrap();
-    let cfg = AnalysisConfig {
+    let cfg = RunSpec {
         measures,
-        ..AnalysisConfig::new(lines, seed)
+        ..RunSpec::new(lines, seed)
     };
     analyze(scene, tracer.as_ref(), &cfg, &RunControl::default()).unwrap()
 }
@@ -219,10 +219,16 @@ fn inside_out_objects_are_diagnosed_and_flipped() {
     );
     assert_eq!(a.pairs, 0);
     assert!(kinds(&a).contains(&RunWarningKind::NoPairs));
-    let v = &a.visibility;
-    assert!(v.positional_entropy.is_some());
-    assert!(v.entropy.is_none() && v.mutual_information.is_none() && v.mse_per_line.is_none());
-    assert!(v.continuous_mutual_information.is_none() && v.accuracy.is_none());
+    assert!(a.estimate(Measure::PositionalEntropy).is_some());
+    assert!(
+        a.estimate(Measure::Entropy).is_none()
+            && a.estimate(Measure::MutualInformation).is_none()
+            && a.estimate(Measure::MsePerLine).is_none()
+    );
+    assert!(
+        a.estimate(Measure::ContinuousMutualInformation).is_none()
+            && a.estimate(Measure::Accuracy).is_none()
+    );
     let all = SceneOptions {
         flip_normals: ObjectSet::All,
         ..SceneOptions::default()
@@ -242,7 +248,7 @@ fn inside_out_objects_are_diagnosed_and_flipped() {
 }
 
 fn v_entropy(a: &Analysis) -> (f64, f64) {
-    let e = a.visibility.entropy.unwrap();
+    let e = a.estimate(Measure::Entropy).unwrap();
     (e.value, e.stderr.unwrap())
 }
 
@@ -481,7 +487,7 @@ fn continuous_mutual_information_is_the_same_in_every_format() {
     let triangles_path = write(dir.path(), "triangles.obj", triangles.as_bytes());
     let scene = load(quads_path.to_str().unwrap()).unwrap();
     let gltf_path = dir.path().join("room.glb");
-    scene_complexity::scene::gltf::write(&scene, &gltf_path).unwrap();
+    scene_complexity::internals::scene::gltf::write(&scene, &gltf_path).unwrap();
     let mut ply = format!(
         "ply\nformat ascii 1.0\nelement vertex {}\nproperty double x\nproperty double y\nproperty double z\n\
          element face {}\nproperty list uchar uint vertex_indices\nend_header\n",
@@ -515,7 +521,7 @@ fn continuous_mutual_information_is_the_same_in_every_format() {
         let scene = load(path.to_str().unwrap()).unwrap();
         assert_eq!(scene.patch_count(), patches, "{}", path.display());
         let a = run(&scene, 300_000, seed as u64 + 1, continuous);
-        let e = a.visibility.continuous_mutual_information.unwrap();
+        let e = a.estimate(Measure::ContinuousMutualInformation).unwrap();
         results.push((path, e.value, e.stderr.unwrap()));
     }
     for a in &results {
@@ -539,15 +545,17 @@ fn continuous_mutual_information_is_the_same_in_every_format() {
 /// same single value (exactly the built-in's), so the exported box measures the same.
 #[test]
 fn materials_keep_their_colours_through_export() {
-    use scene_complexity::scene::grey_value;
-    use scene_complexity::scenes::cornell::{GREEN, GREEN_RGB, RED, RED_RGB, WHITE, WHITE_RGB};
+    use scene_complexity::internals::scene::grey_value;
+    use scene_complexity::internals::scenes::cornell::{
+        GREEN, GREEN_RGB, RED, RED_RGB, WHITE, WHITE_RGB,
+    };
     for (rgb, mean) in [(RED_RGB, RED), (WHITE_RGB, WHITE), (GREEN_RGB, GREEN)] {
         assert_eq!(grey_value(rgb), mean);
     }
     let scene = load("@cornell").unwrap();
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("cornell.obj");
-    scene_complexity::scene::obj::write(&scene, &path).unwrap();
+    scene_complexity::internals::scene::obj::write(&scene, &path).unwrap();
     let mtl = std::fs::read_to_string(dir.path().join("cornell.mtl")).unwrap();
     let [r, g, b] = RED_RGB;
     assert!(mtl.contains(&format!("Kd {r} {g} {b}")), "{mtl}");
@@ -562,7 +570,7 @@ fn materials_keep_their_colours_through_export() {
         dir.path().join("cornell.gltf"),
         dir.path().join("cornell.glb"),
     ] {
-        scene_complexity::scene::gltf::write(&scene, &path).unwrap();
+        scene_complexity::internals::scene::gltf::write(&scene, &path).unwrap();
         let back = load(path.to_str().unwrap()).unwrap();
         let red = back.materials.iter().find(|m| m.name == "red").unwrap();
         for (a, b) in red.reflectance_rgb.iter().zip(RED_RGB) {
@@ -580,8 +588,8 @@ fn materials_keep_their_colours_through_export() {
 /// is reached from the first one's front at its back: a `BackSeen` segment.
 #[test]
 fn the_ends_of_a_line_and_back_sides_seen() {
-    use scene_complexity::sample::pairs::{segments, segments_and_ends, Segment};
-    use scene_complexity::trace::{Line, LineHits};
+    use scene_complexity::internals::sample::pairs::{segments, segments_and_ends, Segment};
+    use scene_complexity::internals::trace::{Line, LineHits};
     let dir = tempfile::tempdir().unwrap();
     let obj = "o a\nv -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nf 1 2 3 4\n\
                o b\nv -1 -1 1\nv 1 -1 1\nv 1 1 1\nv -1 1 1\nf 5 6 7 8\n";
@@ -676,6 +684,6 @@ fn two_sided_walls_one_after_another_pair_as_thin_panels() {
         b.unpaired
     );
     assert_eq!(b.degenerate_pairs, 0);
-    let e = b.visibility.continuous_mutual_information.unwrap();
+    let e = b.estimate(Measure::ContinuousMutualInformation).unwrap();
     assert!(e.value.is_finite());
 }

@@ -6,17 +6,19 @@
 //! reference computed here (never against scx's own earlier output).
 
 use crate::support;
-use scene_complexity::scenes;
+use scene_complexity::internals::measure::Measure;
+use scene_complexity::internals::scenes;
 
 use std::f64::consts::{LN_2, PI};
 
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
-use scene_complexity::measure::channel::row_totals;
-use scene_complexity::run::{analyze, Analysis, AnalysisConfig, RunControl};
-use scene_complexity::sample::pairs::{segments, Segment};
-use scene_complexity::scene::{Material, Scene, SceneBuilder};
-use scene_complexity::trace::{make_tracer, Backend, Line, LineHits, Query, Tracer};
+use scene_complexity::internals::analysis::{analyze, Analysis};
+use scene_complexity::internals::measure::channel::row_totals;
+use scene_complexity::internals::run::{RunControl, RunSpec};
+use scene_complexity::internals::sample::pairs::{segments, Segment};
+use scene_complexity::internals::scene::{Material, Scene, SceneBuilder};
+use scene_complexity::internals::trace::{make_tracer, Backend, Line, LineHits, Query, Tracer};
 use support::{count_entries, ff_parallel_rectangles, room_with_box_obj};
 
 // ------------------------------------------------------------------------------------------------
@@ -30,7 +32,7 @@ fn run(scene: &Scene, lines: u64, seed: u64) -> Analysis {
     analyze(
         scene,
         tracer(scene).as_ref(),
-        &AnalysisConfig::new(lines, seed),
+        &RunSpec::new(lines, seed),
         &RunControl::default(),
     )
     .expect("analysis runs")
@@ -45,17 +47,19 @@ fn trace(tracer: &dyn Tracer, lines: &[Line]) -> LineHits {
 
 /// Every reported measure is a finite number (or absent), never NaN or infinite.
 fn assert_all_finite(a: &Analysis, what: &str) {
-    let v = &a.visibility;
     for (name, e) in [
-        ("H_p", v.positional_entropy),
-        ("H_s", v.entropy),
-        ("H_s corrected", v.entropy_corrected),
-        ("H(X,Y)", v.joint_entropy),
-        ("I_s", v.mutual_information),
-        ("I_s corrected", v.mutual_information_corrected),
-        ("I_s^c", v.continuous_mutual_information),
-        ("accuracy", v.accuracy),
-        ("mse", v.mse_per_line),
+        ("H_p", a.estimate(Measure::PositionalEntropy)),
+        ("H_s", a.estimate(Measure::Entropy)),
+        ("H_s corrected", a.estimate(Measure::EntropyCorrected)),
+        ("H(X,Y)", a.estimate(Measure::JointEntropy)),
+        ("I_s", a.estimate(Measure::MutualInformation)),
+        (
+            "I_s corrected",
+            a.estimate(Measure::MutualInformationCorrected),
+        ),
+        ("I_s^c", a.estimate(Measure::ContinuousMutualInformation)),
+        ("accuracy", a.estimate(Measure::Accuracy)),
+        ("mse", a.estimate(Measure::MsePerLine)),
     ] {
         if let Some(e) = e {
             assert!(e.value.is_finite(), "{what}: {name} = {}", e.value);
@@ -154,7 +158,7 @@ fn room_with_floor_square(b: &mut SceneBuilder, a: f64, c: f64, m: u32) {
     );
     add_quad(b, [p(0.0, a), p(a, a), p(a, c), p(0.0, c)], m, "floor west");
     add_quad(b, [p(c, a), p(1.0, a), p(1.0, c), p(c, c)], m, "floor east");
-    let room = scene_complexity::scenes::solids::cube("room", 1).expect("cube");
+    let room = scene_complexity::internals::scenes::solids::cube("room", 1).expect("cube");
     // The other five walls of the unit cube, inward, from the built-in cube (face 4 is the floor z = 0).
     for (k, patch) in room.patches.iter().enumerate() {
         if k == 4 {
@@ -419,7 +423,7 @@ fn nearly_concentric_spheres_close_to_touching() {
         );
 
         let (reference, se_ref) = nested_reference(&inner, &outer, 300_000, 77 + k as u64);
-        let cmi = a.visibility.continuous_mutual_information.unwrap();
+        let cmi = a.estimate(Measure::ContinuousMutualInformation).unwrap();
         let se = cmi.stderr.unwrap();
         assert!(
             (cmi.value - reference).abs() < 4.5 * (se * se + se_ref * se_ref).sqrt() + 3e-3,
@@ -508,7 +512,7 @@ fn cube_almost_touching_and_touching_the_floor() {
         cmi.push((
             gap,
             exact,
-            a.visibility.continuous_mutual_information.unwrap(),
+            a.estimate(Measure::ContinuousMutualInformation).unwrap(),
         ));
     }
     let a_t = 6.0 + 6.0 * SIDE * SIDE;
@@ -928,14 +932,13 @@ fn tiny_and_huge_scenes_give_the_same_results() {
         scenes::load(path.to_str().unwrap()).unwrap()
     };
     let measures = |a: &Analysis| {
-        let v = &a.visibility;
         [
-            v.positional_entropy,
-            v.entropy,
-            v.entropy_corrected,
-            v.mutual_information,
-            v.continuous_mutual_information,
-            v.mse_per_line,
+            a.estimate(Measure::PositionalEntropy),
+            a.estimate(Measure::Entropy),
+            a.estimate(Measure::EntropyCorrected),
+            a.estimate(Measure::MutualInformation),
+            a.estimate(Measure::ContinuousMutualInformation),
+            a.estimate(Measure::MsePerLine),
         ]
         .map(|e| e.unwrap().value)
     };
@@ -1094,9 +1097,9 @@ const OPEN_BOX: &str = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nv 0 0 1\nv 1 0 1\nv 
 #[test]
 fn enclose_closes_open_scenes_consistently() {
     let lines = 200_000;
-    let cfg = AnalysisConfig {
+    let cfg = RunSpec {
         enclose: true,
-        ..AnalysisConfig::new(lines, 19)
+        ..RunSpec::new(lines, 19)
     };
     let r2 = 0.75;
     let sphere = 4.0 * PI * r2;
@@ -1118,7 +1121,11 @@ fn enclose_closes_open_scenes_consistently() {
     let counts = t.counts.as_ref().unwrap();
     let rows = row_totals(n, counts, &t.escapes_by_patch);
     let mut f = vec![vec![0.0; n]; n];
-    scene_complexity::measure::channel::for_each_form_factor(counts, &rows, |i, j, v| f[i][j] = v);
+    scene_complexity::internals::measure::channel::for_each_form_factor(
+        counts,
+        &rows,
+        |i, j, v| f[i][j] = v,
+    );
     for (i, row) in f.iter().enumerate() {
         assert!((row.iter().sum::<f64>() - 1.0).abs() < 1e-12, "row {i}");
     }
@@ -1132,7 +1139,7 @@ fn enclose_closes_open_scenes_consistently() {
         (to_cube - exact).abs() < 4.5 * sigma,
         "F(env -> cube) = {to_cube}, A_cube / 4 pi R^2 = {exact}"
     );
-    let hp = a.visibility.positional_entropy.unwrap();
+    let hp = a.estimate(Measure::PositionalEntropy).unwrap();
     let total = 6.0 + sphere;
     let exact_hp =
         -(6.0 * (1.0 / total) * (1.0 / total).log2() + (sphere / total) * (sphere / total).log2());
@@ -1157,7 +1164,11 @@ fn enclose_closes_open_scenes_consistently() {
     let counts = t.counts.as_ref().unwrap();
     let rows = row_totals(6, counts, &t.escapes_by_patch);
     let mut f = vec![vec![0.0; 6]; 6];
-    scene_complexity::measure::channel::for_each_form_factor(counts, &rows, |i, j, v| f[i][j] = v);
+    scene_complexity::internals::measure::channel::for_each_form_factor(
+        counts,
+        &rows,
+        |i, j, v| f[i][j] = v,
+    );
     for (i, row) in f.iter().enumerate() {
         assert!((row.iter().sum::<f64>() - 1.0).abs() < 1e-12, "row {i}");
     }

@@ -4,11 +4,11 @@
 
 use std::f64::consts::PI;
 
-use scene_complexity::run::Analysis;
-use scene_complexity::scene::Scene;
+use scene_complexity::internals::analysis::Analysis;
+use scene_complexity::internals::scene::Scene;
 
-use scene_complexity::trace::rust::BruteForceTracer;
-use scene_complexity::trace::{make_tracer, Backend, Query, Tracer};
+use scene_complexity::internals::trace::rust::BruteForceTracer;
+use scene_complexity::internals::trace::{make_tracer, Backend, Query, Tracer};
 
 /// Form factor between two identical, directly opposed parallel rectangles `a x b` at distance `c`.
 pub fn ff_parallel_rectangles(a: f64, b: f64, c: f64) -> f64 {
@@ -229,7 +229,7 @@ pub fn cube_form_factor_row(scene: &Scene, rects: &[AxisRect], i: usize) -> Vec<
 /// symmetry maps every face onto face 0, so the rows of face 0's patches suffice.
 pub fn cube_exact_measures(n: usize) -> (f64, f64) {
     use rayon::prelude::*;
-    let scene = scene_complexity::scenes::load(&format!("@cube:{n}")).unwrap();
+    let scene = scene_complexity::internals::scenes::load(&format!("@cube:{n}")).unwrap();
     let rects: Vec<AxisRect> = (0..scene.patch_count())
         .map(|p| AxisRect::of_patch(&scene, p))
         .collect();

@@ -2,21 +2,23 @@
 //! positional entropy, closure and reciprocity, thread and scale invariance.
 
 use crate::support;
-use scene_complexity::scenes;
+use scene_complexity::internals::measure::Measure;
+use scene_complexity::internals::scenes;
 
-use scene_complexity::measure::channel::{for_each_form_factor, row_totals};
-use scene_complexity::run::Measures;
-use scene_complexity::run::{analyze, Analysis, AnalysisConfig, RunControl};
-use scene_complexity::scene::Scene;
-use scene_complexity::trace::Tracer;
+use scene_complexity::internals::analysis::{analyze, Analysis};
+use scene_complexity::internals::measure::channel::{for_each_form_factor, row_totals};
+use scene_complexity::internals::run::Measures;
+use scene_complexity::internals::run::{RunControl, RunSpec};
+use scene_complexity::internals::scene::Scene;
+use scene_complexity::internals::trace::Tracer;
 use support::*;
 
 const ALL: Measures = Measures::VISIBILITY;
 
 fn run(scene: &Scene, tracer: &dyn Tracer, lines: u64, seed: u64) -> Analysis {
-    let cfg = AnalysisConfig {
+    let cfg = RunSpec {
         measures: ALL,
-        ..AnalysisConfig::new(lines, seed)
+        ..RunSpec::new(lines, seed)
     };
     analyze(scene, tracer, &cfg, &RunControl::default()).expect("analysis runs")
 }
@@ -64,7 +66,7 @@ fn unit_cube_form_factors_and_mutual_information_match_closed_form() {
                 );
             }
         }
-        let is = a.visibility.mutual_information.unwrap();
+        let is = a.estimate(Measure::MutualInformation).unwrap();
         let se = is.stderr.unwrap();
         assert!(se > 0.0 && se < 2e-3, "stderr {se}");
         assert!(
@@ -74,7 +76,7 @@ fn unit_cube_form_factors_and_mutual_information_match_closed_form() {
             is.value
         );
         // And the continuous measure of the cube (paper Table 4: 1.6093), within its error.
-        let cmi = a.visibility.continuous_mutual_information.unwrap();
+        let cmi = a.estimate(Measure::ContinuousMutualInformation).unwrap();
         assert!(
             (cmi.value - 1.6093).abs() < 4.5 * cmi.stderr.unwrap() + 2e-3,
             "{cmi:?}"
@@ -88,7 +90,7 @@ fn positional_entropy_is_exact() {
         let scene = scenes::load(&format!("@cube:{n}")).unwrap();
         let tracer = &all_tracers(&scene)[0];
         let a = run(&scene, tracer.as_ref(), 5_000, 1);
-        let hp = a.visibility.positional_entropy.unwrap();
+        let hp = a.estimate(Measure::PositionalEntropy).unwrap();
         assert!((hp.value - ((6 * n * n) as f64).log2()).abs() < 1e-12);
         assert_eq!(hp.stderr, Some(0.0));
     }
@@ -152,8 +154,14 @@ fn results_do_not_depend_on_the_thread_count() {
             "identical f64 sums"
         );
         assert_eq!(
-            one.visibility.mutual_information.unwrap().value.to_bits(),
-            two.visibility.mutual_information.unwrap().value.to_bits()
+            one.estimate(Measure::MutualInformation)
+                .unwrap()
+                .value
+                .to_bits(),
+            two.estimate(Measure::MutualInformation)
+                .unwrap()
+                .value
+                .to_bits()
         );
     }
 }
@@ -180,13 +188,16 @@ fn scaling_the_scene_changes_nothing() {
         assert_eq!(a.unpaired, base.unpaired);
         for (x, y) in [
             (
-                a.visibility.mutual_information,
-                base.visibility.mutual_information,
+                a.estimate(Measure::MutualInformation),
+                base.estimate(Measure::MutualInformation),
             ),
-            (a.visibility.entropy, base.visibility.entropy),
             (
-                a.visibility.continuous_mutual_information,
-                base.visibility.continuous_mutual_information,
+                a.estimate(Measure::Entropy),
+                base.estimate(Measure::Entropy),
+            ),
+            (
+                a.estimate(Measure::ContinuousMutualInformation),
+                base.estimate(Measure::ContinuousMutualInformation),
             ),
         ] {
             let (x, y) = (x.unwrap().value, y.unwrap().value);
@@ -210,7 +221,7 @@ fn sphere_mutual_information_tends_to_zero() {
         let scene = scenes::load(&format!("@sphere:{level}")).unwrap();
         let tracer = all_tracers(&scene).pop().unwrap();
         let a = run(&scene, tracer.as_ref(), 400_000, 21);
-        let cmi = a.visibility.continuous_mutual_information.unwrap();
+        let cmi = a.estimate(Measure::ContinuousMutualInformation).unwrap();
         assert!(
             cmi.value > 0.0 && cmi.value < 0.45 * previous_cmi,
             "level {level}: I_s^c {cmi:?} after {previous_cmi}"
@@ -219,7 +230,7 @@ fn sphere_mutual_information_tends_to_zero() {
         if level <= 1 {
             // Rows are well sampled here (>= 2500 segments per patch), so the plug-in I_s is close to
             // its limit: below I_s^c, and falling with the subdivision.
-            let is = a.visibility.mutual_information.unwrap();
+            let is = a.estimate(Measure::MutualInformation).unwrap();
             assert!(
                 is.value < cmi.value + 4.0 * cmi.stderr.unwrap(),
                 "level {level}: {is:?} vs {cmi:?}"

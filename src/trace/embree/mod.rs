@@ -24,12 +24,12 @@
 //! 2602 of 61,440 lines grazing `@sphere:2` at vertices and edges (sines 1e-3 and 4e-3), and on 0.3-2 per
 //! thousand lines aimed at vertices and edges of `@cornell` or `@sphere:5` in random directions, while
 //! uniformly distributed lines practically never showed it. Boxes cost candidates (2.6 instead of 1.3 per
-//! line on `@cube:30`, 7.2 instead of 2.0 on `@sphere:5`) and some speed (README, "Two tracers, one
+//! line on `@cube:30`, 7.2 instead of 2.0 on `@sphere:5`) and some speed (docs/design.md, "Two tracers, one
 //! answer").
 //!
 //! For all hits the candidates are decided after the traversal of a batch, in one pass, not in the
 //! callback: there Embree waited, candidate after candidate, for the test and for the cache miss on the
-//! original triangle, while a pass over the batch overlaps them (README, "Exact hits only where they
+//! original triangle, while a pass over the batch overlaps them (docs/design.md, "Exact hits only where they
 //! matter"). First-hit queries decide in the callback, because reporting a hit narrows Embree's search.
 //!
 //! Lines are traced one by one (`rtcIntersect1`, [`Query::Single`]) or in packets of 4, 8 or 16 adjacent

@@ -1,53 +1,42 @@
-//! The per-patch results of a run ([`crate::measure::patches`]), each with its standard error.
+//! The per-patch results of a run ([`crate::measure::shares`]), each with its standard error.
 //!
 //! Every group of lines gets its own per-patch terms (and, when the scene emits, its own radiosity
 //! solution), and each full-run value gets the batch-means standard error of the group values, as the
-//! scene's measures do ([`super::errors`]); like theirs, the errors of the plug-in terms of undersampled
+//! scene's measures do ([`crate::run::errors`]); like theirs, the errors of the plug-in terms of undersampled
 //! rows measure the statistical error only, not the bias.
 
 use rayon::prelude::*;
 
-use super::state::FinishedRun;
 use crate::measure::estimators::EntropyEstimator;
-use crate::measure::patches::{patch_values, ContinuousSums, PatchValues};
 use crate::measure::radiosity::{self, FormFactors, PatchMaterials, SolveOptions};
-use crate::measure::Estimate;
+use crate::measure::shares::{patch_values, ContinuousSums, PatchValues};
+use crate::measure::{Estimate, PatchMeasure};
+use crate::run::FinishedRun;
 use crate::sample::tally::Tally;
 use crate::scene::Scene;
 
-/// One patch's results (patch `k` of the scene is entry `k`). Bits for the entropies and terms; the
-/// radiosities in the units of the scene's emissions.
+/// One patch's results (patch `k` of the scene is entry `k`): its segments and, for each per-patch
+/// quantity of the catalogue ([`PatchMeasure`]), its value with a standard error. Bits for the entropies
+/// and terms; the radiosities in the units of the scene's emissions.
 #[derive(Clone, Debug, PartialEq)]
-pub struct PatchEstimate {
+pub struct PatchResult {
     /// `N_i`: segments leaving the patch's front side (to patches, or escaping).
     pub segments: u64,
     /// Of them, the escapes.
     pub escapes: u64,
-    /// `H_i = -sum_j F_ij log2 F_ij`, the plug-in row entropy (eq. (17)'s inner sum).
-    pub row_entropy: Estimate,
-    /// `H_i` by the run's bias-correcting estimator.
-    pub row_entropy_corrected: Estimate,
-    /// `a_i sum_j F_ij log2(F_ij / a_j)`, the patch's term of eq. (21).
-    pub mutual_information_term: Estimate,
-    /// The same with the corrected `H_i`.
-    pub mutual_information_term_corrected: Estimate,
-    /// The patch's share of eq. (27) (`None` when I_s^c was not computed).
-    pub continuous_term: Option<Estimate>,
-    /// The information the discretisation loses at the patch: `continuous_term -
-    /// mutual_information_term`.
-    pub lost_information: Option<Estimate>,
-    /// `continuous_term - mutual_information_term_corrected`.
-    pub lost_information_corrected: Option<Estimate>,
-    /// `B_i`, the radiosity (eq. (2)), when the scene emits.
-    pub radiosity: Option<Estimate>,
-    /// `B_i^in = sum_j F_ij B_j`, the radiosity arriving, when the scene emits.
-    pub incoming_radiosity: Option<Estimate>,
+    /// Each quantity's estimate, by [`PatchMeasure`] (`None`: not computed, e.g. no I_s^c or no light).
+    values: [Option<Estimate>; PatchMeasure::COUNT],
 }
 
-impl PatchEstimate {
+impl PatchResult {
     /// Whether any segment left the patch (an unsampled patch's terms are 0 and say nothing).
     pub fn sampled(&self) -> bool {
         self.segments > 0
+    }
+
+    /// The estimate of `quantity` (`None`: not computed).
+    pub fn get(&self, quantity: PatchMeasure) -> Option<Estimate> {
+        self.values[quantity as usize]
     }
 }
 
@@ -72,7 +61,7 @@ pub(crate) fn estimates(
     run: &FinishedRun,
     estimator: EntropyEstimator,
     light: Option<PatchLight<'_>>,
-) -> Option<Vec<PatchEstimate>> {
+) -> Option<Vec<PatchResult>> {
     let of = |t: &Tally| of_tally(scene, t, estimator, light);
     let (all, groups): (Option<TallyPatches>, Vec<Option<TallyPatches>>) = rayon::join(
         || of(&run.total),
@@ -110,7 +99,7 @@ fn of_tally(
 }
 
 /// Patch `i`'s values from all the lines, with the batch-means standard errors of the groups'.
-fn patch_estimate(i: usize, all: &TallyPatches, groups: &[TallyPatches]) -> PatchEstimate {
+fn patch_estimate(i: usize, all: &TallyPatches, groups: &[TallyPatches]) -> PatchResult {
     let est = |f: &dyn Fn(&TallyPatches) -> Option<f64>| -> Option<Estimate> {
         let value = f(all)?;
         let per_group: Option<Vec<f64>> = groups.iter().map(f).collect();
@@ -122,9 +111,6 @@ fn patch_estimate(i: usize, all: &TallyPatches, groups: &[TallyPatches]) -> Patc
             },
         })
     };
-    let always = |f: &dyn Fn(&PatchValues) -> f64| {
-        est(&|t| Some(f(&t.values))).expect("every tally has its counts' values")
-    };
     let continuous = |t: &TallyPatches| Some(t.values.continuous_term.as_ref()?[i]);
     let lost = |t: &TallyPatches, corrected: bool| {
         let discrete = if corrected {
@@ -134,17 +120,26 @@ fn patch_estimate(i: usize, all: &TallyPatches, groups: &[TallyPatches]) -> Patc
         };
         Some(continuous(t)? - discrete)
     };
-    PatchEstimate {
+    // The estimator behind each entry of the per-patch catalogue.
+    let value = |q: PatchMeasure, t: &TallyPatches| -> Option<f64> {
+        let v = &t.values;
+        match q {
+            PatchMeasure::RowEntropy => Some(v.row_entropy[i]),
+            PatchMeasure::RowEntropyCorrected => Some(v.row_entropy_corrected[i]),
+            PatchMeasure::MutualInformationTerm => Some(v.mutual_information_term[i]),
+            PatchMeasure::MutualInformationTermCorrected => {
+                Some(v.mutual_information_term_corrected[i])
+            }
+            PatchMeasure::ContinuousTerm => continuous(t),
+            PatchMeasure::LostInformation => lost(t, false),
+            PatchMeasure::LostInformationCorrected => lost(t, true),
+            PatchMeasure::Radiosity => Some(t.light.as_ref()?.0[i]),
+            PatchMeasure::IncomingRadiosity => Some(t.light.as_ref()?.1[i]),
+        }
+    };
+    PatchResult {
         segments: all.values.segments[i],
         escapes: all.values.escapes[i],
-        row_entropy: always(&|v| v.row_entropy[i]),
-        row_entropy_corrected: always(&|v| v.row_entropy_corrected[i]),
-        mutual_information_term: always(&|v| v.mutual_information_term[i]),
-        mutual_information_term_corrected: always(&|v| v.mutual_information_term_corrected[i]),
-        continuous_term: est(&continuous),
-        lost_information: est(&|t| lost(t, false)),
-        lost_information_corrected: est(&|t| lost(t, true)),
-        radiosity: est(&|t| Some(t.light.as_ref()?.0[i])),
-        incoming_radiosity: est(&|t| Some(t.light.as_ref()?.1[i])),
+        values: PatchMeasure::ALL.map(|q| est(&|t| value(q, t))),
     }
 }

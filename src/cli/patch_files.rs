@@ -1,8 +1,8 @@
 //! `--patches FILE` and `--form-factors FILE` of `scx analyze` and `scx merge`: the per-patch results
 //! and the sparse form-factor matrix, written for pandas, polars, numpy and scipy.
 //!
-//! * `--patches x.csv`: one row per patch, in the order `scx export` writes the faces (README,
-//!   "Per-patch results" lists the columns and their units);
+//! * `--patches x.csv`: one row per patch, in the order `scx export` writes the faces
+//!   (docs/per-patch.md, "Per-patch results", lists the columns and their units);
 //! * `--form-factors x.csv`: one row per non-zero `F_ij` (i, j, N_ij, N_i, F_ij and its standard error
 //!   `sqrt(F (1 - F) / N_i)`, the binomial error of a row's share);
 //! * `--form-factors x.mtx`: the same matrix as Matrix Market coordinates (`scipy.io.mmread`), 1-based.
@@ -13,15 +13,16 @@ use std::path::{Path, PathBuf};
 
 use rayon::prelude::*;
 
-use scene_complexity::geom::Point;
-use scene_complexity::measure::Estimate;
-use scene_complexity::run::{Analysis, PatchEstimate, RunIdentity};
-use scene_complexity::sample::counts::PairCounts;
-use scene_complexity::sample::tally::Wanted;
-use scene_complexity::scene::Scene;
+use scene_complexity::PairCounts;
+use scene_complexity::PatchMeasure;
+use scene_complexity::Point;
+use scene_complexity::RunIdentity;
+use scene_complexity::Scene;
+use scene_complexity::Wanted;
+use scene_complexity::{Analysis, PatchResult};
 
+use super::exit::Failure;
 use super::output::{self, io_failure, warn, wrote};
-use super::Failure;
 
 /// The per-patch files of `scx analyze` and `scx merge`.
 #[derive(clap::Args, Debug)]
@@ -76,7 +77,7 @@ impl PatchFiles {
         if self.is_empty() {
             return Ok(());
         }
-        if identity.enclose {
+        if identity.spec.enclose {
             return Err(Failure::bad_input(format!(
                 "{file}: the run closed the scene with --enclose; --patches and --form-factors \
                  describe the scene's own patches"
@@ -91,10 +92,11 @@ impl PatchFiles {
         if !self.patches.is_empty() && wanted.continuous && !without_sums.is_empty() {
             warn(&format!(
                 "{}: saved without the per-patch sums of eq. (27) (the run was not asked for \
-                 --patches), so the continuous_mutual_information_term and lost_information columns \
-                 of --patches stay empty; give --patches to the first run (to every shard) to have \
-                 them",
-                without_sums.join(", ")
+                 --patches), so the {} and {} columns of --patches stay empty; give --patches to the \
+                 first run (to every shard) to have them",
+                without_sums.join(", "),
+                PatchMeasure::ContinuousTerm.info().column,
+                PatchMeasure::LostInformation.info().column
             ));
         }
         Ok(())
@@ -303,7 +305,7 @@ fn matrix_market(
         "% form factors F_ij = N_ij / N_i of {} from {} global lines (seed {}), written by scx {}",
         scene.name.replace('\n', " "),
         a.lines,
-        a.seed,
+        a.spec.seed,
         env!("CARGO_PKG_VERSION")
     )?;
     writeln!(w, "% row i, column j (1-based: patch index + 1)")?;
@@ -336,34 +338,7 @@ fn centroid(scene: &Scene, patch: usize) -> Point {
     }
 }
 
-/// The columns of the per-patch file after the geometry: each estimate as value and standard error.
-const ESTIMATE_COLUMNS: [&str; 9] = [
-    "row_entropy",
-    "row_entropy_corrected",
-    "mutual_information_term",
-    "mutual_information_term_corrected",
-    "continuous_mutual_information_term",
-    "lost_information",
-    "lost_information_corrected",
-    "radiosity",
-    "incoming_radiosity",
-];
-
-fn estimates_of(p: &PatchEstimate) -> [Option<Estimate>; 9] {
-    [
-        Some(p.row_entropy),
-        Some(p.row_entropy_corrected),
-        Some(p.mutual_information_term),
-        Some(p.mutual_information_term_corrected),
-        p.continuous_term,
-        p.lost_information,
-        p.lost_information_corrected,
-        p.radiosity,
-        p.incoming_radiosity,
-    ]
-}
-
-fn patches_csv(w: &mut dyn Write, scene: &Scene, patches: &[PatchEstimate]) -> std::io::Result<()> {
+fn patches_csv(w: &mut dyn Write, scene: &Scene, patches: &[PatchResult]) -> std::io::Result<()> {
     let mut out = csv::Writer::from_writer(w);
     let mut header: Vec<String> = [
         "id",
@@ -383,7 +358,8 @@ fn patches_csv(w: &mut dyn Write, scene: &Scene, patches: &[PatchEstimate]) -> s
     ]
     .map(String::from)
     .to_vec();
-    for name in ESTIMATE_COLUMNS {
+    for q in PatchMeasure::ALL {
+        let name = q.info().column;
         header.push(name.to_string());
         header.push(format!("{name}_stderr"));
     }
@@ -411,7 +387,7 @@ fn patches_csv(w: &mut dyn Write, scene: &Scene, patches: &[PatchEstimate]) -> s
             p.escapes.to_string(),
             p.sampled().to_string(),
         ];
-        for e in estimates_of(p) {
+        for e in PatchMeasure::ALL.map(|q| p.get(q)) {
             row.push(num(e.map(|e| e.value)));
             row.push(num(e.and_then(|e| e.stderr)));
         }

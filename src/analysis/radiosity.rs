@@ -2,36 +2,27 @@
 //!
 //! The radiosity system is solved on the form factors estimated from the run's own pair counts, so the
 //! radiosity measures carry the statistical error of those counts. As for the visibility measures
-//! ([`super::errors`]), every group's counts give their own form factors, their own solution `B` and
+//! ([`crate::run::errors`]), every group's counts give their own form factors, their own solution `B` and
 //! their own eqs. (33)-(35), and so do the counts with each group left out for the jackknife.
 
 use rayon::prelude::*;
 
-use super::errors::Spread;
-use super::reliability::{coverage_verdict, plug_in, Reliability, SamplingReport};
-use super::state::FinishedRun;
+use super::reliability::{self, Reliability, SamplingReport};
 use crate::measure::bias::row_corrections;
 use crate::measure::estimators::EntropyEstimator;
 use crate::measure::radiosity::{
     self, FormFactors, PatchMaterials, RadiosityValues, SolveError, SolveOptions,
 };
-use crate::measure::Estimate;
+use crate::measure::{ByMeasure, Estimate, Measure};
+use crate::run::FinishedRun;
+use crate::run::Spread;
 use crate::sample::tally::Tally;
 use crate::scene::Scene;
 
-/// The radiosity measures of a run, with the full-run solver's figures.
+/// The figures of a run's radiosity solution (its measures are among the run's readings,
+/// [`crate::analysis::Analysis::estimates`]).
 #[derive(Clone, Debug, PartialEq)]
-pub struct RadiosityEstimates {
-    /// Eq. (33).
-    pub positional_entropy: Estimate,
-    /// Eq. (34).
-    pub entropy: Estimate,
-    /// Eq. (35).
-    pub mutual_information: Estimate,
-    /// Eq. (34) with bias-corrected rows ([`radiosity::corrected`]).
-    pub entropy_corrected: Estimate,
-    /// Eq. (35) with bias-corrected rows.
-    pub mutual_information_corrected: Estimate,
+pub struct RadiositySolve {
     /// Relative residual `max |B - E - R F B| / max B` of the full-run solution.
     pub solver_residual: f64,
     /// The tolerance it was solved to.
@@ -42,29 +33,20 @@ pub struct RadiosityEstimates {
     pub excluded_patches: usize,
     /// Their share of the scene's area.
     pub excluded_area_fraction: f64,
-    /// The verdicts on eqs. (34) and (35), plug-in and corrected, as for the visibility measures: the
-    /// rows are those of F, reweighted by the radiosities.
-    pub reliability: RadiosityReliability,
 }
 
-/// The verdicts on the radiosity readings.
-#[derive(Clone, Debug, PartialEq)]
-pub struct RadiosityReliability {
-    /// Eq. (34), plug-in.
-    pub entropy: Reliability,
-    /// Eq. (34), corrected.
-    pub entropy_corrected: Reliability,
-    /// Eq. (35), plug-in.
-    pub mutual_information: Reliability,
-    /// Eq. (35), corrected.
-    pub mutual_information_corrected: Reliability,
+/// The radiosity readings of a run and their verdicts (as for the visibility measures: the rows are
+/// those of F, reweighted by the radiosities).
+pub(crate) struct RadiosityReadings {
+    pub(crate) estimates: ByMeasure<Estimate>,
+    pub(crate) reliability: ByMeasure<Reliability>,
 }
 
-/// The radiosity measures, or why there are none.
+/// Whether the radiosity measures were computed (with the solution's figures), or why not.
 #[derive(Clone, Debug, PartialEq)]
 pub enum RadiosityOutcome {
-    /// Computed (boxed: the estimates are large beside the other variants).
-    Computed(Box<RadiosityEstimates>),
+    /// Computed.
+    Computed(RadiositySolve),
     /// Not asked for.
     NotRequested,
     /// Left out, with the reason for the report.
@@ -96,7 +78,7 @@ pub(crate) fn estimates(
     estimator: EntropyEstimator,
     jackknife: bool,
     sampling: &SamplingReport,
-) -> Result<RadiosityOutcome, SolveFailure> {
+) -> Result<(RadiosityOutcome, Option<RadiosityReadings>), SolveFailure> {
     let areas: Vec<f64> = scene.patches.iter().map(|p| p.area).collect();
     let solve = |t: &Tally| solve_tally(&areas, materials, t, opts, estimator);
     // A group whose own solve fails (too few lines) only loses the standard error.
@@ -119,9 +101,12 @@ pub(crate) fn estimates(
     let (all, solution) = match solve(&run.total) {
         Err(e) => return Err(solve_failure(scene, materials, e)),
         Ok(None) => {
-            return Ok(RadiosityOutcome::Skipped(
-                "no patch both receives and sends light: every transformed area A_i B_i^in B_i (eq. 30) is 0"
-                    .into(),
+            return Ok((
+                RadiosityOutcome::Skipped(
+                    "no patch both receives and sends light: every transformed area A_i B_i^in B_i (eq. 30) is 0"
+                        .into(),
+                ),
+                None,
             ))
         }
         Ok(Some(solved)) => solved,
@@ -132,36 +117,44 @@ pub(crate) fn estimates(
         groups: &per_group,
         replicates: replicates.as_deref(),
     };
-    let est = |f: fn(&RadiosityValues) -> f64| -> Estimate {
-        spread
-            .estimate(|v| v.as_ref().map(f))
-            .expect("the whole run has radiosity values")
-    };
     let all = all.as_ref().expect("solved above");
-    let (entropy, entropy_corrected) = (est(|v| v.entropy), est(|v| v.entropy_corrected));
-    let mutual_information = est(|v| v.mutual_information);
-    // As for H_s: the plug-in reads low by about the correction, 𝓘_s high by as much.
-    let bias = entropy.value - entropy_corrected.value;
-    let lines = run.total.counters.lines;
-    let reliability = RadiosityReliability {
-        entropy: plug_in(entropy, bias, sampling, lines),
-        entropy_corrected: coverage_verdict(sampling),
-        mutual_information: plug_in(mutual_information, -bias, sampling, lines),
-        mutual_information_corrected: coverage_verdict(sampling),
-    };
-    Ok(RadiosityOutcome::Computed(Box::new(RadiosityEstimates {
-        positional_entropy: est(|v| v.positional_entropy),
-        entropy,
-        mutual_information,
-        entropy_corrected,
-        mutual_information_corrected: est(|v| v.mutual_information_corrected),
-        reliability,
+    let estimates = ByMeasure::from_fn(|m| {
+        let pick = value_of(m)?;
+        spread.estimate(|v| v.as_ref().map(pick))
+    });
+    let reliability = reliability::verdicts(
+        &estimates,
+        Some(sampling),
+        run.total.counters.lines,
+        run.total.counters.pairs,
+    );
+    let solve = RadiositySolve {
         solver_residual: solution.residual,
         solver_tolerance: opts.tolerance,
         solver_sweeps: solution.sweeps,
         excluded_patches: all.excluded_patches,
         excluded_area_fraction: all.excluded_area_fraction,
-    })))
+    };
+    Ok((
+        RadiosityOutcome::Computed(solve),
+        Some(RadiosityReadings {
+            estimates,
+            reliability,
+        }),
+    ))
+}
+
+/// The estimator behind each radiosity entry of the catalogue ([`crate::measure::catalogue`]): its
+/// value in a solution's measures.
+fn value_of(m: Measure) -> Option<fn(&RadiosityValues) -> f64> {
+    Some(match m {
+        Measure::RadiosityPositionalEntropy => |v| v.positional_entropy,
+        Measure::RadiosityEntropy => |v| v.entropy,
+        Measure::RadiosityEntropyCorrected => |v| v.entropy_corrected,
+        Measure::RadiosityMutualInformation => |v| v.mutual_information,
+        Measure::RadiosityMutualInformationCorrected => |v| v.mutual_information_corrected,
+        _ => return None,
+    })
 }
 
 /// Solves the radiosity system on a tally's form factors and measures it; `Ok(None)` when no patch is

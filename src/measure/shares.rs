@@ -29,7 +29,7 @@ use super::channel::{area_distribution, row_totals};
 use super::estimators::EntropyEstimator;
 use super::rows::Rows;
 use crate::sample::counts::PairCounts;
-use crate::sample::patch_sums::PatchKernelSums;
+use crate::sample::kernel_sums::PatchKernelSums;
 
 /// The per-patch terms of one set of lines (a run, or one of its groups), one entry per patch in every
 /// vector.

@@ -1,0 +1,413 @@
+//! The reliability verdict of every reading: whether its standard error tells the whole story, and the
+//! bounds of the theory it breaks (docs/results.md, "Reading the reliability verdict").
+//!
+//! The discrete measures of an undersampled run are biased (their standard errors do not include it):
+//! * a plug-in reading (H_s, H(X, Y), I_s and the accuracies built on them) is `ok` when the rows' sample
+//!   coverage is at least [`COVERAGE_OK`] and its estimated bias, the distance to the bias-corrected
+//!   reading, is within its standard error;
+//! * a bias-corrected reading is `ok` when the coverage is at least [`COVERAGE_OK`];
+//! * any discrete reading is `unusable` below [`COVERAGE_UNUSABLE`]: most of the rows' probability was
+//!   never drawn, and no estimator can see what was not drawn;
+//! * E(MSE) (eq. 22) has an unbiased estimate whatever the coverage: `ok` when its estimated bias is
+//!   within its standard error;
+//! * I_s^c (eq. 27) is a mean of independent terms: `ok` with enough pairs in every group.
+//!
+//! Independently, a reading that breaks a bound the theory guarantees (an entropy or mutual information
+//! below 0, I_s above I_s^c (Proposition 2), an accuracy outside [0, 1]) by more than twice its standard
+//! error is flagged, and is never `ok`.
+
+use crate::measure::catalogue::{Bound, VerdictRule};
+use crate::measure::sampling::Sampling;
+use crate::measure::{ByMeasure, Estimate, Family, Measure};
+
+/// Rows whose area-weighted sample coverage is at least this give `ok` bias-corrected readings.
+pub const COVERAGE_OK: f64 = 0.99;
+/// Below this coverage every discrete reading is `unusable`.
+pub const COVERAGE_UNUSABLE: f64 = 0.5;
+/// I_s^c needs at least this many pairs in the run to be `ok`.
+const MIN_PAIRS: u64 = 1000;
+
+/// What a reading is worth.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+pub enum Verdict {
+    /// Its standard error covers its error.
+    Ok,
+    /// It is biased beyond its standard error: cast more lines (see [`Reliability::lines_needed`]).
+    Undersampled,
+    /// It cannot be trusted at all.
+    Unusable,
+}
+
+impl Verdict {
+    /// The name in reports (`ok`, `undersampled`, `unusable`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Verdict::Ok => "ok",
+            Verdict::Undersampled => "undersampled",
+            Verdict::Unusable => "unusable",
+        }
+    }
+}
+
+/// The verdict on one reading, with the numbers behind it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Reliability {
+    /// The verdict.
+    pub verdict: Verdict,
+    /// The estimated bias of the reading (bits, or lines for E(MSE)), when there is an estimate.
+    pub estimated_bias: Option<f64>,
+    /// Roughly how many lines in all would make it `ok` (`None`: not estimated, or already ok).
+    pub lines_needed: Option<u64>,
+    /// The bounds of the theory it breaks, as sentences.
+    pub flags: Vec<String>,
+}
+
+impl Reliability {
+    fn new(verdict: Verdict) -> Self {
+        Reliability {
+            verdict,
+            estimated_bias: None,
+            lines_needed: None,
+            flags: Vec::new(),
+        }
+    }
+
+    /// Flags a broken bound: the reading is then at least undersampled.
+    fn flag(&mut self, sentence: String) {
+        self.flags.push(sentence);
+        self.verdict = self.verdict.max(Verdict::Undersampled);
+    }
+}
+
+/// How the rows were sampled, for the report.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SamplingReport {
+    /// The rows' sampling.
+    pub sampling: Sampling,
+    /// The lines in all for a coverage of [`COVERAGE_OK`] (`None`: beyond reach of the extrapolation).
+    pub lines_for_coverage: Option<u64>,
+}
+
+/// Whether `a` exceeds `b` by more than twice their combined standard error.
+fn clearly_above(a: Estimate, b: Estimate) -> bool {
+    let se = (a.stderr.unwrap_or(0.0).powi(2) + b.stderr.unwrap_or(0.0).powi(2)).sqrt();
+    a.value - b.value > 2.0 * se
+}
+
+fn stderr(e: Estimate) -> f64 {
+    e.stderr.unwrap_or(f64::INFINITY)
+}
+
+/// The lines for a bias `bias` to fall within the standard error `se`: bias falls like 1 / lines, the
+/// standard error like 1 / sqrt(lines).
+fn lines_for_bias(lines: u64, bias: f64, se: f64) -> Option<u64> {
+    (se > 0.0 && se.is_finite() && bias.abs() > se)
+        .then(|| (lines as f64 * (bias / se).powi(2)).ceil() as u64)
+}
+
+/// The coverage part of a discrete reading's verdict.
+pub(crate) fn coverage_verdict(report: &SamplingReport) -> Reliability {
+    let c = report.sampling.coverage;
+    let mut r = Reliability::new(if c < COVERAGE_UNUSABLE {
+        Verdict::Unusable
+    } else if c < COVERAGE_OK {
+        Verdict::Undersampled
+    } else {
+        Verdict::Ok
+    });
+    if r.verdict != Verdict::Ok {
+        r.lines_needed = report.lines_for_coverage;
+    }
+    r
+}
+
+/// A plug-in reading with estimated bias `bias`.
+pub(crate) fn plug_in(e: Estimate, bias: f64, report: &SamplingReport, lines: u64) -> Reliability {
+    let mut r = coverage_verdict(report);
+    r.estimated_bias = Some(bias);
+    if bias.abs() > stderr(e) {
+        r.verdict = r.verdict.max(Verdict::Undersampled);
+        let for_bias = lines_for_bias(lines, bias, stderr(e));
+        r.lines_needed = r.lines_needed.max(for_bias);
+    }
+    r
+}
+
+/// Flags a reading below 0 (an entropy or mutual information).
+fn flag_negative(r: &mut Reliability, e: Estimate, what: &str) {
+    if e.value < -2.0 * e.stderr.unwrap_or(0.0) {
+        r.flag(format!("{what} is negative, which no scene allows"));
+    }
+}
+
+/// Flags a ratio outside [0, 1].
+fn flag_unit_interval(r: &mut Reliability, e: Estimate, what: &str) {
+    let se = e.stderr.unwrap_or(0.0);
+    if e.value < -2.0 * se || e.value > 1.0 + 2.0 * se {
+        r.flag(format!("{what} is outside [0, 1], which no scene allows"));
+    }
+}
+
+/// Flags a mutual information above I_s^c (Proposition 2 says I_s <= I_s^c).
+fn flag_above_continuous(
+    r: &mut Reliability,
+    e: Estimate,
+    continuous: Option<Estimate>,
+    what: &str,
+) {
+    if let Some(c) = continuous.filter(|&c| clearly_above(e, c)) {
+        r.flag(format!(
+            "{what} {:.4} is above I_s^c {:.4}: Proposition 2 says I_s <= I_s^c; the rows are \
+             undersampled",
+            e.value, c.value
+        ));
+    }
+}
+
+/// What the verdicts of a family's readings are judged from.
+struct Evidence<'a> {
+    estimates: &'a ByMeasure<Estimate>,
+    /// The rows' sampling, when the pairs were counted.
+    sampling: Option<&'a SamplingReport>,
+    lines: u64,
+    pairs: u64,
+}
+
+impl Evidence<'_> {
+    fn estimate(&self, m: Measure) -> Option<Estimate> {
+        self.estimates.get(m).copied()
+    }
+
+    /// The rows' sampling and the estimated bias of the family's plug-in entropy, when both are known:
+    /// every verdict of a discrete reading needs them.
+    fn discrete(&self, family: Family) -> Option<(&SamplingReport, f64)> {
+        let (plain, corrected) = family.entropies();
+        let bias = self.estimate(plain)?.value - self.estimate(corrected)?.value;
+        Some((self.sampling?, bias))
+    }
+}
+
+/// The verdicts on every reading of a run of `lines` lines with `pairs` pairs ([`VerdictRule`] of each
+/// measure's catalogue entry); `sampling` is the rows' sampling when the pairs were counted. A reading
+/// without a standard error (too few groups with lines) is `unusable`: nothing tells how far off it is.
+pub fn verdicts(
+    estimates: &ByMeasure<Estimate>,
+    sampling: Option<&SamplingReport>,
+    lines: u64,
+    pairs: u64,
+) -> ByMeasure<Reliability> {
+    let evidence = Evidence {
+        estimates,
+        sampling,
+        lines,
+        pairs,
+    };
+    let mut out = ByMeasure::default();
+    for (m, &e) in estimates.iter() {
+        let r = verdict(&evidence, &out, m, e);
+        out.set(m, r);
+    }
+    for (m, e) in estimates.iter() {
+        if let (Some(r), None) = (out.get_mut(m), e.stderr) {
+            r.verdict = Verdict::Unusable;
+        }
+    }
+    out
+}
+
+/// The verdict on reading `e` of measure `m`, given the verdicts `so_far` of the measures before it.
+fn verdict(
+    evidence: &Evidence,
+    so_far: &ByMeasure<Reliability>,
+    m: Measure,
+    e: Estimate,
+) -> Option<Reliability> {
+    let info = m.info();
+    let continuous = evidence.estimate(Measure::ContinuousMutualInformation);
+    let mut r = match info.verdict {
+        VerdictRule::Exact => return None,
+        VerdictRule::Mean => {
+            Reliability::new(if evidence.pairs >= MIN_PAIRS && e.stderr.is_some() {
+                Verdict::Ok
+            } else {
+                Verdict::Unusable
+            })
+        }
+        VerdictRule::PlugIn { sign } => {
+            let (report, bias) = evidence.discrete(info.family)?;
+            plug_in(e, sign * bias, report, evidence.lines)
+        }
+        VerdictRule::Corrected => coverage_verdict(evidence.discrete(info.family)?.0),
+        VerdictRule::RatioOf { of, sign } => {
+            evidence.discrete(info.family)?;
+            // The ratio inherits the verdict of its I_s, not its flags (they are I_s's).
+            let mut r = so_far
+                .get(of)
+                .cloned()
+                .unwrap_or_else(|| Reliability::new(Verdict::Unusable));
+            r.flags.clear();
+            r.estimated_bias = r
+                .estimated_bias
+                .zip(continuous)
+                .map(|(b, c)| sign * b / c.value);
+            r
+        }
+        VerdictRule::Unbiased => {
+            let (report, _) = evidence.discrete(info.family)?;
+            let bias = report.sampling.mse_bias;
+            let mut r = Reliability::new(if bias.abs() <= stderr(e) {
+                Verdict::Ok
+            } else {
+                Verdict::Undersampled
+            });
+            r.estimated_bias = Some(bias);
+            r.lines_needed = lines_for_bias(evidence.lines, bias, stderr(e));
+            r
+        }
+    };
+    match info.bound {
+        Bound::None => {}
+        Bound::NonNegative => flag_negative(&mut r, e, info.flag_name),
+        Bound::NonNegativeBelowContinuous => {
+            flag_negative(&mut r, e, info.flag_name);
+            flag_above_continuous(&mut r, e, continuous, info.flag_name);
+        }
+        Bound::UnitInterval => {
+            flag_unit_interval(&mut r, e, info.flag_name);
+            if continuous.is_some_and(|c| c.value.abs() <= 3.0 * stderr(c)) {
+                r.verdict = Verdict::Unusable;
+                r.flags
+                    .push("I_s^c is not distinguishable from 0, so the ratio means nothing".into());
+            }
+        }
+    }
+    Some(r)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn est(value: f64, stderr: f64) -> Option<Estimate> {
+        Some(Estimate {
+            value,
+            stderr: Some(stderr),
+        })
+    }
+
+    fn report(coverage: f64) -> SamplingReport {
+        SamplingReport {
+            sampling: Sampling {
+                rows: 100,
+                sampled_rows: 100,
+                segments_per_row: 1000.0,
+                coverage,
+                singleton_share: 0.1,
+                mse_bias: -0.001,
+            },
+            lines_for_coverage: Some(5_000_000),
+        }
+    }
+
+    fn readings(h: f64, hc: f64, isc: f64) -> ByMeasure<Estimate> {
+        ByMeasure::from_fn(|m| match m {
+            Measure::PositionalEntropy => est(9.0, 0.0),
+            Measure::Entropy => est(h, 0.001),
+            Measure::EntropyCorrected => est(hc, 0.001),
+            Measure::JointEntropy => est(9.0 + h, 0.001),
+            Measure::MutualInformation => est(9.0 - h, 0.001),
+            Measure::MutualInformationCorrected => est(9.0 - hc, 0.001),
+            Measure::ContinuousMutualInformation => est(isc, 0.001),
+            Measure::Accuracy => est((9.0 - h) / isc, 0.001),
+            Measure::AccuracyCorrected => est((9.0 - hc) / isc, 0.001),
+            Measure::RelativeError => est(1.0 - (9.0 - h) / isc, 0.001),
+            Measure::MsePerLine => est(500.0, 0.01),
+            _ => None,
+        })
+    }
+
+    fn of(r: &ByMeasure<Reliability>, m: Measure) -> Reliability {
+        r.get(m).cloned().expect("a verdict")
+    }
+
+    /// Well sampled rows: every reading ok; a plug-in far from its correction: undersampled, with the
+    /// lines to fix it; low coverage: unusable.
+    #[test]
+    fn verdicts_follow_coverage_and_the_plug_in_bias() {
+        let r = verdicts(
+            &readings(7.8, 7.8005, 1.6),
+            Some(&report(0.999)),
+            1_000_000,
+            1_000_000,
+        );
+        assert_eq!(of(&r, Measure::MutualInformation).verdict, Verdict::Ok);
+        assert_eq!(
+            of(&r, Measure::MutualInformationCorrected).verdict,
+            Verdict::Ok
+        );
+        assert_eq!(
+            of(&r, Measure::ContinuousMutualInformation).verdict,
+            Verdict::Ok
+        );
+
+        let r = verdicts(
+            &readings(7.6, 7.8, 1.6),
+            Some(&report(0.999)),
+            1_000_000,
+            1_000_000,
+        );
+        let mi = of(&r, Measure::MutualInformation);
+        assert_eq!(mi.verdict, Verdict::Undersampled);
+        assert!((mi.estimated_bias.unwrap() - 0.2).abs() < 1e-12);
+        // (0.2 / 0.001)^2 times the lines.
+        let needed = mi.lines_needed.unwrap() as f64;
+        assert!((needed / 4e10 - 1.0).abs() < 1e-9, "{needed}");
+        assert_eq!(
+            of(&r, Measure::MutualInformationCorrected).verdict,
+            Verdict::Ok
+        );
+
+        let r = verdicts(
+            &readings(5.0, 7.5, 1.6),
+            Some(&report(0.3)),
+            100_000,
+            100_000,
+        );
+        assert_eq!(
+            of(&r, Measure::MutualInformationCorrected).verdict,
+            Verdict::Unusable
+        );
+        // E(MSE) has an unbiased estimate whatever the coverage: its bias (0.001) is within 0.01.
+        assert_eq!(of(&r, Measure::MsePerLine).verdict, Verdict::Ok);
+    }
+
+    /// Readings beyond the theory's bounds are flagged and never ok.
+    #[test]
+    fn impossible_readings_are_flagged() {
+        // I_s = 3 > I_s^c = 1.6: Proposition 2 broken, accuracy 1.9 > 1.
+        let r = verdicts(
+            &readings(6.0, 6.0, 1.6),
+            Some(&report(0.999)),
+            1_000_000,
+            1_000_000,
+        );
+        let mi = of(&r, Measure::MutualInformation);
+        assert!(
+            mi.flags.iter().any(|f| f.contains("Proposition 2")),
+            "{mi:?}"
+        );
+        assert_ne!(mi.verdict, Verdict::Ok);
+        assert!(!of(&r, Measure::Accuracy).flags.is_empty());
+        // A negative I_s^c, and a ratio over an I_s^c indistinguishable from 0.
+        let mut v = readings(7.8, 7.8, -0.5);
+        v.set(Measure::ContinuousMutualInformation, est(-0.5, 0.01));
+        let r = verdicts(&v, Some(&report(0.999)), 100, 16);
+        assert!(!of(&r, Measure::ContinuousMutualInformation)
+            .flags
+            .is_empty());
+        let mut v = readings(7.8, 7.8, 0.0005);
+        v.set(Measure::ContinuousMutualInformation, est(0.0005, 0.001));
+        let r = verdicts(&v, Some(&report(0.999)), 1_000_000, 1_000_000);
+        assert_eq!(of(&r, Measure::Accuracy).verdict, Verdict::Unusable);
+    }
+}

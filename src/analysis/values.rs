@@ -1,0 +1,279 @@
+//! The values of every measure on a run's whole lines, on each of its groups and, for the jackknife, on
+//! its lines with each group left out; and the estimates with standard errors made from them.
+
+use rayon::prelude::*;
+
+use super::reliability::{self, Reliability, SamplingReport, COVERAGE_OK};
+use crate::measure::bias::{self, CorrectedValues};
+use crate::measure::catalogue::VerdictRule;
+use crate::measure::channel;
+use crate::measure::entropy::xlog2x;
+use crate::measure::estimators::EntropyEstimator;
+use crate::measure::rows::Rows;
+use crate::measure::sampling::{lines_factor_for_coverage, Sampling};
+use crate::measure::visibility::{self, ContinuousValues, DiscreteValues};
+use crate::measure::{ByMeasure, Estimate, Family, Measure};
+use crate::run::{FinishedRun, Spread};
+use crate::sample::tally::{Tally, Wanted};
+use crate::scene::Scene;
+
+/// Measures of one group, of one group left out, or of the whole run.
+#[derive(Clone, Copy, Debug)]
+struct GroupValues {
+    discrete: Option<DiscreteValues>,
+    corrected: Option<CorrectedValues>,
+    continuous: Option<ContinuousValues>,
+    /// The environment patch's area (tracing space), when enclosed.
+    environment_area: Option<f64>,
+    /// How the rows were sampled (when counted).
+    sampling: Option<Sampling>,
+    /// The factor on the lines for a coverage of [`COVERAGE_OK`] (the whole run's values only).
+    lines_factor: Option<f64>,
+}
+
+impl GroupValues {
+    /// The values of a tally; of the enclosed scene when `enclose` ([`Tally::enclosed`]); with the
+    /// extrapolation of the rows' coverage when `extrapolate` (the whole run's).
+    fn of(
+        scene: &Scene,
+        t: &Tally,
+        estimator: EntropyEstimator,
+        enclose: bool,
+        extrapolate: bool,
+    ) -> Self {
+        if enclose {
+            let (enclosed, areas) = t.enclosed(scene);
+            return GroupValues {
+                environment_area: Some(t.environment_area(scene)),
+                ..GroupValues::plain(&areas, &enclosed, estimator, extrapolate)
+            };
+        }
+        GroupValues::plain(&areas(scene), t, estimator, extrapolate)
+    }
+
+    fn plain(areas: &[f64], t: &Tally, estimator: EntropyEstimator, extrapolate: bool) -> Self {
+        let mut values = GroupValues {
+            discrete: None,
+            corrected: None,
+            continuous: ContinuousValues::from_sum(
+                t.counters.cmi_sum.value(),
+                t.counters.cmi_pairs,
+            ),
+            environment_area: None,
+            sampling: None,
+            lines_factor: None,
+        };
+        let Some(c) = t.counts.as_ref().filter(|_| t.counters.lines > 0) else {
+            return values;
+        };
+        // One pass over the counts serves the plug-in and the corrected measures and the sampling.
+        let a = channel::area_distribution(areas);
+        let a = a.as_slice().expect("a fresh array is contiguous");
+        let rows = Rows::gather(a, c, &t.escapes_by_patch, estimator);
+        values.discrete = Some(visibility::discrete_from_rows(a, &rows.sums));
+        values.corrected = Some(bias::corrected_from_rows(a, &rows, c, &t.escapes_by_patch));
+        values.sampling = Some(Sampling::of_rows(a, &rows.sums));
+        if extrapolate {
+            values.lines_factor = lines_factor_for_coverage(a, &rows.sums, COVERAGE_OK);
+        }
+        values
+    }
+
+    fn accuracy(&self) -> Option<f64> {
+        Some(self.discrete?.mutual_information / self.continuous?.mutual_information)
+    }
+
+    fn accuracy_corrected(&self) -> Option<f64> {
+        Some(self.corrected?.mutual_information / self.continuous?.mutual_information)
+    }
+}
+
+fn areas(scene: &Scene) -> Vec<f64> {
+    scene.patches.iter().map(|p| p.area).collect()
+}
+
+/// The visibility side of a finished run.
+pub(super) struct VisibilityOfRun {
+    pub(super) estimates: ByMeasure<Estimate>,
+    /// The groups with lines.
+    pub(super) groups: usize,
+    /// Patches no segment left, and their area fraction (when counted).
+    pub(super) unsampled: Option<(usize, f64)>,
+    /// The environment's area in scene units, when enclosed.
+    pub(super) environment_area: Option<Estimate>,
+    /// Whether the standard errors came from the jackknife.
+    pub(super) jackknifed: bool,
+    /// How the rows were sampled (when counted).
+    pub(super) sampling: Option<SamplingReport>,
+    /// The verdict on every reading.
+    pub(super) reliability: ByMeasure<Reliability>,
+}
+
+/// Every visibility measure of a finished run with its standard error (by the jackknife when asked and
+/// possible), and the environment's area when enclosed.
+pub(super) fn visibility_estimates(
+    scene: &Scene,
+    run: &FinishedRun,
+    estimator: EntropyEstimator,
+    enclose: bool,
+    jackknife: bool,
+    wanted: Wanted,
+) -> VisibilityOfRun {
+    let values_of = |t: &Tally| GroupValues::of(scene, t, estimator, enclose, false);
+    let (all, per_group): (GroupValues, Vec<GroupValues>) = rayon::join(
+        || GroupValues::of(scene, &run.total, estimator, enclose, true),
+        || run.groups.par_iter().map(values_of).collect(),
+    );
+    let replicates = jackknife
+        .then(|| jackknife_replicates(scene, &run.total, &run.groups, estimator))
+        .flatten();
+    let areas = areas(scene);
+    let spread = Spread {
+        all: &all,
+        groups: &per_group,
+        replicates: replicates.as_deref(),
+    };
+    let mut estimates = if run.total.counters.lines == 0 {
+        exact_only(&areas)
+    } else {
+        estimates(&areas, &spread, wanted)
+    };
+    let mut environment_area = None;
+    if enclose {
+        // The environment's area is counted, so H_p has a spread over the groups too.
+        estimates.set(
+            Measure::PositionalEntropy,
+            spread.batch_means(|g| Some(g.discrete?.positional_entropy)),
+        );
+        let scale2 = scene.normalization.scale.powi(2);
+        environment_area = spread.batch_means(|g| Some(g.environment_area? * scale2));
+    }
+    let lines = run.total.counters.lines;
+    let sampling = all.sampling.map(|sampling| SamplingReport {
+        sampling,
+        lines_for_coverage: all.lines_factor.map(|k| (k * lines as f64).ceil() as u64),
+    });
+    let reliability = reliability::verdicts(
+        &estimates,
+        sampling.as_ref(),
+        lines,
+        run.total.counters.pairs,
+    );
+    VisibilityOfRun {
+        estimates,
+        sampling,
+        reliability,
+        groups: per_group.len(),
+        unsampled: all
+            .discrete
+            .map(|d| (d.unsampled_patches, d.unsampled_area_fraction)),
+        environment_area,
+        jackknifed: replicates.is_some(),
+    }
+}
+
+/// The delete-a-group jackknife's replicates: the run's values with each group's lines left out, from
+/// the total's row sums lowered by that group's counts ([`Rows::without_group`]). `None` without pair
+/// counts. Not for an enclosed scene (the environment patch's area is itself estimated from the lines)
+/// nor for Chao–Shen (its second pass needs every count of the replicate): the caller checks.
+fn jackknife_replicates(
+    scene: &Scene,
+    total: &Tally,
+    groups: &[Tally],
+    estimator: EntropyEstimator,
+) -> Option<Vec<GroupValues>> {
+    let total_counts = total.counts.as_ref()?;
+    let a = channel::area_distribution(&areas(scene));
+    let a = a.as_slice()?;
+    let rows = Rows::gather(a, total_counts, &total.escapes_by_patch, estimator);
+    groups
+        .par_iter()
+        .map(|g| {
+            let counts = g.counts.as_ref()?;
+            let left = rows.without_group(
+                a,
+                (total_counts, &total.escapes_by_patch),
+                (counts, &g.escapes_by_patch),
+            );
+            Some(GroupValues {
+                discrete: Some(visibility::discrete_from_rows(a, &left.sums)),
+                // The counts are read only by Chao–Shen, excluded by the caller.
+                corrected: Some(bias::corrected_from_rows(
+                    a,
+                    &left,
+                    counts,
+                    &g.escapes_by_patch,
+                )),
+                continuous: ContinuousValues::from_sum(
+                    total.counters.cmi_sum.minus(g.counters.cmi_sum).value(),
+                    total.counters.cmi_pairs - g.counters.cmi_pairs,
+                ),
+                environment_area: None,
+                sampling: None,
+                lines_factor: None,
+            })
+        })
+        .collect()
+}
+
+/// The estimates of a run in which no segment joined two patches: only the positional entropy (exact,
+/// from the areas) is defined; every visibility measure has no pair to be computed from, and zeros would
+/// read as measurements.
+pub(super) fn exact_only(areas: &[f64]) -> ByMeasure<Estimate> {
+    let mut out = ByMeasure::default();
+    out.set(
+        Measure::PositionalEntropy,
+        Some(Estimate::exact(positional_entropy(areas))),
+    );
+    out
+}
+
+/// Eq. (19), exact from the areas.
+fn positional_entropy(areas: &[f64]) -> f64 {
+    -channel::area_distribution(areas)
+        .iter()
+        .map(|&x| xlog2x(x))
+        .sum::<f64>()
+}
+
+/// The value of the visibility measure `m` in a group's (or the run's) values: the estimator behind each
+/// entry of the catalogue ([`crate::measure::catalogue`]). `None` when the values do not have it.
+fn value_of(m: Measure, g: &GroupValues) -> Option<f64> {
+    match m {
+        Measure::Entropy => Some(g.discrete?.entropy),
+        Measure::EntropyCorrected => Some(g.corrected?.entropy),
+        Measure::JointEntropy => Some(g.discrete?.joint_entropy),
+        Measure::MutualInformation => Some(g.discrete?.mutual_information),
+        Measure::MutualInformationCorrected => Some(g.corrected?.mutual_information),
+        Measure::ContinuousMutualInformation => Some(g.continuous?.mutual_information),
+        Measure::Accuracy => g.accuracy(),
+        Measure::AccuracyCorrected => g.accuracy_corrected(),
+        Measure::RelativeError => Some(1.0 - g.accuracy()?),
+        Measure::MsePerLine => Some(g.discrete?.mse_per_line),
+        Measure::PositionalEntropy
+        | Measure::RadiosityPositionalEntropy
+        | Measure::RadiosityEntropy
+        | Measure::RadiosityEntropyCorrected
+        | Measure::RadiosityMutualInformation
+        | Measure::RadiosityMutualInformationCorrected => None,
+    }
+}
+
+/// Every visibility measure the run gathered what it needs for, with its standard error: exact for
+/// H_p (from the areas); by batch means for a mean (I_s^c), whose batch-means error is exact; else by
+/// the delete-a-group jackknife when the spread has replicates, or batch means.
+fn estimates(areas: &[f64], spread: &Spread<GroupValues>, wanted: Wanted) -> ByMeasure<Estimate> {
+    ByMeasure::from_fn(|m| {
+        let info = m.info();
+        if info.family != Family::Visibility
+            || !info.needs.met_by(wanted.discrete, wanted.continuous)
+        {
+            return None;
+        }
+        match info.verdict {
+            VerdictRule::Exact => Some(Estimate::exact(positional_entropy(areas))),
+            VerdictRule::Mean => spread.batch_means(|g| value_of(m, g)),
+            _ => spread.estimate(|g| value_of(m, g)),
+        }
+    })
+}

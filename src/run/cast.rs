@@ -1,0 +1,278 @@
+//! Casting a run's lines: its empty state, and the rounds of batches that fill it until the line count,
+//! the budget or a stop request ends it.
+//!
+//! A stopped run keeps the longest prefix of finished batches, so its lines are always batches `0..k`: the
+//! same seed gives the same numbers for the same number of lines, whatever the thread count.
+
+use std::time::{Duration, Instant};
+
+use super::batches::LineStream;
+use super::control::{RunControl, StopReason};
+use super::plan::{BatchPlan, BatchSet, MAX_ROUND_KEYS, MAX_ROUND_LINES};
+use super::spec::RunSpec;
+use super::state::{RunState, TracedBatches};
+use crate::measure::radiosity::{MaterialError, PatchMaterials};
+use crate::sample::tally::Wanted;
+use crate::scene::Scene;
+use crate::trace::{TraceError, Tracer};
+
+/// What a precision target's measure reads on the run so far: its standard error, and whether its
+/// reading is reliable. The analysis computes it (`analysis::cast`); the engine only decides, from
+/// it, whether to stop and how long the next round is.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TargetReading {
+    /// The standard error (`None`: none could be estimated yet).
+    pub stderr: Option<f64>,
+    /// Whether the reading's verdict is ok.
+    pub reliable: bool,
+}
+
+/// Reads a precision target's measure on a run's state (between rounds).
+pub type TargetWatch<'a> = &'a (dyn Fn(&RunState) -> TargetReading + Sync);
+
+/// What a run's caller sees between rounds: the precision target's reading (the run stops when its
+/// target is met), and the state after each round (to save a checkpoint).
+pub struct CastHooks<'a> {
+    /// Reads the target's measure; without it a target never stops the run.
+    pub target: Option<TargetWatch<'a>>,
+    /// Sees the state after each round.
+    pub after_round: &'a mut dyn FnMut(&RunState),
+}
+
+/// Which measures a run of `cfg` gathers on `scene`: the pair counts also for the radiosity measures
+/// when something emits. Checks the materials first when radiosity is asked for.
+fn gathered(scene: &Scene, cfg: &RunSpec) -> Result<Wanted, MaterialError> {
+    let lit = if cfg.measures.radiosity {
+        PatchMaterials::of_scene(scene)?.any_emission()
+    } else {
+        false
+    };
+    Ok(Wanted {
+        discrete: cfg.measures.discrete || lit || cfg.per_patch,
+        continuous: cfg.measures.continuous,
+        per_patch: cfg.per_patch && cfg.measures.continuous,
+    })
+}
+
+/// The empty state of a run of `cfg` on `scene`, checked before any line is cast (the materials, when
+/// radiosity is asked for).
+pub fn start(scene: &Scene, cfg: &RunSpec) -> Result<RunState, MaterialError> {
+    Ok(RunState::new(
+        cfg.plan(),
+        cfg.group_count(),
+        gathered(scene, cfg)?,
+    ))
+}
+
+/// Shard `index` (from 1) of `count`: a contiguous block of about 1/count of a run's batches.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub struct Shard {
+    /// Which shard, 1 to `count`.
+    pub index: u32,
+    /// How many shards.
+    pub count: u32,
+}
+
+/// The batches a run casts: all of them, or one shard's share.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Scope {
+    /// Every batch of the plan.
+    All,
+    /// One shard's batches.
+    Shard(Shard),
+}
+
+impl Scope {
+    /// The scope of a run that is `shard`, or all of it.
+    pub fn of(shard: Option<Shard>) -> Self {
+        shard.map_or(Scope::All, Scope::Shard)
+    }
+
+    /// The batches of a plan of `batches` batches in this scope.
+    pub fn batches(self, batches: u64) -> std::ops::Range<u64> {
+        match self {
+            Scope::All => 0..batches,
+            Scope::Shard(Shard { index, count }) => {
+                let (k, m) = (u64::from(index.max(1) - 1), u64::from(count.max(1)));
+                (k * batches / m)..((k + 1) * batches / m)
+            }
+        }
+    }
+}
+
+/// How a run casts its batches: which of them, and in rounds of about how long.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CastOptions {
+    /// The batches to cast.
+    pub scope: Scope,
+    /// Keep rounds to about this many seconds (a checkpointed run saves between rounds); `None`: rounds
+    /// as large as memory allows. Rounds change nothing in the numbers.
+    pub round_seconds: Option<f64>,
+}
+
+impl Default for CastOptions {
+    fn default() -> Self {
+        CastOptions {
+            scope: Scope::All,
+            round_seconds: None,
+        }
+    }
+}
+
+/// Lines still to cast in `scope` for a run in `state`.
+pub fn remaining_lines(state: &RunState, scope: Scope) -> u64 {
+    let plan = state.plan();
+    let range = scope.batches(plan.batches());
+    let missing = state.done().missing(range.end);
+    missing
+        .indices_within(range)
+        .into_iter()
+        .map(|b| plan.batch_len(b) as u64)
+        .sum()
+}
+
+/// Casts the batches of `options.scope` not done yet in `state`, in rounds, until they are all done,
+/// the budget is spent or a stop is requested; every finished batch is kept, and `after_round` sees the
+/// state after each round (to save a checkpoint).
+pub fn cast(
+    scene: &Scene,
+    tracer: &dyn Tracer,
+    cfg: &RunSpec,
+    state: &mut RunState,
+    options: CastOptions,
+    control: &RunControl,
+    hooks: CastHooks,
+) -> Result<StopReason, TraceError> {
+    let start = Instant::now();
+    let plan = state.plan();
+    let wanted = state.wanted();
+    let stream = LineStream {
+        plan,
+        source: cfg.source,
+        seed: cfg.seed,
+    };
+    let deadline = cfg
+        .budget
+        .seconds
+        .map(|s| start + Duration::from_secs_f64(s.max(0.0)));
+    let stop = |b: u64| {
+        let late = deadline.is_some_and(|d| Instant::now() >= d);
+        if control.stop_requested() || late {
+            return true;
+        }
+        control.started(plan.batch_len(b) as u64);
+        false
+    };
+    let scope = options.scope.batches(plan.batches());
+    // Rounds bound the memory held in pair keys and let a budget run check itself.
+    let first_round = (4 * state.group_count()).max(64);
+    let mut round = if cfg.budget.is_open_ended() || options.round_seconds.is_some() {
+        first_round
+    } else {
+        max_round_batches(plan, wanted, state)
+    };
+    let mut cast_batches = 0u64;
+    // The next batch to look at, and the last round's batches when they are not counted yet: without a
+    // precision target the next round's size does not depend on the counts, so a round is counted while
+    // the next one is traced, which keeps both cores busy through the counting's serial parts.
+    let mut cursor = scope.start;
+    let mut pending: Option<TracedBatches> = None;
+    let stop_reason = loop {
+        let (batches, next) = next_batches(state.done(), cursor, scope.end, round);
+        let trace = || TracedBatches::trace(scene, tracer, &stream, &batches, wanted, &stop);
+        let (traced, complete) = match pending.take() {
+            Some(previous) => {
+                let (traced, ()) = rayon::join(trace, || state.add(scene, previous));
+                (hooks.after_round)(state);
+                traced?
+            }
+            None => trace()?,
+        };
+        cursor = next;
+        cast_batches += traced.len() as u64;
+        let ended = if !complete {
+            Some(if control.stop_requested() {
+                StopReason::Interrupted
+            } else {
+                StopReason::Seconds
+            })
+        } else if cursor >= scope.end {
+            Some(StopReason::Lines)
+        } else if deadline.is_some_and(|d| Instant::now() >= d) {
+            Some(StopReason::Seconds)
+        } else {
+            None
+        };
+        if ended.is_some() || cfg.budget.target.is_some() {
+            state.add(scene, traced);
+            (hooks.after_round)(state);
+        } else {
+            pending = Some(traced);
+        }
+        if let Some(reason) = ended {
+            break reason;
+        }
+        if let (Some(target), Some(watch)) = (cfg.budget.target, hooks.target) {
+            let done = state.batches_done();
+            let TargetReading {
+                stderr: se,
+                reliable,
+            } = watch(state);
+            match se {
+                Some(se) if se <= target.stderr && reliable => break StopReason::Target,
+                // stderr ~ 1/sqrt(lines): aim 10% past the predicted need, at most doubling per round.
+                Some(se) if se > target.stderr => {
+                    let need = done as f64 * (se / target.stderr).powi(2) * 1.1;
+                    round = ((need as u64).saturating_sub(done)).clamp(1, done.max(1));
+                }
+                // Small enough an error on a biased reading: double, since the bias falls faster.
+                _ => round = done.max(1),
+            }
+        } else if let Some(seconds) = options.round_seconds {
+            // Rounds of about `seconds` at the rate so far.
+            let rate = cast_batches as f64 / start.elapsed().as_secs_f64().max(1e-3);
+            round = ((rate * seconds) as u64).max(first_round);
+        } else {
+            // Doubling: few rounds, and a time budget is checked before every batch anyway.
+            round = state.batches_done().max(64);
+        }
+        round = round.min(max_round_batches(plan, wanted, state));
+    };
+    Ok(stop_reason)
+}
+
+/// The most batches a round may hold: [`MAX_ROUND_LINES`], and when pairs are counted no more than
+/// about [`MAX_ROUND_KEYS`] pair keys at the run's pairs per line so far (a first round assumes four).
+/// Rounds change no number, only the memory and the time between counts.
+fn max_round_batches(plan: BatchPlan, wanted: Wanted, state: &RunState) -> u64 {
+    let by_lines = MAX_ROUND_LINES;
+    let by_keys = if wanted.discrete {
+        let (lines, pairs) = state
+            .filled_groups()
+            .iter()
+            .fold((0u64, 0u64), |(l, p), t| {
+                (l + t.counters.lines, p + t.counters.pairs)
+            });
+        let pairs_per_line = if lines > 0 {
+            pairs as f64 / lines as f64
+        } else {
+            4.0
+        };
+        (MAX_ROUND_KEYS as f64 / pairs_per_line.max(0.25)) as u64
+    } else {
+        u64::MAX
+    };
+    (by_lines.min(by_keys) / plan.batch_size).max(1)
+}
+
+/// Up to `count` batches from `cursor` to `end` that are not `done`, and where to look next.
+fn next_batches(done: &BatchSet, mut cursor: u64, end: u64, count: u64) -> (Vec<u64>, u64) {
+    let mut out = Vec::with_capacity(count.min(1 << 16) as usize);
+    while cursor < end && (out.len() as u64) < count {
+        if !done.contains(cursor) {
+            out.push(cursor);
+        }
+        cursor += 1;
+    }
+    (out, cursor)
+}

@@ -1,0 +1,321 @@
+//! What a run is: [`RunSpec`], every setting that determines its numbers.
+//!
+//! A spec is a value: the command line is parsed into one once, a saved state stores it as it is
+//! ([`super::persist`]), and a resumed or merged run compares specs by their derived equality
+//! ([`RunSpec::difference`] says how two differ). How a run runs (its threads, its tracer, its
+//! progress display, where its outputs go) is not part of it: none of that changes a number. The
+//! tracer and its query are left out on purpose: Embree and the pure-Rust tracer give the same hits by
+//! design (`scx crosscheck` checks it line by line), so parts of one run may be traced by either.
+
+use serde::{Deserialize, Serialize};
+
+use super::control::Budget;
+use super::errors::ErrorMethod;
+use super::plan::BatchPlan;
+use crate::measure::estimators::EntropyEstimator;
+use crate::measure::radiosity::SolveOptions;
+use crate::sample::lines::LineSource;
+
+/// Default number of independent groups of lines behind every standard error.
+pub const DEFAULT_GROUPS: usize = 16;
+
+/// The entropy estimator behind the bias-corrected H_s and I_s, chosen by measurement against the exact
+/// I_s of `@cube:N` (docs/results.md, "The default estimator").
+pub const DEFAULT_ESTIMATOR: EntropyEstimator = EntropyEstimator::ChaoWangJost;
+
+/// Which families of measures a run computes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Measures {
+    /// The discrete measures from pair counts (H_s, I_s, E(MSE), ..., paper sec. 3.1).
+    pub discrete: bool,
+    /// The continuous mutual information I_s^c (eq. 27, sec. 3.2).
+    pub continuous: bool,
+    /// The radiosity measures (sec. 4), when the scene emits; they need the pair counts, which are then
+    /// gathered whatever `discrete` says.
+    pub radiosity: bool,
+}
+
+impl Measures {
+    /// Every measure.
+    pub const ALL: Measures = Measures {
+        discrete: true,
+        continuous: true,
+        radiosity: true,
+    };
+
+    /// The visibility measures only (no radiosity).
+    pub const VISIBILITY: Measures = Measures {
+        discrete: true,
+        continuous: true,
+        radiosity: false,
+    };
+}
+
+/// A run: every setting that determines its numbers.
+///
+/// Two runs can be parts of one run (shards to merge, a state to resume) when their specs are equal but
+/// for [`RunSpec::lines`] and [`RunSpec::per_patch`] ([`RunSpec::common`]).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RunSpec {
+    /// Global lines to cast (a cap when a budget is set). Parts of one run may differ: a resumed run goes
+    /// on to more lines.
+    pub lines: u64,
+    /// Seed of the line streams.
+    pub seed: u64,
+    /// Independent lines, or bundles of parallel lines ([`LineSource`]); a bundle never straddles two
+    /// batches, so the group spread includes the correlation within a bundle.
+    pub source: LineSource,
+    /// Groups for the standard errors ([`super::errors`]).
+    pub groups: usize,
+    /// Which measures to compute.
+    pub measures: Measures,
+    /// The estimator of the bias-corrected H_s and I_s.
+    pub estimator: EntropyEstimator,
+    /// How the standard errors of the count-based measures are estimated.
+    pub errors: ErrorMethod,
+    /// Close an open scene with the environment patch ([`crate::sample::environment`]): escapes become
+    /// pairs with it, and every measure is that of the enclosed scene. Changes nothing when nothing
+    /// escapes.
+    pub enclose: bool,
+    /// When to stop before `lines`.
+    pub budget: Budget,
+    /// How the radiosity system is solved.
+    pub solve: SolveOptions,
+    /// Also share the measures out among the patches (the per-patch results); gathers eq. (27)'s terms
+    /// per patch, which costs nothing when left off. Not with `enclose` on an open scene. Parts of one
+    /// run may differ: their merge keeps the per-patch sums only when every part has them.
+    pub per_patch: bool,
+}
+
+impl RunSpec {
+    /// `lines` lines from `seed`, every measure, default groups and estimator, no budget.
+    pub fn new(lines: u64, seed: u64) -> Self {
+        RunSpec {
+            lines,
+            seed,
+            source: LineSource::Independent,
+            groups: DEFAULT_GROUPS,
+            measures: Measures::ALL,
+            estimator: DEFAULT_ESTIMATOR,
+            errors: ErrorMethod::Groups,
+            enclose: false,
+            budget: Budget::default(),
+            solve: SolveOptions::default(),
+            per_patch: false,
+        }
+    }
+
+    /// How the run's lines are cut into batches: fixed by the line count, or full batches when a budget
+    /// may end the run anywhere.
+    pub fn plan(&self) -> BatchPlan {
+        if self.budget.is_open_ended() {
+            BatchPlan::open_ended(self.lines, self.source)
+        } else {
+            BatchPlan::for_source(self.lines, self.source)
+        }
+    }
+
+    /// The standard-error groups of the run: the groups asked for, but one per batch when a short run
+    /// has fewer batches than that (and always at least 2).
+    pub fn group_count(&self) -> usize {
+        let batches = self.plan().batches();
+        (self.groups.max(2) as u64).min(batches.max(2)) as usize
+    }
+
+    /// The settings two parts of one run must share: the spec without its line count and per-patch
+    /// flag.
+    pub fn common(&self) -> RunSpec {
+        RunSpec {
+            lines: 0,
+            per_patch: false,
+            ..self.clone()
+        }
+    }
+
+    /// The same run continued to `lines` lines (a resume): refused when `lines` is fewer than the run's,
+    /// or when the longer run would cut its lines differently (other batches or groups), which would
+    /// change the numbers of the lines already cast.
+    pub fn extended_to(&self, lines: u64) -> Result<RunSpec, ExtendError> {
+        let longer = RunSpec {
+            lines,
+            ..self.clone()
+        };
+        if lines < self.lines {
+            return Err(ExtendError::Fewer {
+                lines: self.lines,
+                asked: lines,
+            });
+        }
+        let (old, new) = (self.plan(), longer.plan());
+        if new.batch_size != old.batch_size || longer.group_count() != self.group_count() {
+            return Err(ExtendError::CutDifferently {
+                lines: self.lines,
+                batch_size: old.batch_size,
+                asked: lines,
+                asked_batch_size: new.batch_size,
+                asked_groups: longer.group_count(),
+            });
+        }
+        Ok(longer)
+    }
+
+    /// The first settings in which two runs that should be parts of one run differ, as `(setting, ours,
+    /// theirs)` in words (nested settings as `budget.target`); `None` when they can be combined. The
+    /// line counts are compared too unless `lines_may_differ`.
+    pub fn difference(&self, other: &RunSpec, lines_may_differ: bool) -> Option<SpecDifference> {
+        let keep_lines = |s: &RunSpec| RunSpec {
+            lines: if lines_may_differ { 0 } else { s.lines },
+            ..s.common()
+        };
+        let (ours, theirs) = (keep_lines(self), keep_lines(other));
+        if ours == theirs {
+            return None;
+        }
+        let as_json = |s: &RunSpec| serde_json::to_value(s).expect("a spec always serialises");
+        first_difference("", &as_json(&ours), &as_json(&theirs))
+    }
+}
+
+/// A setting in which two specs differ, with both values in words.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct SpecDifference {
+    /// The setting (`seed`, `budget.target`).
+    pub setting: String,
+    /// Its value in the first spec.
+    pub ours: String,
+    /// Its value in the second.
+    pub theirs: String,
+}
+
+/// The first differing leaf of two JSON values, by path.
+fn first_difference(
+    path: &str,
+    a: &serde_json::Value,
+    b: &serde_json::Value,
+) -> Option<SpecDifference> {
+    use serde_json::Value;
+    if let (Value::Object(x), Value::Object(y)) = (a, b) {
+        for (key, va) in x {
+            let vb = y.get(key).unwrap_or(&Value::Null);
+            let inner = if path.is_empty() {
+                key.clone()
+            } else {
+                format!("{path}.{key}")
+            };
+            if let Some(d) = first_difference(&inner, va, vb) {
+                return Some(d);
+            }
+        }
+        return None;
+    }
+    (a != b).then(|| SpecDifference {
+        setting: path.to_string(),
+        ours: in_words(a),
+        theirs: in_words(b),
+    })
+}
+
+/// A JSON value as a reader would write it: strings bare, `null` as `none`, objects as `key value`.
+fn in_words(v: &serde_json::Value) -> String {
+    use serde_json::Value;
+    match v {
+        Value::Null => "none".into(),
+        Value::String(s) => s.clone(),
+        Value::Object(m) => m
+            .iter()
+            .map(|(k, v)| format!("{k} {}", in_words(v)))
+            .collect::<Vec<_>>()
+            .join(", "),
+        other => other.to_string(),
+    }
+}
+
+/// Why a run cannot be continued to more lines.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum ExtendError {
+    /// Fewer lines than the run has.
+    #[error("a run of {lines} lines cannot be continued to fewer lines ({asked})")]
+    Fewer {
+        /// The run's lines.
+        lines: u64,
+        /// The lines asked for.
+        asked: u64,
+    },
+    /// The longer run would have other batches or groups.
+    #[error(
+        "a run of {lines} lines (batches of {batch_size}) can be continued to more lines cut the same \
+         way: {asked} lines would be batches of {asked_batch_size} in {asked_groups} groups (from {} lines \
+         on, every run has batches of {})",
+        BatchPlan::FULL_FROM,
+        BatchPlan::MAX_BATCH
+    )]
+    CutDifferently {
+        /// The run's lines.
+        lines: u64,
+        /// Its batch size.
+        batch_size: u64,
+        /// The lines asked for.
+        asked: u64,
+        /// Their batch size.
+        asked_batch_size: u64,
+        /// Their groups.
+        asked_groups: usize,
+    },
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::measure::Measure;
+    use crate::run::control::Target;
+
+    /// Specs that differ only in lines and per-patch sums combine; any other setting is named, nested
+    /// ones by their path, in words.
+    #[test]
+    fn differences_are_named_in_words() {
+        let a = RunSpec::new(1_000_000, 1);
+        let more = RunSpec {
+            per_patch: true,
+            ..RunSpec::new(2_000_000, 1)
+        };
+        assert_eq!(a.difference(&more, true), None);
+        let d = a.difference(&more, false).unwrap();
+        assert_eq!((d.setting.as_str(), d.ours.as_str()), ("lines", "1000000"));
+        let seeded = RunSpec::new(1_000_000, 7);
+        let d = a.difference(&seeded, true).unwrap();
+        assert_eq!(
+            (d.setting, d.ours, d.theirs),
+            ("seed".into(), "1".into(), "7".into())
+        );
+        let targeted = RunSpec {
+            budget: Budget {
+                seconds: None,
+                target: Some(Target {
+                    measure: Measure::Entropy,
+                    stderr: 0.01,
+                }),
+            },
+            ..a.clone()
+        };
+        let d = a.difference(&targeted, true).unwrap();
+        assert_eq!(d.setting, "budget.target");
+        assert_eq!(
+            (d.ours.as_str(), d.theirs.as_str()),
+            ("none", "measure entropy, stderr 0.01")
+        );
+    }
+
+    /// A run continues to more lines only when they are cut the same way.
+    #[test]
+    fn runs_extend_only_when_cut_the_same_way() {
+        let run = RunSpec::new(300_000, 1);
+        assert_eq!(run.extended_to(700_000).unwrap().lines, 700_000);
+        assert!(matches!(
+            run.extended_to(100_000),
+            Err(ExtendError::Fewer { .. })
+        ));
+        let short = RunSpec::new(200_000, 1);
+        let e = short.extended_to(300_000).unwrap_err().to_string();
+        assert!(e.contains("batches of 3125") && e.contains("262144"), "{e}");
+    }
+}
