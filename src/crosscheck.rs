@@ -11,16 +11,27 @@
 //!
 //! Every line that breaks one of these is a difference. The measures are then compared by running
 //! [`analyze`] with each tracer on the same seed.
+//!
+//! Random lines practically never meet a vertex or an edge, nor lie in a triangle's plane: [`aimed`]
+//! makes lines aimed at exactly those places, of several kinds, and [`compare_aimed`] compares the two
+//! tracers on them, kind by kind, by the same rules.
+
+pub mod aimed;
 
 use std::fmt;
 
+use rayon::prelude::*;
+
 use crate::analysis::{analyze, Analysis, AnalysisError};
+use crate::geom::DVec3;
 use crate::measure::{Estimate, Measure};
 use crate::run::{
-    all_batches, map_batches, Batch, LineStream, Measures, RunControl, RunSpec, TraceBuffers,
+    all_batches, map_batches, BatchPlan, LineStream, Measures, RunControl, RunSpec, TraceBuffers,
 };
 use crate::scene::Scene;
-use crate::trace::{Hit, Line, TraceError, Tracer};
+use crate::trace::rust::bvh::margin;
+use crate::trace::{Hit, Line, LineHits, TraceError, Tracer};
+use aimed::{Aim, AimKind, AimTargets};
 
 /// How far apart two hits' distances may be and still agree.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -195,7 +206,9 @@ pub fn compare_hits(
         scene.bounding_radius(),
         &all_batches(&stream),
         &|_| false,
-        |buf: &mut Buffers, batch| compare_batch(scene, a, b, cfg, batch, buf),
+        |buf: &mut Buffers, batch| {
+            compare_batch(scene, (a, b), cfg, batch.first_line, batch.lines, buf)
+        },
     )?;
     let mut total = HitComparison::empty((a.name(), b.name()), cfg.tolerance);
     for (_, p) in parts {
@@ -204,22 +217,22 @@ pub fn compare_hits(
     Ok(total)
 }
 
+/// Compares the two tracers on one batch of lines, whose first line is line `first_line` of its run.
 fn compare_batch(
     scene: &Scene,
-    a: &dyn Tracer,
-    b: &dyn Tracer,
+    (a, b): (&dyn Tracer, &dyn Tracer),
     cfg: &CrossCheckConfig,
-    batch: Batch<'_>,
+    first_line: u64,
+    lines: &[Line],
     buf: &mut Buffers,
 ) -> Result<HitComparison, TraceError> {
-    buf.a.trace(a, batch.lines)?;
-    buf.b.trace(b, batch.lines)?;
+    buf.a.trace(a, lines)?;
+    buf.b.trace(b, lines)?;
     let (hits_a, hits_b) = (&buf.a.hits, &buf.b.hits);
-    let count = batch.lines.len();
     let mut part = HitComparison::empty((a.name(), b.name()), cfg.tolerance);
-    part.lines = count as u64;
+    part.lines = lines.len() as u64;
     part.hits = (hits_a.hits.len() as u64, hits_b.hits.len() as u64);
-    for k in 0..count {
+    for (k, line) in lines.iter().enumerate() {
         let (ra, rb) = (hits_a.of_line(k), hits_b.of_line(k));
         let (kind, ulps) = compare_line(scene, ra, rb, cfg.tolerance);
         part.max_ulps = part.max_ulps.max(ulps);
@@ -227,8 +240,8 @@ fn compare_batch(
         part.differing[kind as usize] += 1;
         if part.examples.len() < cfg.examples {
             part.examples.push(LineDifference {
-                index: batch.first_line + k as u64,
-                line: batch.lines[k],
+                index: first_line + k as u64,
+                line: *line,
                 kind,
                 a: ra.to_vec(),
                 b: rb.to_vec(),
@@ -236,6 +249,172 @@ fn compare_batch(
         }
     }
     Ok(part)
+}
+
+/// What to compare on aimed lines ([`aimed`]).
+#[derive(Clone, Debug)]
+pub struct AimedConfig {
+    /// Lines of each kind.
+    pub lines_per_kind: u64,
+    /// The kinds to cast, in report order.
+    pub kinds: Vec<AimKind>,
+    /// Seed of the lines' random streams.
+    pub seed: u64,
+    /// Distance tolerance.
+    pub tolerance: Tolerance,
+    /// How many differing lines to keep as examples, per kind.
+    pub examples: usize,
+}
+
+/// The two tracers on the aimed lines of one kind.
+#[derive(Clone, Debug)]
+pub struct KindComparison {
+    /// The kind of lines.
+    pub kind: AimKind,
+    /// How many targets (vertices, edges, sides of triangles, faces) its lines go round; 0 when the
+    /// scene has none, and the kind cast no line.
+    pub targets: usize,
+    /// The hit comparison; example indices count the kind's lines from 0.
+    pub hits: HitComparison,
+    /// What each example line was aimed at, in the order of `hits.examples`.
+    pub aims: Vec<Aim>,
+    /// The first tracer's hits whose point lies outside its triangle's box grown by the tracers' margin
+    /// (1/65536 of the scene's size): hits of lines that lie in the triangle's plane to within rounding, where the
+    /// watertight test's verdict and distance are rounding ([`aimed`], "What agreement means on these
+    /// lines").
+    pub stray_hits: u64,
+}
+
+/// A cross-check on aimed lines, kind by kind.
+#[derive(Clone, Debug)]
+pub struct AimedCheck {
+    /// The scene's name.
+    pub scene: String,
+    /// Seed.
+    pub seed: u64,
+    /// One comparison per kind asked for, in that order.
+    pub kinds: Vec<KindComparison>,
+}
+
+impl AimedCheck {
+    /// Lines cast, all kinds.
+    pub fn lines(&self) -> u64 {
+        self.kinds.iter().map(|k| k.hits.lines).sum()
+    }
+
+    /// Lines that differ, all kinds.
+    pub fn differing_lines(&self) -> u64 {
+        self.kinds.iter().map(|k| k.hits.differing_lines()).sum()
+    }
+
+    /// Whether the tracers agree on every aimed line.
+    pub fn passed(&self) -> bool {
+        self.differing_lines() == 0
+    }
+}
+
+/// Traces `cfg.lines_per_kind` aimed lines of each kind with both tracers and compares their canonical
+/// hits line by line, as [`compare_hits`] does random lines: in parallel over the batches of every
+/// kind, with results independent of the thread count.
+pub fn compare_aimed(
+    scene: &Scene,
+    a: &dyn Tracer,
+    b: &dyn Tracer,
+    cfg: &AimedConfig,
+) -> Result<AimedCheck, TraceError> {
+    let targets = AimTargets::new(scene);
+    let boxes = GrownBoxes::new(scene);
+    let plan = BatchPlan::new(cfg.lines_per_kind);
+    let per_batch = CrossCheckConfig {
+        lines: cfg.lines_per_kind,
+        seed: cfg.seed,
+        tolerance: cfg.tolerance,
+        examples: cfg.examples,
+    };
+    let jobs: Vec<(usize, u64)> = (0..cfg.kinds.len())
+        .filter(|&k| targets.count(cfg.kinds[k]) > 0)
+        .flat_map(|k| (0..plan.batches()).map(move |batch| (k, batch)))
+        .collect();
+    let parts: Vec<(usize, HitComparison, Vec<Aim>, u64)> = jobs
+        .par_iter()
+        .map_init(
+            || (Vec::new(), Vec::new(), Buffers::default()),
+            |(lines, aims, buf), &(k, batch)| {
+                lines.clear();
+                aims.clear();
+                targets.draw(cfg.kinds[k], cfg.seed, &plan, batch, lines, aims);
+                let first = plan.first_line(batch);
+                let part = compare_batch(scene, (a, b), &per_batch, first, lines, buf)?;
+                let stray = boxes.stray_hits(lines, &buf.a.hits);
+                let example_aims = part
+                    .examples
+                    .iter()
+                    .map(|d| aims[(d.index - first) as usize])
+                    .collect();
+                Ok((k, part, example_aims, stray))
+            },
+        )
+        .collect::<Result<_, TraceError>>()?;
+    let mut kinds: Vec<KindComparison> = cfg
+        .kinds
+        .iter()
+        .map(|&kind| KindComparison {
+            kind,
+            targets: targets.count(kind),
+            hits: HitComparison::empty((a.name(), b.name()), cfg.tolerance),
+            aims: Vec::new(),
+            stray_hits: 0,
+        })
+        .collect();
+    for (k, part, aims, stray) in parts {
+        let into = &mut kinds[k];
+        into.stray_hits += stray;
+        let room = cfg.examples.saturating_sub(into.aims.len());
+        into.aims.extend(aims.into_iter().take(room));
+        into.hits.merge(part, cfg.examples);
+    }
+    Ok(AimedCheck {
+        scene: scene.name.clone(),
+        seed: cfg.seed,
+        kinds,
+    })
+}
+
+/// Every triangle's box grown by the tracers' [`margin`], in f64: the boxes both tracers propose
+/// candidates from.
+struct GrownBoxes {
+    boxes: Vec<(DVec3, DVec3)>,
+}
+
+impl GrownBoxes {
+    fn new(scene: &Scene) -> Self {
+        let m = DVec3::splat(f64::from(margin(scene)));
+        let corner = |v: u32| DVec3::from_array(scene.positions[v as usize].map(f64::from));
+        let boxes = scene
+            .triangles
+            .iter()
+            .map(|t| {
+                let [a, b, c] = t.map(corner);
+                (a.min(b).min(c) - m, a.max(b).max(c) + m)
+            })
+            .collect();
+        GrownBoxes { boxes }
+    }
+
+    /// How many of `hits` (of `lines`) lie outside their triangle's grown box.
+    fn stray_hits(&self, lines: &[Line], hits: &LineHits) -> u64 {
+        let mut stray = 0;
+        for (k, line) in lines.iter().enumerate() {
+            let origin = DVec3::from_array(line.origin.map(f64::from));
+            let dir = DVec3::from_array(line.dir.map(f64::from));
+            for h in hits.of_line(k) {
+                let p = origin + f64::from(h.t) * dir;
+                let (lo, hi) = self.boxes[h.triangle as usize];
+                stray += u64::from(p.cmplt(lo).any() || p.cmpgt(hi).any());
+            }
+        }
+        stray
+    }
 }
 
 /// One measure from both runs.
@@ -420,6 +599,112 @@ pub fn report(check: &CrossCheck, scene: &Scene) -> String {
     } else {
         "FAIL: some lines differ beyond the tolerance\n"
     };
+    s
+}
+
+/// A readable report of a cross-check on aimed lines: per kind, the lines cast and the lines that
+/// differ (by hit count, patch, distance), then the first `show` differing lines; `scene` names the
+/// patches of their hits.
+pub fn report_aimed(check: &AimedCheck, scene: &Scene, show: usize) -> String {
+    let Some(first) = check.kinds.first() else {
+        return format!(
+            "crosscheck {}: no kind of aimed lines asked for\n",
+            check.scene
+        );
+    };
+    let (na, nb) = first.hits.names;
+    let mut s = format!(
+        "crosscheck {} seed {}: {} aimed lines, {} kinds\n",
+        check.scene,
+        check.seed,
+        check.lines(),
+        check.kinds.len()
+    );
+    s += &format!(
+        "tolerance: same hit count, same patches, |t_a - t_b| <= {} ulps at max(t, 1); measures are not \
+         compared (aimed lines are not uniformly distributed)\n",
+        first.hits.tolerance.ulps
+    );
+    s += &format!(
+        "{:<16} {:>8} {:>9} {:>11} {:>11} {:>9} {:>6} {:>6} {:>8} {:>9} {:>6}\n",
+        "kind",
+        "targets",
+        "lines",
+        na,
+        nb,
+        "differing",
+        "count",
+        "patch",
+        "distance",
+        "max ulps",
+        "stray"
+    );
+    let mut total = HitComparison::empty((na, nb), first.hits.tolerance);
+    let mut stray = 0;
+    for k in &check.kinds {
+        s += &kind_row(k.kind.name(), k.targets.to_string(), &k.hits, k.stray_hits);
+        total.merge(k.hits.clone(), 0);
+        stray += k.stray_hits;
+    }
+    s += &kind_row("all", String::new(), &total, stray);
+    s += &format!(
+        "stray: {na} hits further than the box margin from their triangle (lines in its plane to within \
+         rounding, where the hit and its t are rounding; both tracers round alike)\n"
+    );
+    let examples = check
+        .kinds
+        .iter()
+        .flat_map(|k| k.hits.examples.iter().zip(&k.aims))
+        .take(show);
+    for (d, aim) in examples {
+        s += &format!(
+            "  {} line {} ({}): {}\n    origin {:?} dir {:?}\n    {na}: {}\n    {nb}: {}\n",
+            aim.kind,
+            d.index,
+            d.kind,
+            describe_aim(aim),
+            d.line.origin,
+            d.line.dir,
+            fmt_hits(scene, &d.a),
+            fmt_hits(scene, &d.b)
+        );
+    }
+    s += if check.passed() {
+        "PASS: every aimed line agrees\n"
+    } else {
+        "FAIL: some aimed lines differ beyond the tolerance\n"
+    };
+    s
+}
+
+/// One row of the aimed report's table.
+fn kind_row(name: &str, targets: String, h: &HitComparison, stray: u64) -> String {
+    format!(
+        "{:<16} {:>8} {:>9} {:>11} {:>11} {:>9} {:>6} {:>6} {:>8} {:>9.1} {:>6}\n",
+        name,
+        targets,
+        h.lines,
+        h.hits.0,
+        h.hits.1,
+        h.differing_lines(),
+        h.differing[0],
+        h.differing[1],
+        h.differing[2],
+        h.max_ulps,
+        stray
+    )
+}
+
+/// Where an aimed line was aimed, in words.
+fn describe_aim(aim: &Aim) -> String {
+    let p = |v: DVec3| format!("({:.7}, {:.7}, {:.7})", v.x, v.y, v.z);
+    let mut s = format!("through {} of triangle {}", p(aim.through), aim.triangle);
+    if let Some(end) = aim.also_through {
+        s += &format!(" and {}", p(end));
+    }
+    if let Some((normal, angle)) = aim.plane {
+        s += &format!(", {angle:.1e} rad from the plane of normal {}", p(normal));
+    }
     s
 }
 
