@@ -117,6 +117,17 @@ fn merged_shards_are_the_single_run() {
 
 /// Spawns an analysis, interrupts it with `signal` after `after` seconds and waits for it.
 fn interrupt(args: &[&str], signal: &str, after: f64) -> std::process::Output {
+    interrupt_when(args, signal, after, || true)
+}
+
+/// [`interrupt`], but waiting (up to two minutes more) after `after` seconds until `ready` says so: on a
+/// loaded machine a fixed delay may come before the run has done what the test needs (a checkpoint).
+fn interrupt_when(
+    args: &[&str],
+    signal: &str,
+    after: f64,
+    ready: impl Fn() -> bool,
+) -> std::process::Output {
     let child = Command::new(env!("CARGO_BIN_EXE_scx"))
         .args(args)
         .stdout(Stdio::piped())
@@ -124,6 +135,10 @@ fn interrupt(args: &[&str], signal: &str, after: f64) -> std::process::Output {
         .spawn()
         .unwrap();
     std::thread::sleep(std::time::Duration::from_secs_f64(after));
+    let waited = std::time::Instant::now();
+    while !ready() && waited.elapsed().as_secs() < 120 {
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
     let status = Command::new("kill")
         .args([signal, &child.id().to_string()])
         .status()
@@ -193,7 +208,7 @@ fn interrupted_killed_and_extended_runs_resume_to_the_same_numbers() {
         "--checkpoint-every",
         "0.2",
     ];
-    let out = interrupt(&args, "-KILL", 1.2);
+    let out = interrupt_when(&args, "-KILL", 1.2, || Path::new(&killed).exists());
     assert_eq!(out.status.code(), None, "killed by a signal");
     assert!(Path::new(&killed).exists(), "a checkpoint was written");
     let resumed = run_json(&["analyze", "--resume", &killed, "--format", "json", "-q"]);
