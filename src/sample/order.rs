@@ -153,6 +153,11 @@ fn order_window_between(
     order_window(&mut crossings[start..end], starts[0], COINCIDENT).0
 }
 
+/// Whether two crossings are at one place along the line (coincident planes, within rounding).
+pub(super) fn at_one_place(a: &Crossing, b: &Crossing) -> bool {
+    (a.t - b.t).abs() <= COINCIDENT * a.t.abs().max(b.t.abs()).max(1.0)
+}
+
 /// Orders one window: by plane distance, and crossings whose plane distances differ by at most
 /// `same_place` (times max(t, 1)) so that the line alternates between front and back space, starting
 /// `in_front` or not. Returns the overlaps met and whether the line ends in front.

@@ -7,7 +7,9 @@
 //! the scene (an open scene). Every other segment (inside a solid, behind an enclosure, between a front and
 //! a back side) is *unpaired*; of those, a segment between a front side and a back side is reported as
 //! [`Segment::BackSeen`]: a surface seen from behind, which a closed, consistently oriented scene never
-//! shows (a one-sided surface meant to be seen from both sides, or normals facing the wrong way).
+//! shows (a one-sided surface meant to be seen from both sides, or normals facing the wrong way). A
+//! segment of no length between overlapping surfaces facing the same way (a decal on a wall) is no such
+//! thing: the covered surface is hidden, not seen from behind, and the segment stays unpaired.
 //!
 //! Facing is decided from our own f64 patch normals, identically for every tracer; a line exactly in a
 //! patch's plane faces neither side and makes its segments unpaired.
@@ -281,6 +283,9 @@ fn pair_crossings(
                 cos_from: prev.cos,
                 cos_to: -next.cos,
             });
+        } else if prev.cos * next.cos > 0.0 && order::at_one_place(&prev, &next) {
+            // Overlapping surfaces facing the same way: the one behind is covered, not seen from behind.
+            visit(Segment::Unpaired);
         } else if prev.cos > 0.0 && next.cos > 0.0 {
             visit(Segment::BackSeen {
                 patch: next.patch,
