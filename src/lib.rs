@@ -72,8 +72,8 @@ pub use geom::{Direction, Normal, Point, Vector};
 pub use scene::format::load_stream;
 pub use scene::{
     gltf::write as write_gltf, obj::load_text_with as load_obj_text, obj::write as write_obj,
-    Material, Normalization, ObjectSet, Patch, Planarity, Scene, SceneBuilder, SceneError,
-    SceneOptions, DEFAULT_PLANARITY,
+    obj::MaterialSource, obj::MtlError, Material, Normalization, ObjectSet, Patch, Planarity,
+    Scene, SceneBuilder, SceneError, SceneOptions, DEFAULT_PLANARITY,
 };
 pub use scene::{Reach, ReadPolicy};
 pub use scenes::{load, load_with, load_with_policy, Builtin, CATALOGUE};
