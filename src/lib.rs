@@ -98,12 +98,13 @@ pub use sample::tally::{Tally, Wanted};
 pub use analysis::{
     analyze, cast, finish, Analysis, AnalysisError, PatchResult, RadiosityOutcome, RadiositySolve,
     Reliability, RunWarning, RunWarningKind, SamplingReport, SolveFailure, TargetOutcome, Verdict,
+    COVERAGE_OK, COVERAGE_UNUSABLE,
 };
 pub use measure::catalogue::{
     Bound, ByMeasure, Family, Measure, MeasureInfo, Needs, PatchMeasure, PatchMeasureInfo, Unit,
     VerdictRule, CATALOGUE as MEASURES, PATCH_CATALOGUE as PATCH_MEASURES,
 };
-pub use measure::Estimate;
+pub use measure::{student_t_975, Estimate};
 
 pub use crosscheck::{crosscheck, CrossCheck, CrossCheckConfig, Tolerance};
 pub use refine::{refine, RefineConfig, RefineError, Refinement, Strategy};
