@@ -73,8 +73,8 @@ pub use geom::{Direction, Normal, Point, Vector};
 pub use scene::format::load_stream;
 pub use scene::{
     gltf::write as write_gltf, obj::load_text_with as load_obj_text, obj::write as write_obj,
-    Material, Normalization, ObjectSet, Patch, Planarity, Scene, SceneBuilder, SceneError,
-    SceneOptions, DEFAULT_PLANARITY,
+    obj::MaterialSource, obj::MtlError, Material, Normalization, ObjectSet, Patch, Planarity,
+    Scene, SceneBuilder, SceneError, SceneOptions, DEFAULT_PLANARITY,
 };
 pub use scene::{Reach, ReadPolicy};
 pub use scenes::{load, load_with, load_with_policy, Builtin, CATALOGUE};
@@ -99,12 +99,13 @@ pub use sample::tally::{Tally, Wanted};
 pub use analysis::{
     analyze, cast, finish, Analysis, AnalysisError, PatchResult, RadiosityOutcome, RadiositySolve,
     Reliability, RunWarning, RunWarningKind, SamplingReport, SolveFailure, TargetOutcome, Verdict,
+    COVERAGE_OK, COVERAGE_UNUSABLE,
 };
 pub use measure::catalogue::{
     Bound, ByMeasure, Family, Measure, MeasureInfo, Needs, PatchMeasure, PatchMeasureInfo, Unit,
     VerdictRule, CATALOGUE as MEASURES, PATCH_CATALOGUE as PATCH_MEASURES,
 };
-pub use measure::Estimate;
+pub use measure::{student_t_975, Estimate};
 
 pub use crosscheck::{crosscheck, CrossCheck, CrossCheckConfig, Tolerance};
 pub use refine::{refine, RefineConfig, RefineError, Refinement, Strategy};

@@ -17,7 +17,7 @@ use std::time::Instant;
 
 pub use patch_results::{PatchLight, PatchResult};
 pub use radiosity::{RadiosityOutcome, RadiositySolve, SolveFailure, NOTHING_EMITS};
-pub use reliability::{Reliability, SamplingReport, Verdict};
+pub use reliability::{Reliability, SamplingReport, Verdict, COVERAGE_OK, COVERAGE_UNUSABLE};
 pub use warnings::{RunWarning, RunWarningKind};
 
 use patch_results as per_patch;
@@ -25,7 +25,7 @@ use values::visibility_estimates;
 
 use crate::measure::estimators::EntropyEstimator;
 use crate::measure::radiosity::{MaterialError, PatchMaterials};
-use crate::measure::{ByMeasure, Estimate, Measure};
+use crate::measure::{student_t_975, ByMeasure, Estimate, Measure};
 use crate::run::{
     BatchPlan, BatchSet, CastHooks, CastOptions, ErrorMethod, FinishedRun, RunControl, RunSpec,
     RunState, StopReason, TargetReading,
@@ -126,6 +126,19 @@ impl Analysis {
     /// The verdict on the reading of `measure` (`None`: no reading, or an exact one).
     pub fn verdict(&self, measure: Measure) -> Option<Verdict> {
         self.reliability.get(measure).map(|r| r.verdict)
+    }
+
+    /// The half-width of the 95% interval in standard errors: Student's t quantile for the groups less
+    /// one degrees of freedom ([`student_t_975`]).
+    pub fn interval_quantile(&self) -> f64 {
+        student_t_975(self.groups.saturating_sub(1))
+    }
+
+    /// The 95% interval of the reading of `measure`: value ± [`Analysis::interval_quantile`] stderr
+    /// (`None`: no reading or no standard error). A reading marked ok is one whose interval covers the
+    /// exact value in 95% of runs (docs/calibration.md measures it).
+    pub fn interval_95(&self, measure: Measure) -> Option<(f64, f64)> {
+        self.estimate(measure)?.interval(self.interval_quantile())
     }
 
     /// Whether the report covers every batch of its plan.
@@ -270,11 +283,14 @@ pub fn finish(
     let covered = state.done().clone();
     let run = state.finish(scene);
     let enclose = cfg.enclose && run.groups.iter().any(|t| t.counters.escapes > 0);
-    let jackknife = cfg.errors == ErrorMethod::Jackknife
-        && !enclose
-        && cfg.estimator != EntropyEstimator::ChaoShen
-        && run.groups.len() >= 2;
-    let visibility = visibility_estimates(scene, &run, cfg.estimator, enclose, jackknife, wanted);
+    let visibility = visibility_estimates(
+        scene,
+        &run,
+        cfg.estimator,
+        enclose,
+        replication(cfg, &run, enclose),
+        wanted,
+    );
     let target = cfg.budget.target.map(|t| TargetOutcome {
         measure: t.measure,
         stderr_goal: t.stderr,
@@ -370,9 +386,21 @@ pub fn finish(
     })
 }
 
-/// The standard error of `measure` and the verdict on its reading, from the run so far. Batch means:
-/// the jackknife needs the total's counts, which a dense run merges only at the end; batch means are
-/// larger where they differ, so a target is never met early.
+/// Whether a run's delete-a-group replicates can be computed (for the bias estimates behind the
+/// verdicts), and whether they also give the standard errors (`--errors jackknife`). Not with
+/// `--enclose` nor Chao–Shen (its second pass needs every count of the replicate), and not with fewer
+/// than 2 groups.
+fn replication(cfg: &RunSpec, run: &FinishedRun, enclose: bool) -> (bool, bool) {
+    let replicable =
+        !enclose && cfg.estimator != EntropyEstimator::ChaoShen && run.groups.len() >= 2;
+    (
+        replicable,
+        replicable && cfg.errors == ErrorMethod::Jackknife,
+    )
+}
+
+/// The standard error of `measure` and the verdict on its reading, from the run so far, judged as the
+/// finished run's will be (the same errors and bias estimates).
 fn current_reading(
     scene: &Scene,
     state: &RunState,
@@ -382,7 +410,14 @@ fn current_reading(
     let wanted = state.wanted();
     let run = state.snapshot(scene);
     let enclose = cfg.enclose && run.groups.iter().any(|t| t.counters.escapes > 0);
-    let v = visibility_estimates(scene, &run, cfg.estimator, enclose, false, wanted);
+    let v = visibility_estimates(
+        scene,
+        &run,
+        cfg.estimator,
+        enclose,
+        replication(cfg, &run, enclose),
+        wanted,
+    );
     TargetReading {
         stderr: v.estimates.get(measure).and_then(|e| e.stderr),
         reliable: v.reliability.get(measure).map(|r| r.verdict) == Some(Verdict::Ok),

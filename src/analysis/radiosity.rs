@@ -128,7 +128,7 @@ pub(crate) fn estimates(
         pairs: c.pairs,
         open: c.escapes + c.absorbed > 0,
     };
-    let reliability = reliability::verdicts(&estimates, Some(sampling), facts);
+    let reliability = reliability::verdicts(&estimates, Some(sampling), None, facts);
     let solve = RadiositySolve {
         solver_residual: solution.residual,
         solver_tolerance: opts.tolerance,

@@ -118,13 +118,16 @@ pub(super) struct VisibilityOfRun {
 }
 
 /// Every visibility measure of a finished run with its standard error (by the jackknife when asked and
-/// possible), and the environment's area when enclosed.
+/// possible), and the environment's area when enclosed. The delete-a-group replicates are computed
+/// whenever they can be (`replicable`) and the rows are covered well enough for an `ok` corrected
+/// reading, for the bias estimates behind its verdict; `jackknife` says whether they also give the
+/// standard errors (and are then always computed).
 pub(super) fn visibility_estimates(
     scene: &Scene,
     run: &FinishedRun,
     estimator: EntropyEstimator,
     enclose: bool,
-    jackknife: bool,
+    (replicable, jackknife): (bool, bool),
     wanted: Wanted,
 ) -> VisibilityOfRun {
     let values_of = |t: &Tally| GroupValues::of(scene, t, estimator, enclose, false);
@@ -132,15 +135,27 @@ pub(super) fn visibility_estimates(
         || GroupValues::of(scene, &run.total, estimator, enclose, true),
         || run.groups.par_iter().map(values_of).collect(),
     );
-    let replicates = jackknife
+    // Below the coverage of an ok verdict the bias changes no verdict: the replicates cost only then.
+    let covered = all.sampling.is_some_and(|s| s.coverage >= COVERAGE_OK);
+    let replicates = (jackknife || (replicable && covered))
         .then(|| jackknife_replicates(scene, &run.total, &run.groups, estimator))
         .flatten();
     let areas = areas(scene);
-    let spread = Spread {
+    let with_replicates = Spread {
         all: &all,
         groups: &per_group,
         replicates: replicates.as_deref(),
     };
+    let spread = Spread {
+        replicates: replicates.as_deref().filter(|_| jackknife),
+        ..with_replicates
+    };
+    let bias = ByMeasure::from_fn(|m| {
+        let info = m.info();
+        (info.family == Family::Visibility && info.verdict == VerdictRule::Corrected)
+            .then(|| with_replicates.jackknife_bias(|g| value_of(m, g)))
+            .flatten()
+    });
     let mut estimates = if run.total.counters.lines == 0 {
         exact_only(&areas)
     } else {
@@ -168,7 +183,7 @@ pub(super) fn visibility_estimates(
         // Enclosed, the escapes are pairs with the environment: only back sides still lose segments.
         open: c.absorbed > 0 || (c.escapes > 0 && !enclose),
     };
-    let reliability = reliability::verdicts(&estimates, sampling.as_ref(), facts);
+    let reliability = reliability::verdicts(&estimates, sampling.as_ref(), Some(&bias), facts);
     VisibilityOfRun {
         estimates,
         sampling,
@@ -178,7 +193,7 @@ pub(super) fn visibility_estimates(
             .discrete
             .map(|d| (d.unsampled_patches, d.unsampled_area_fraction)),
         environment_area,
-        jackknifed: replicates.is_some(),
+        jackknifed: spread.replicates.is_some(),
     }
 }
 

@@ -9,7 +9,9 @@ use clap::ValueEnum;
 use scene_complexity::LineSource;
 use scene_complexity::Scene;
 use scene_complexity::VerdictRule;
-use scene_complexity::{Analysis, RadiosityOutcome, Reliability, TargetOutcome, Verdict};
+use scene_complexity::{
+    Analysis, RadiosityOutcome, Reliability, TargetOutcome, Verdict, COVERAGE_OK,
+};
 use scene_complexity::{ErrorMethod, Shard, StopReason, Tracing};
 use scene_complexity::{Estimate, Family, Measure, Unit};
 use serde_json::{json, Value};
@@ -115,24 +117,28 @@ fn reliability_json(r: Option<&Reliability>) -> Value {
     }
 }
 
-fn estimate_json(e: Estimate, unit: Unit, r: Option<&Reliability>) -> Value {
+fn estimate_json(e: Estimate, unit: Unit, r: Option<&Reliability>, quantile: f64) -> Value {
+    let interval = e
+        .interval(quantile)
+        .filter(|(lo, hi)| lo.is_finite() && hi.is_finite());
     json!({
         "value": finite(e.value),
         "stderr": e.stderr.and_then(finite),
+        "interval_95": interval.map(|(lo, hi)| [positive_zero(lo), positive_zero(hi)]),
         "unit": unit.name(),
         "reliability": reliability_json(r),
     })
 }
 
-fn row_json(r: &Row) -> Value {
+fn row_json(r: &Row, quantile: f64) -> Value {
     let Some(e) = r.estimate else {
         return Value::Null;
     };
-    let mut v = estimate_json(e, r.unit, r.reliability);
+    let mut v = estimate_json(e, r.unit, r.reliability, quantile);
     if let (Value::Object(map), Some(c)) = (&mut v, r.corrected) {
         map.insert(
             "corrected".into(),
-            estimate_json(c, r.unit, r.corrected_reliability),
+            estimate_json(c, r.unit, r.corrected_reliability, quantile),
         );
     }
     v
@@ -187,7 +193,7 @@ fn target_json(t: &Option<TargetOutcome>) -> Value {
 pub fn json(run: &RunInfo, a: &Analysis) -> String {
     let mut visibility = serde_json::Map::new();
     for r in rows(a, Family::Visibility) {
-        visibility.insert(r.key.into(), row_json(&r));
+        visibility.insert(r.key.into(), row_json(&r, a.interval_quantile()));
     }
     let doc = json!({
         "schema_version": SCHEMA_VERSION,
@@ -206,6 +212,11 @@ pub fn json(run: &RunInfo, a: &Analysis) -> String {
         "seed": a.spec.seed,
         "threads": run.threads,
         "groups": a.groups,
+        "intervals": json!({
+            "level": 0.95,
+            "quantile": finite(a.interval_quantile()),
+            "degrees_of_freedom": a.groups.saturating_sub(1),
+        }),
         "seconds": a.seconds,
         "stop_reason": a.stop_reason.name(),
         "interrupted": a.stop_reason == StopReason::Interrupted,
@@ -257,7 +268,7 @@ fn radiosity_json(a: &Analysis) -> Value {
     };
     let mut m = serde_json::Map::new();
     for row in rows(a, Family::Radiosity) {
-        m.insert(row.key.into(), row_json(&row));
+        m.insert(row.key.into(), row_json(&row, a.interval_quantile()));
     }
     m.insert("solver_residual".into(), json!(finite(r.solver_residual)));
     m.insert("solver_tolerance".into(), json!(r.solver_tolerance));
@@ -519,8 +530,11 @@ pub fn table(run: &RunInfo, a: &Analysis) -> String {
     let _ = writeln!(
         s,
         "\nstandard errors: {errors} (statistical error only).\n\
+         95% intervals: value ± {:.3} stderr (Student's t, {} degrees of freedom).\n\
          corrected: row entropies by the {} estimator; the plug-in H_s and I_s are biased when rows are \
          undersampled.",
+        a.interval_quantile(),
+        a.groups.saturating_sub(1),
         a.spec.estimator.name()
     );
     reliability_summary(&mut s, a);
@@ -572,24 +586,40 @@ fn reliability_summary(s: &mut String, a: &Analysis) {
         .filter_map(|m| a.verdict(m))
         .max();
     if worst.is_some_and(|v| v != Verdict::Ok) {
-        let needed = a
-            .sampling
-            .as_ref()
-            .filter(|smp| smp.sampling.coverage < 0.99)
-            .map(|smp| match smp.lines_for_coverage {
-                Some(n) => format!(
-                    "; the corrected readings need a coverage of 0.99, at least about {n:.1e} lines \
-                     (an extrapolation, good to about twice the lines cast)"
-                ),
-                None => "; a coverage of 0.99 is beyond reach of the extrapolation".into(),
-            })
-            .unwrap_or_default();
+        let needed = corrected_needs(a);
         let _ = writeln!(
             s,
             "reliability: an `undersampled` reading is biased beyond its standard error, an `unusable` one \
              cannot be trusted (rows' coverage below 0.5){needed} (docs/results.md, \"Reading the reliability \
              verdict\")."
         );
+    }
+}
+
+/// What the corrected readings need to be ok, for the reliability line (empty when they are ok).
+fn corrected_needs(a: &Analysis) -> String {
+    let corrected = a.reliability.get(Measure::MutualInformationCorrected);
+    let Some(r) = corrected.filter(|r| r.verdict != Verdict::Ok) else {
+        return String::new();
+    };
+    let coverage_short = a
+        .sampling
+        .as_ref()
+        .is_some_and(|smp| smp.sampling.coverage < COVERAGE_OK);
+    let unreachable = a
+        .sampling
+        .as_ref()
+        .is_some_and(|smp| smp.lines_for_coverage.is_none());
+    match r.lines_needed {
+        _ if coverage_short && unreachable => {
+            "; a coverage of 0.99 is beyond reach of the extrapolation".into()
+        }
+        Some(n) => format!(
+            "; the corrected readings need a coverage of 0.99 and a remaining bias (the jackknife's \
+             estimate) within their standard error, at least about {n:.1e} lines (an extrapolation, good \
+             to about twice the lines cast)"
+        ),
+        None => String::new(),
     }
 }
 

@@ -18,5 +18,5 @@ pub mod shares;
 pub mod visibility;
 
 pub use catalogue::{ByMeasure, Family, Measure, MeasureInfo, PatchMeasure, Unit};
-pub use estimate::Estimate;
+pub use estimate::{student_t_975, Estimate};
 pub use visibility::{ContinuousValues, DiscreteValues};

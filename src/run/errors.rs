@@ -75,6 +75,21 @@ impl<V> Spread<'_, V> {
         })
     }
 
+    /// The delete-a-group jackknife's estimate of the bias of the measure `f` picks: `(G - 1)` times the
+    /// mean of the values with one group left out less the value on all the lines, the bias of an
+    /// estimator whose bias falls like 1 / lines (the replicates have `(G - 1) / G` of the lines). `None`
+    /// without replicates or a value in each.
+    pub fn jackknife_bias(&self, f: impl Fn(&V) -> Option<f64>) -> Option<f64> {
+        let value = f(self.all)?;
+        let reps: Vec<f64> = self.replicates?.iter().filter_map(&f).collect();
+        let g = self.replicates?.len();
+        if g < 2 || reps.len() != g || reps.iter().any(|v| !v.is_finite()) {
+            return None;
+        }
+        let mean = reps.iter().sum::<f64>() / g as f64;
+        Some((g - 1) as f64 * (mean - value))
+    }
+
     /// The estimate of the measure `f` picks, with the jackknife standard error when there are
     /// replicates and each has a value, else batch means.
     pub fn estimate(&self, f: impl Fn(&V) -> Option<f64>) -> Option<Estimate> {

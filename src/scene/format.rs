@@ -112,7 +112,7 @@ pub fn load_file_with_policy(
 ) -> Result<Scene, SceneError> {
     let shown = path.display().to_string();
     let bytes = read::read_scene_file(path, policy.max_bytes)
-        .map_err(|m| SceneError::in_file(&shown, m))?;
+        .map_err(|e| SceneError::in_file(&shown, e.to_string()))?;
     load_detected(
         &shown,
         bytes,
@@ -146,7 +146,7 @@ pub fn load_stream(
     policy: &ReadPolicy,
 ) -> Result<Scene, SceneError> {
     let bytes = read_stream(stream, Path::new(shown), policy.max_bytes)
-        .map_err(|m| SceneError::in_file(shown, m))?;
+        .map_err(|e| SceneError::in_file(shown, e.to_string()))?;
     load_bytes(shown, bytes, folder, options, policy)
 }
 
@@ -172,14 +172,13 @@ fn load_detected(
     folder: &Folder,
     options: &SceneOptions,
 ) -> Result<Scene, SceneError> {
-    let file_error = |message: String| SceneError::in_file(shown, message);
+    let file_error = |problem: FormatProblem| SceneError::in_file(shown, problem.to_string());
     let format = detect(&bytes).ok_or_else(|| file_error(unknown_format(path, &bytes)))?;
     if format == Format::Obj {
         let text = String::from_utf8(bytes).map_err(|e| {
-            file_error(format!(
-                "not a text file (invalid UTF-8 at byte {})",
-                e.utf8_error().valid_up_to()
-            ))
+            file_error(FormatProblem::InvalidUtf8 {
+                at: e.utf8_error().valid_up_to(),
+            })
         })?;
         return obj::load_obj_text(shown, &text, folder, options);
     }
@@ -198,13 +197,10 @@ fn load_format(
     match format {
         Format::Obj => {
             let text = std::str::from_utf8(bytes).map_err(|e| {
-                SceneError::in_file(
-                    shown,
-                    format!(
-                        "not a text file (invalid UTF-8 at byte {})",
-                        e.valid_up_to()
-                    ),
-                )
+                let problem = FormatProblem::InvalidUtf8 {
+                    at: e.valid_up_to(),
+                };
+                SceneError::in_file(shown, problem.to_string())
             })?;
             obj::load_obj_text(shown, text, folder, options)
         }
@@ -220,14 +216,13 @@ const STREAM_HEAD: u64 = 64 << 10;
 /// Reads a stream up to `max_bytes`. After its first [`STREAM_HEAD`] bytes, a stream in no format scx
 /// reads is refused at once, and a binary STL (the one format told by its size) is read only up to the
 /// size its header gives.
-fn read_stream(stream: impl Read, path: &Path, max_bytes: u64) -> Result<Vec<u8>, String> {
-    let cannot = |e: std::io::Error| format!("cannot read it: {e}");
+fn read_stream(stream: impl Read, path: &Path, max_bytes: u64) -> Result<Vec<u8>, StreamProblem> {
     let mut stream = stream;
     let mut bytes = Vec::new();
     (&mut stream)
         .take(STREAM_HEAD.min(max_bytes + 1))
         .read_to_end(&mut bytes)
-        .map_err(cannot)?;
+        .map_err(StreamProblem::Unreadable)?;
     if (bytes.len() as u64) < STREAM_HEAD {
         return within(bytes, max_bytes);
     }
@@ -239,43 +234,155 @@ fn read_stream(stream: impl Read, path: &Path, max_bytes: u64) -> Result<Vec<u8>
         Some(_) => max_bytes,
         None => match stl_size(&bytes) {
             Some(size) if size <= max_bytes => size,
-            _ => return Err(unknown_format(path, &bytes)),
+            _ => return Err(unknown_format(path, &bytes).into()),
         },
     };
     stream
         .take((limit + 1).saturating_sub(bytes.len() as u64))
         .read_to_end(&mut bytes)
-        .map_err(cannot)?;
+        .map_err(StreamProblem::Unreadable)?;
     within(bytes, max_bytes)
+}
+
+/// Why a stream (standard input) was not read as a scene.
+#[derive(Debug, thiserror::Error)]
+pub(crate) enum StreamProblem {
+    /// Reading it failed.
+    #[error("cannot read it: {0}")]
+    Unreadable(#[source] std::io::Error),
+    /// It holds more than the limit, in bytes.
+    #[error(
+        "it holds more than the {} scx reads (--max-file-size raises the limit)",
+        read::size_text(*.0)
+    )]
+    TooLarge(u64),
+    /// What it holds is no scene scx reads.
+    #[error(transparent)]
+    Format(#[from] FormatProblem),
+}
+
+/// Why bytes are no scene scx reads: in no format it knows, or not text where text is needed. The
+/// message names what the bytes look like.
+#[derive(Debug, thiserror::Error)]
+pub(crate) enum FormatProblem {
+    /// No bytes at all.
+    #[error("the file is empty")]
+    Empty,
+    /// A file named `.stl` whose size is not the one its binary STL header gives.
+    #[error(
+        "a binary STL of the wrong size: its header says {count} triangles ({expected} bytes), the \
+         file has {size} bytes ({})",
+        stl_size_why(*.size, *.expected)
+    )]
+    StlSize {
+        /// The triangle count in the header.
+        count: u64,
+        /// The size that count gives: 84 bytes and 50 per triangle.
+        expected: u64,
+        /// The size the file has.
+        size: u64,
+    },
+    /// Binary bytes (not UTF-8) of no binary format scx reads: the extension, if any, and the first
+    /// bytes.
+    #[error(
+        "not a text file and in no binary format scx reads{}: it starts `{}`; scx reads OBJ, glTF \
+         (.gltf, .glb), PLY and STL",
+        Extension(.extension),
+        Start(.start)
+    )]
+    Binary {
+        /// The file's extension, if it has one.
+        extension: Option<String>,
+        /// Its first bytes (up to 8).
+        start: Vec<u8>,
+    },
+    /// Text (or bytes that pass for it) in no format scx reads: the extension, if any, and the first
+    /// bytes.
+    #[error(
+        "unknown scene format{}: it starts `{}`; scx reads OBJ, glTF (.gltf, .glb), PLY and STL",
+        Extension(.extension),
+        Start(.start)
+    )]
+    Unknown {
+        /// The file's extension, if it has one.
+        extension: Option<String>,
+        /// Its first bytes (up to 8).
+        start: Vec<u8>,
+    },
+    /// Text that is not UTF-8: the offset of the first invalid byte.
+    #[error("not a text file (invalid UTF-8 at byte {at})")]
+    InvalidUtf8 {
+        /// The offset of the first invalid byte.
+        at: usize,
+    },
+    /// Text with a NUL byte: its offset.
+    #[error("not a text file (a NUL byte at byte {at})")]
+    Nul {
+        /// The offset of the NUL byte.
+        at: usize,
+    },
+}
+
+/// Why a binary STL's size may be wrong, from the size it has and the one its header gives.
+fn stl_size_why(size: u64, expected: u64) -> &'static str {
+    if size < expected {
+        "cut short?"
+    } else {
+        "more bytes than its triangles need: a wrong count, or data after the triangles"
+    }
+}
+
+/// A file's extension in a message: ` (extension `.obj`)`, or nothing.
+struct Extension<'a>(&'a Option<String>);
+
+impl std::fmt::Display for Extension<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self.0 {
+            Some(e) => write!(f, " (extension `.{e}`)"),
+            None => Ok(()),
+        }
+    }
+}
+
+/// A file's first bytes in a message: printable ASCII as it is, other bytes as `\xNN`.
+struct Start<'a>(&'a [u8]);
+
+impl std::fmt::Display for Start<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        for &b in self.0 {
+            if b.is_ascii_graphic() || b == b' ' {
+                write!(f, "{}", b as char)?;
+            } else {
+                write!(f, "\\x{b:02x}")?;
+            }
+        }
+        Ok(())
+    }
 }
 
 /// The first bytes of a stream in a text format must be text: valid UTF-8 (but for a character cut at
 /// the end) without NUL bytes. Anything else is refused before more is read (random bytes whose start
 /// is not even UTF-8 would otherwise be read to the size limit as an OBJ).
-fn text_head(head: &[u8]) -> Result<(), String> {
+fn text_head(head: &[u8]) -> Result<(), FormatProblem> {
     let valid = match std::str::from_utf8(head) {
         Ok(_) => head.len(),
         Err(e) if e.error_len().is_none() => e.valid_up_to(),
         Err(e) => {
-            return Err(format!(
-                "not a text file (invalid UTF-8 at byte {})",
-                e.valid_up_to()
-            ))
+            return Err(FormatProblem::InvalidUtf8 {
+                at: e.valid_up_to(),
+            })
         }
     };
     match head[..valid].iter().position(|&b| b == 0) {
-        Some(at) => Err(format!("not a text file (a NUL byte at byte {at})")),
+        Some(at) => Err(FormatProblem::Nul { at }),
         None => Ok(()),
     }
 }
 
 /// Bytes read from a stream, refused when over the size limit.
-fn within(bytes: Vec<u8>, max_bytes: u64) -> Result<Vec<u8>, String> {
+fn within(bytes: Vec<u8>, max_bytes: u64) -> Result<Vec<u8>, StreamProblem> {
     if bytes.len() as u64 > max_bytes {
-        return Err(format!(
-            "it holds more than the {} scx reads (--max-file-size raises the limit)",
-            read::size_text(max_bytes)
-        ));
+        return Err(StreamProblem::TooLarge(max_bytes));
     }
     Ok(bytes)
 }
@@ -287,51 +394,27 @@ fn stl_size(bytes: &[u8]) -> Option<u64> {
 }
 
 /// Why a file is in no format scx reads, naming what it looks like.
-fn unknown_format(path: &Path, bytes: &[u8]) -> String {
-    let ext = path
-        .extension()
-        .map(|e| format!(" (extension `.{}`)", e.to_string_lossy()))
-        .unwrap_or_default();
-    let start: String = bytes
-        .iter()
-        .take(8)
-        .map(|&b| {
-            if b.is_ascii_graphic() || b == b' ' {
-                (b as char).to_string()
-            } else {
-                format!("\\x{b:02x}")
-            }
-        })
-        .collect();
+fn unknown_format(path: &Path, bytes: &[u8]) -> FormatProblem {
+    let extension = path.extension().map(|e| e.to_string_lossy().into_owned());
+    let start = bytes[..bytes.len().min(8)].to_vec();
     if bytes.is_empty() {
-        return "the file is empty".into();
+        return FormatProblem::Empty;
     }
     let stl = path
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("stl"));
     if stl && bytes.len() >= 84 {
         let count = u32::from_le_bytes([bytes[80], bytes[81], bytes[82], bytes[83]]) as u64;
-        let expected = 84 + 50 * count;
-        let why = if (bytes.len() as u64) < expected {
-            "cut short?"
-        } else {
-            "more bytes than its triangles need: a wrong count, or data after the triangles"
+        return FormatProblem::StlSize {
+            count,
+            expected: 84 + 50 * count,
+            size: bytes.len() as u64,
         };
-        return format!(
-            "a binary STL of the wrong size: its header says {count} triangles ({expected} bytes), \
-             the file has {} bytes ({why})",
-            bytes.len()
-        );
     }
     if std::str::from_utf8(&bytes[..bytes.len().min(4096)]).is_err() && !is_binary_stl(bytes) {
-        return format!(
-            "not a text file and in no binary format scx reads{ext}: it starts `{start}`; scx reads \
-             OBJ, glTF (.gltf, .glb), PLY and STL"
-        );
+        return FormatProblem::Binary { extension, start };
     }
-    format!(
-        "unknown scene format{ext}: it starts `{start}`; scx reads OBJ, glTF (.gltf, .glb), PLY and STL"
-    )
+    FormatProblem::Unknown { extension, start }
 }
 
 #[cfg(test)]

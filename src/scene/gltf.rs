@@ -58,19 +58,19 @@ fn load_document(
     options: &SceneOptions,
 ) -> Result<Scene, SceneError> {
     let file_error = |message: String| SceneError::in_file(shown, message);
-    check_glb_header(bytes).map_err(file_error)?;
+    check_glb_header(bytes).map_err(|p| file_error(p.to_string()))?;
     let unreadable = |e: ::gltf::Error| file_error(format!("not a readable glTF 2.0 file: {e}"));
     let raw = ::gltf::Gltf::from_slice_without_validation(bytes).map_err(unreadable)?;
     // gltf-json's validation indexes the accessors with each POSITION attribute unchecked: check
     // those indices first, then validate as `Gltf::from_slice` does.
-    check_position_accessors(raw.document.as_json()).map_err(file_error)?;
+    check_position_accessors(raw.document.as_json()).map_err(|p| file_error(p.to_string()))?;
     let gltf = ::gltf::Gltf {
         document: ::gltf::Document::from_json(raw.document.into_json()).map_err(unreadable)?,
         blob: raw.blob,
     };
     let root = gltf.document.as_json();
-    check_version(&root.asset).map_err(file_error)?;
-    let buffers = gltf_data::buffers(&gltf, folder).map_err(file_error)?;
+    check_version(&root.asset).map_err(|p| file_error(p.to_string()))?;
+    let buffers = gltf_data::buffers(&gltf, folder).map_err(|p| file_error(p.to_string()))?;
     let data = Data {
         root,
         buffers: &buffers,
@@ -86,7 +86,7 @@ fn load_document(
         None => gltf_data::parentless_nodes(root),
     };
     // Depth first in document order: objects come in the file's order.
-    let tree = gltf_data::node_tree(root, &roots).map_err(file_error)?;
+    let tree = gltf_data::node_tree(root, &roots).map_err(|p| file_error(p.to_string()))?;
     let nodes: Vec<::gltf::Node> = gltf.nodes().collect();
     let mut worlds: Vec<Matrix> = Vec::with_capacity(tree.len());
     let mut primitives_seen = 0usize;
@@ -134,12 +134,14 @@ fn load_document(
             };
             let ids: Vec<u32> = data
                 .positions(positions.index(), &mut budget)
-                .map_err(at)?
+                .map_err(|p| at(p.to_string()))?
                 .into_iter()
                 .map(|p| b.vertex(transform_point(&world, p)))
                 .collect();
             let indices: Vec<u32> = match primitive.indices() {
-                Some(i) => data.indices(i.index(), &mut budget).map_err(at)?,
+                Some(i) => data
+                    .indices(i.index(), &mut budget)
+                    .map_err(|p| at(p.to_string()))?,
                 None => (0..ids.len() as u32).collect(),
             };
             let mode = primitive.mode();
@@ -193,8 +195,40 @@ fn load_document(
     b.build_with(options)
 }
 
+/// What is wrong with a glTF document as a whole, found before its meshes are read.
+#[derive(Debug, thiserror::Error)]
+enum DocumentProblem {
+    /// A POSITION attribute naming an accessor that does not exist.
+    #[error(
+        "mesh {mesh} primitive {primitive}: its POSITION accessor {accessor} does not exist (the file \
+         has {accessors})"
+    )]
+    NoPositionAccessor {
+        /// The mesh's index.
+        mesh: usize,
+        /// The primitive's index in its mesh.
+        primitive: usize,
+        /// The accessor it names.
+        accessor: usize,
+        /// How many accessors the file has.
+        accessors: usize,
+    },
+    /// A .glb shorter than its header: its size.
+    #[error("a .glb of {0} bytes, shorter than its 12-byte header")]
+    GlbTooShort(usize),
+    /// A .glb header giving a length shorter than the header: that length.
+    #[error("a .glb whose header gives a length of {0} bytes, less than the header's own 12")]
+    GlbLength(u32),
+    /// An asset version other than 2.x: the version.
+    #[error("glTF version `{0}`: scx reads glTF 2.0")]
+    Version(String),
+    /// A `minVersion` other than 2.0: that version.
+    #[error("the file needs a reader of glTF {0} (its minVersion): scx reads glTF 2.0")]
+    MinVersion(String),
+}
+
 /// Every POSITION attribute names an accessor that exists.
-fn check_position_accessors(root: &::gltf::json::Root) -> Result<(), String> {
+fn check_position_accessors(root: &::gltf::json::Root) -> Result<(), DocumentProblem> {
     let positions = ::gltf::json::validation::Checked::Valid(Semantic::Positions);
     for (m, mesh) in root.meshes.iter().enumerate() {
         for (p, primitive) in mesh.primitives.iter().enumerate() {
@@ -202,11 +236,12 @@ fn check_position_accessors(root: &::gltf::json::Root) -> Result<(), String> {
                 continue;
             };
             if k.value() >= root.accessors.len() {
-                return Err(format!(
-                    "mesh {m} primitive {p}: its POSITION accessor {} does not exist (the file has {})",
-                    k.value(),
-                    root.accessors.len()
-                ));
+                return Err(DocumentProblem::NoPositionAccessor {
+                    mesh: m,
+                    primitive: p,
+                    accessor: k.value(),
+                    accessors: root.accessors.len(),
+                });
             }
         }
     }
@@ -215,40 +250,30 @@ fn check_position_accessors(root: &::gltf::json::Root) -> Result<(), String> {
 
 /// The length a .glb's header gives must cover the header itself (the gltf crate subtracts the one from
 /// the other unchecked).
-fn check_glb_header(bytes: &[u8]) -> Result<(), String> {
+fn check_glb_header(bytes: &[u8]) -> Result<(), DocumentProblem> {
     if !bytes.starts_with(b"glTF") {
         return Ok(());
     }
     let Some(length) = bytes.get(8..12) else {
-        return Err(format!(
-            "a .glb of {} bytes, shorter than its 12-byte header",
-            bytes.len()
-        ));
+        return Err(DocumentProblem::GlbTooShort(bytes.len()));
     };
     let length = u32::from_le_bytes([length[0], length[1], length[2], length[3]]);
     if length < 12 {
-        return Err(format!(
-            "a .glb whose header gives a length of {length} bytes, less than the header's own 12"
-        ));
+        return Err(DocumentProblem::GlbLength(length));
     }
     Ok(())
 }
 
 /// A glTF 2.x asset: glTF 1.0 is another format (the gltf crate would read its JSON as 2.0 and find
 /// nonsense), and a `minVersion` above 2.0 asks for features scx does not know.
-fn check_version(asset: &::gltf::json::Asset) -> Result<(), String> {
+fn check_version(asset: &::gltf::json::Asset) -> Result<(), DocumentProblem> {
     let major = |v: &str| v.split('.').next().map(str::to_string);
     if major(&asset.version).as_deref() != Some("2") {
-        return Err(format!(
-            "glTF version `{}`: scx reads glTF 2.0",
-            asset.version
-        ));
+        return Err(DocumentProblem::Version(asset.version.clone()));
     }
     if let Some(min) = asset.min_version.as_deref() {
         if min != "2.0" {
-            return Err(format!(
-                "the file needs a reader of glTF {min} (its minVersion): scx reads glTF 2.0"
-            ));
+            return Err(DocumentProblem::MinVersion(min.to_string()));
         }
     }
     Ok(())

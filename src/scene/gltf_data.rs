@@ -8,7 +8,7 @@
 //! at most once. Accessors are read from the document's JSON, not through the crate's reader, so that no
 //! malformed value reaches code that would panic on it.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::rc::Rc;
 
 use ::gltf::json;
@@ -16,29 +16,113 @@ use base64::Engine as _;
 use json::accessor::{ComponentType, Type};
 use json::validation::Checked;
 
-use super::read::{Folder, Reach, RefError};
+use super::read::{Escape, Folder, Reach, ReadError, RefError};
 
 /// A buffer's bytes, shared by the buffers that name the same file or chunk.
 pub(super) type Buffer = Rc<Vec<u8>>;
 
 /// The bytes of every buffer: the binary chunk of a .glb, a base64 data URI, or a file in the glTF's
 /// folder (read as the folder's policy allows).
-pub(super) fn buffers(gltf: &::gltf::Gltf, folder: &Folder) -> Result<Vec<Buffer>, String> {
+pub(super) fn buffers(gltf: &::gltf::Gltf, folder: &Folder) -> Result<Vec<Buffer>, BufferProblem> {
     let blob = gltf.blob.clone().map(Rc::new);
     gltf.buffers()
         .map(|buffer| {
             let data = buffer_data(&buffer, blob.as_ref(), folder)?;
             if data.len() < buffer.length() {
-                return Err(format!(
-                    "buffer {} has {} bytes, the file says {}",
-                    buffer.index(),
-                    data.len(),
-                    buffer.length()
-                ));
+                return Err(BufferProblem::TooShort {
+                    buffer: buffer.index(),
+                    has: data.len(),
+                    declared: buffer.length(),
+                });
             }
             Ok(data)
         })
         .collect()
+}
+
+/// Why a buffer's bytes were not read: the buffer's index and what went wrong.
+#[derive(Debug, thiserror::Error)]
+pub(super) enum BufferProblem {
+    /// Fewer bytes than the document says the buffer has.
+    #[error("buffer {buffer} has {has} bytes, the file says {declared}")]
+    TooShort {
+        /// The buffer's index.
+        buffer: usize,
+        /// The bytes it has.
+        has: usize,
+        /// The bytes the document gives it.
+        declared: usize,
+    },
+    /// The buffer is the binary chunk of a .glb, which the file lacks.
+    #[error("buffer {0} is the binary chunk, which is missing")]
+    NoBinaryChunk(usize),
+    /// A data URI that is not base64.
+    #[error("buffer {0}: a data URI that is not base64")]
+    NotBase64(usize),
+    /// A base64 data URI that does not decode.
+    #[error("buffer {buffer}: bad base64 in its data URI: {error}")]
+    BadBase64 {
+        /// The buffer's index.
+        buffer: usize,
+        /// Why it does not decode.
+        #[source]
+        error: base64::DecodeError,
+    },
+    /// A `file:` URI, under a policy that keeps references in the scene's folder.
+    #[error(
+        "buffer {buffer}: `{uri}` is a `file:` URI, an absolute path outside the scene's folder: scx \
+         reads the files a scene names only inside its folder (--read-anywhere lifts this)"
+    )]
+    FileUri {
+        /// The buffer's index.
+        buffer: usize,
+        /// The URI.
+        uri: String,
+    },
+    /// A URI with another scheme (`http:`, ...): scx fetches nothing from a network.
+    #[error(
+        "buffer {buffer}: `{uri}` is a `{scheme}:` URI: scx reads buffers from data URIs and from files \
+         beside the glTF, never from a network"
+    )]
+    Scheme {
+        /// The buffer's index.
+        buffer: usize,
+        /// The URI.
+        uri: String,
+        /// Its scheme.
+        scheme: String,
+    },
+    /// No file where the URI points (or it cannot be resolved).
+    #[error("buffer {buffer}: cannot read `{}`: {error}", .path.display())]
+    Missing {
+        /// The buffer's index.
+        buffer: usize,
+        /// The file's path for messages (the folder joined with the URI's path).
+        path: PathBuf,
+        /// Why.
+        #[source]
+        error: std::io::Error,
+    },
+    /// The reading policy keeps the file out of reach.
+    #[error("buffer {buffer}: {escape}")]
+    Outside {
+        /// The buffer's index.
+        buffer: usize,
+        /// How its path leaves the scene's folder.
+        #[source]
+        escape: Escape,
+    },
+    /// The file is there but was not read (not a regular file, too large, a failure to read).
+    #[error("buffer {buffer}: `{uri}`: {error}")]
+    Unreadable {
+        /// The buffer's index.
+        buffer: usize,
+        /// The URI.
+        uri: String,
+        /// Why.
+        #[source]
+        error: ReadError,
+    },
 }
 
 /// One buffer's bytes.
@@ -46,48 +130,51 @@ fn buffer_data(
     buffer: &::gltf::Buffer,
     blob: Option<&Buffer>,
     folder: &Folder,
-) -> Result<Buffer, String> {
+) -> Result<Buffer, BufferProblem> {
     let k = buffer.index();
     match buffer.source() {
-        ::gltf::buffer::Source::Bin => blob
-            .cloned()
-            .ok_or_else(|| format!("buffer {k} is the binary chunk, which is missing")),
+        ::gltf::buffer::Source::Bin => blob.cloned().ok_or(BufferProblem::NoBinaryChunk(k)),
         ::gltf::buffer::Source::Uri(uri) if uri.starts_with("data:") => {
             let (_, payload) = uri
                 .split_once(";base64,")
-                .ok_or_else(|| format!("buffer {k}: a data URI that is not base64"))?;
+                .ok_or(BufferProblem::NotBase64(k))?;
             base64::engine::general_purpose::STANDARD
                 .decode(payload)
                 .map(Rc::new)
-                .map_err(|e| format!("buffer {k}: bad base64 in its data URI: {e}"))
+                .map_err(|error| BufferProblem::BadBase64 { buffer: k, error })
         }
         ::gltf::buffer::Source::Uri(uri) => {
-            let path = uri_path(uri, folder).map_err(|e| format!("buffer {k}: {e}"))?;
+            let path = uri_path(k, uri, folder)?;
             let fetched = folder.fetch(Path::new(&path)).map_err(|e| match e {
-                RefError::Missing(io) => format!(
-                    "buffer {k}: cannot read `{}`: {io}",
-                    folder.shown(Path::new(&path)).display()
-                ),
-                outside @ RefError::Outside(_) => format!("buffer {k}: {outside}"),
-                other => format!("buffer {k}: `{uri}`: {other}"),
+                RefError::Missing(error) => BufferProblem::Missing {
+                    buffer: k,
+                    path: folder.shown(Path::new(&path)),
+                    error,
+                },
+                RefError::Outside(escape) => BufferProblem::Outside { buffer: k, escape },
+                RefError::Unreadable(error) => BufferProblem::Unreadable {
+                    buffer: k,
+                    uri: uri.to_string(),
+                    error,
+                },
             })?;
             Ok(fetched.bytes)
         }
     }
 }
 
-/// The file path of a buffer URI that is not a data URI: a relative reference, percent-decoded. A URI
-/// with a scheme is refused (scx fetches nothing from a network), except `file:` when the policy reaches
-/// anywhere.
-fn uri_path(uri: &str, folder: &Folder) -> Result<String, String> {
+/// The file path of buffer `k`'s URI that is not a data URI: a relative reference, percent-decoded. A
+/// URI with a scheme is refused (scx fetches nothing from a network), except `file:` when the policy
+/// reaches anywhere.
+fn uri_path(k: usize, uri: &str, folder: &Folder) -> Result<String, BufferProblem> {
     match scheme(uri) {
         None => Ok(percent_decode(uri)),
         Some(s) if s.eq_ignore_ascii_case("file") => {
             if folder.policy().reach != Reach::Anywhere {
-                return Err(format!(
-                    "`{uri}` is a `file:` URI, an absolute path outside the scene's folder: scx reads \
-                     the files a scene names only inside its folder (--read-anywhere lifts this)"
-                ));
+                return Err(BufferProblem::FileUri {
+                    buffer: k,
+                    uri: uri.to_string(),
+                });
             }
             let rest = &uri[s.len() + 1..];
             let path = rest
@@ -96,10 +183,11 @@ fn uri_path(uri: &str, folder: &Folder) -> Result<String, String> {
                 .unwrap_or(rest);
             Ok(percent_decode(path))
         }
-        Some(s) => Err(format!(
-            "`{uri}` is a `{s}:` URI: scx reads buffers from data URIs and from files beside the \
-             glTF, never from a network"
-        )),
+        Some(s) => Err(BufferProblem::Scheme {
+            buffer: k,
+            uri: uri.to_string(),
+            scheme: s.to_string(),
+        }),
     }
 }
 
@@ -135,15 +223,11 @@ impl Budget {
     }
 
     /// Spends `bytes`, or says that the meshes hold too much.
-    fn spend(&mut self, bytes: u64) -> Result<(), String> {
-        self.left = self.left.checked_sub(bytes).ok_or_else(|| {
-            format!(
-                "the meshes its nodes place hold more than {} of vertices and indices (a mesh counts once \
-                 for each node that places it): more than a file within the read limit could hold \
-                 (--max-file-size raises the limit)",
-                super::read::size_text(self.max)
-            )
-        })?;
+    fn spend(&mut self, bytes: u64) -> Result<(), AccessorProblem> {
+        self.left = self
+            .left
+            .checked_sub(bytes)
+            .ok_or(AccessorProblem::OverBudget { max: self.max })?;
         Ok(())
     }
 }
@@ -156,20 +240,232 @@ pub(super) struct Data<'a> {
     pub buffers: &'a [Buffer],
 }
 
+/// An accessor as messages name it: what a primitive reads from it, its index, and whether the
+/// message is about its sparse values.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Role {
+    /// What the primitive reads from it.
+    reads: Reads,
+    /// The accessor's index.
+    index: usize,
+    /// Whether the message is about its sparse indices or values.
+    sparse: bool,
+}
+
+/// What a primitive reads from an accessor.
+#[derive(Clone, Copy, Debug)]
+enum Reads {
+    /// Its vertex positions.
+    Positions,
+    /// Its vertex indices.
+    Indices,
+}
+
+impl std::fmt::Display for Role {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let attribute = match self.reads {
+            Reads::Positions => "POSITION",
+            Reads::Indices => "indices",
+        };
+        write!(f, "its {attribute} accessor {}", self.index)?;
+        if self.sparse {
+            f.write_str(" (sparse)")?;
+        }
+        Ok(())
+    }
+}
+
+/// Why an accessor's data was not read: most name the accessor by its [`Role`], and give the numbers
+/// that do not fit.
+#[derive(Debug, thiserror::Error)]
+pub(super) enum AccessorProblem {
+    /// The accessor does not exist: its index.
+    #[error("accessor {0} does not exist")]
+    Missing(usize),
+    /// The component type is not one glTF defines.
+    #[error("{0} has an invalid component type")]
+    InvalidComponent(Role),
+    /// Positions that are not FLOAT VEC3: what they are.
+    #[error(
+        "{role} holds {} {}: scx reads positions as FLOAT VEC3",
+        component_name(*.component),
+        type_name(.type_)
+    )]
+    NotFloatVec3 {
+        /// The accessor.
+        role: Role,
+        /// Its component type.
+        component: ComponentType,
+        /// Its type.
+        type_: Checked<Type>,
+    },
+    /// Indices of a component type that is not unsigned: that type.
+    #[error(
+        "{role} holds {}: indices are UNSIGNED_BYTE, UNSIGNED_SHORT or UNSIGNED_INT",
+        component_name(*.component)
+    )]
+    IndexComponent {
+        /// The accessor.
+        role: Role,
+        /// Its component type.
+        component: ComponentType,
+    },
+    /// Indices that are not SCALAR: their type.
+    #[error("{role} is {}: indices are SCALAR", type_name(.type_))]
+    IndexType {
+        /// The accessor.
+        role: Role,
+        /// Its type.
+        type_: Checked<Type>,
+    },
+    /// An accessor of no elements.
+    #[error("{0} has no elements (count 0)")]
+    Empty(Role),
+    /// A count whose bytes overflow the address space.
+    #[error("{role}: its count {count} is beyond any buffer")]
+    CountTooLarge {
+        /// The accessor.
+        role: Role,
+        /// Its count.
+        count: usize,
+    },
+    /// An accessor without data: no buffer view and no sparse values.
+    #[error("{0} has no buffer view and no sparse values: it holds no data")]
+    NoData(Role),
+    /// A buffer view that does not exist: its index.
+    #[error("{role}: buffer view {view} does not exist")]
+    NoView {
+        /// The accessor.
+        role: Role,
+        /// The buffer view's index.
+        view: usize,
+    },
+    /// A byte stride shorter than the elements.
+    #[error(
+        "{role}: its buffer view {view} has a byte stride of {stride}, less than its {size}-byte \
+         elements"
+    )]
+    Stride {
+        /// The accessor.
+        role: Role,
+        /// The buffer view's index.
+        view: usize,
+        /// Its byte stride.
+        stride: usize,
+        /// The size of an element, in bytes.
+        size: usize,
+    },
+    /// A buffer that does not exist: its index.
+    #[error("{role}: buffer {buffer} does not exist")]
+    NoBuffer {
+        /// The accessor.
+        role: Role,
+        /// The buffer's index.
+        buffer: usize,
+    },
+    /// A buffer view reaching past the end of its buffer.
+    #[error(
+        "{role}: its buffer view {view} (bytes {start} to {}) does not fit in buffer {buffer} of \
+         {buffer_length} bytes",
+        .start.saturating_add(*.length)
+    )]
+    ViewOutside {
+        /// The accessor.
+        role: Role,
+        /// The buffer view's index.
+        view: usize,
+        /// Where the view starts in its buffer.
+        start: u64,
+        /// The view's length in bytes.
+        length: u64,
+        /// The buffer's index.
+        buffer: usize,
+        /// The buffer's length in bytes.
+        buffer_length: usize,
+    },
+    /// Elements reaching past the end of their buffer view.
+    #[error(
+        "{role}: its {count} elements of {size} bytes (stride {stride}) from byte {offset} do not \
+         fit in its buffer view {view} of {length} bytes"
+    )]
+    ElementsOutside {
+        /// The accessor.
+        role: Role,
+        /// How many elements.
+        count: usize,
+        /// The size of an element, in bytes.
+        size: usize,
+        /// The stride between elements.
+        stride: usize,
+        /// The offset of the first element in the view.
+        offset: u64,
+        /// The buffer view's index.
+        view: usize,
+        /// The view's length in bytes.
+        length: u64,
+    },
+    /// More sparse values than elements.
+    #[error("{role}: {values} sparse values for {count} elements")]
+    SparseCount {
+        /// The accessor.
+        role: Role,
+        /// How many sparse values.
+        values: usize,
+        /// How many elements.
+        count: usize,
+    },
+    /// Sparse indices of a component type that is not unsigned.
+    #[error("{0}: its sparse indices are not UNSIGNED_BYTE, UNSIGNED_SHORT or UNSIGNED_INT")]
+    SparseIndexComponent(Role),
+    /// A sparse index out of range or not above the one before.
+    #[error(
+        "{role}: sparse index {index} (number {number}) is not below {count} and above the one before"
+    )]
+    SparseOrder {
+        /// The accessor.
+        role: Role,
+        /// The sparse index.
+        index: usize,
+        /// Its place among the sparse indices.
+        number: usize,
+        /// How many elements.
+        count: usize,
+    },
+    /// The meshes the nodes place hold more bytes than the limit: the limit.
+    #[error(
+        "the meshes its nodes place hold more than {} of vertices and indices (a mesh counts once for \
+         each node that places it): more than a file within the read limit could hold \
+         (--max-file-size raises the limit)",
+        super::read::size_text(*.max)
+    )]
+    OverBudget {
+        /// The limit, in bytes.
+        max: u64,
+    },
+}
+
 impl Data<'_> {
     /// The vertex positions of accessor `k`: FLOAT VEC3.
-    pub fn positions(&self, k: usize, budget: &mut Budget) -> Result<Vec<[f32; 3]>, String> {
+    pub fn positions(
+        &self,
+        k: usize,
+        budget: &mut Budget,
+    ) -> Result<Vec<[f32; 3]>, AccessorProblem> {
         let accessor = self.accessor(k)?;
-        let what = format!("its POSITION accessor {k}");
-        let component = component_type(accessor, &what)?;
+        let role = Role {
+            reads: Reads::Positions,
+            index: k,
+            sparse: false,
+        };
+        let component = component_type(accessor, role)?;
         if component != ComponentType::F32 || accessor.type_ != Checked::Valid(Type::Vec3) {
-            return Err(format!(
-                "{what} holds {} {}: scx reads positions as FLOAT VEC3",
-                component_name(component),
-                type_name(&accessor.type_)
-            ));
+            return Err(AccessorProblem::NotFloatVec3 {
+                role,
+                component,
+                type_: accessor.type_,
+            });
         }
-        let bytes = self.packed(accessor, 12, &what, budget)?;
+        let bytes = self.packed(accessor, 12, role, budget)?;
         Ok(bytes
             .chunks_exact(12)
             .map(|c| std::array::from_fn(|a| f32::from_le_bytes(word(&c[4 * a..]))))
@@ -177,36 +473,35 @@ impl Data<'_> {
     }
 
     /// The vertex indices of accessor `k`: unsigned bytes, shorts or ints, SCALAR.
-    pub fn indices(&self, k: usize, budget: &mut Budget) -> Result<Vec<u32>, String> {
+    pub fn indices(&self, k: usize, budget: &mut Budget) -> Result<Vec<u32>, AccessorProblem> {
         let accessor = self.accessor(k)?;
-        let what = format!("its indices accessor {k}");
-        let component = component_type(accessor, &what)?;
+        let role = Role {
+            reads: Reads::Indices,
+            index: k,
+            sparse: false,
+        };
+        let component = component_type(accessor, role)?;
         let size = match component {
             ComponentType::U8 => 1,
             ComponentType::U16 => 2,
             ComponentType::U32 => 4,
-            _ => {
-                return Err(format!(
-                    "{what} holds {}: indices are UNSIGNED_BYTE, UNSIGNED_SHORT or UNSIGNED_INT",
-                    component_name(component)
-                ))
-            }
+            _ => return Err(AccessorProblem::IndexComponent { role, component }),
         };
         if accessor.type_ != Checked::Valid(Type::Scalar) {
-            return Err(format!(
-                "{what} is {}: indices are SCALAR",
-                type_name(&accessor.type_)
-            ));
+            return Err(AccessorProblem::IndexType {
+                role,
+                type_: accessor.type_,
+            });
         }
-        let bytes = self.packed(accessor, size, &what, budget)?;
+        let bytes = self.packed(accessor, size, role, budget)?;
         Ok(bytes.chunks_exact(size).map(unsigned).collect())
     }
 
-    fn accessor(&self, k: usize) -> Result<&json::Accessor, String> {
+    fn accessor(&self, k: usize) -> Result<&json::Accessor, AccessorProblem> {
         self.root
             .accessors
             .get(k)
-            .ok_or_else(|| format!("accessor {k} does not exist"))
+            .ok_or(AccessorProblem::Missing(k))
     }
 
     /// An accessor's elements, `size` bytes each, packed one after the other: from its buffer view, or
@@ -215,20 +510,20 @@ impl Data<'_> {
         &self,
         accessor: &json::Accessor,
         size: usize,
-        what: &str,
+        role: Role,
         budget: &mut Budget,
-    ) -> Result<Vec<u8>, String> {
+    ) -> Result<Vec<u8>, AccessorProblem> {
         let count = usize::try_from(accessor.count.0).unwrap_or(usize::MAX);
         if count == 0 {
-            return Err(format!("{what} has no elements (count 0)"));
+            return Err(AccessorProblem::Empty(role));
         }
         let total = count
             .checked_mul(size)
-            .ok_or_else(|| format!("{what}: its count {count} is beyond any buffer"))?;
+            .ok_or(AccessorProblem::CountTooLarge { role, count })?;
         let offset = accessor.byte_offset.map_or(0, |o| o.0);
         let mut out = match accessor.buffer_view {
             Some(view) => {
-                let (bytes, stride) = self.range(view.value(), offset, count, size, what)?;
+                let (bytes, stride) = self.range(view.value(), offset, count, size, role)?;
                 budget.spend(total as u64)?;
                 let mut out = Vec::with_capacity(total);
                 for k in 0..count {
@@ -240,14 +535,10 @@ impl Data<'_> {
                 budget.spend(total as u64)?;
                 vec![0; total]
             }
-            None => {
-                return Err(format!(
-                    "{what} has no buffer view and no sparse values: it holds no data"
-                ))
-            }
+            None => return Err(AccessorProblem::NoData(role)),
         };
         if let Some(sparse) = &accessor.sparse {
-            self.apply_sparse(&mut out, sparse, count, size, what)?;
+            self.apply_sparse(&mut out, sparse, count, size, role)?;
         }
         Ok(out)
     }
@@ -260,41 +551,45 @@ impl Data<'_> {
         offset: u64,
         count: usize,
         size: usize,
-        what: &str,
-    ) -> Result<(&[u8], usize), String> {
+        role: Role,
+    ) -> Result<(&[u8], usize), AccessorProblem> {
         let v = self
             .root
             .buffer_views
             .get(view)
-            .ok_or_else(|| format!("{what}: buffer view {view} does not exist"))?;
+            .ok_or(AccessorProblem::NoView { role, view })?;
         // No stride (or 0, which the gltf crate reads the same way): tightly packed.
         let stride = match v.byte_stride {
             Some(s) if s.0 > 0 => s.0,
             _ => size,
         };
         if stride < size {
-            return Err(format!(
-                "{what}: its buffer view {view} has a byte stride of {stride}, less than its {size}-byte \
-                 elements"
-            ));
+            return Err(AccessorProblem::Stride {
+                role,
+                view,
+                stride,
+                size,
+            });
         }
         let b = v.buffer.value();
         let data = self
             .buffers
             .get(b)
-            .ok_or_else(|| format!("{what}: buffer {b} does not exist"))?;
+            .ok_or(AccessorProblem::NoBuffer { role, buffer: b })?;
         let start = v.byte_offset.map_or(0, |o| o.0);
         let length = v.byte_length.0;
         let end = start
             .checked_add(length)
             .filter(|&e| e <= data.len() as u64);
         let Some(end) = end else {
-            return Err(format!(
-                "{what}: its buffer view {view} (bytes {start} to {}) does not fit in buffer {b} of {} \
-                 bytes",
-                start.saturating_add(length),
-                data.len()
-            ));
+            return Err(AccessorProblem::ViewOutside {
+                role,
+                view,
+                start,
+                length,
+                buffer: b,
+                buffer_length: data.len(),
+            });
         };
         let needed = (count as u64 - 1)
             .checked_mul(stride as u64)
@@ -302,10 +597,15 @@ impl Data<'_> {
             .and_then(|n| n.checked_add(offset))
             .filter(|&n| n <= length);
         let Some(needed) = needed else {
-            return Err(format!(
-                "{what}: its {count} elements of {size} bytes (stride {stride}) from byte {offset} do not \
-                 fit in its buffer view {view} of {length} bytes"
-            ));
+            return Err(AccessorProblem::ElementsOutside {
+                role,
+                count,
+                size,
+                stride,
+                offset,
+                view,
+                length,
+            });
         };
         let from = (start + offset) as usize;
         let to = (start + needed) as usize;
@@ -320,48 +620,54 @@ impl Data<'_> {
         sparse: &json::accessor::sparse::Sparse,
         count: usize,
         size: usize,
-        what: &str,
-    ) -> Result<(), String> {
+        role: Role,
+    ) -> Result<(), AccessorProblem> {
         let n = usize::try_from(sparse.count.0).unwrap_or(usize::MAX);
         if n == 0 {
             return Ok(());
         }
         if n > count {
-            return Err(format!("{what}: {n} sparse values for {count} elements"));
+            return Err(AccessorProblem::SparseCount {
+                role,
+                values: n,
+                count,
+            });
         }
         let index_size = match sparse.indices.component_type {
             Checked::Valid(json::accessor::IndexComponentType(ComponentType::U8)) => 1,
             Checked::Valid(json::accessor::IndexComponentType(ComponentType::U16)) => 2,
             Checked::Valid(json::accessor::IndexComponentType(ComponentType::U32)) => 4,
-            _ => {
-                return Err(format!(
-                "{what}: its sparse indices are not UNSIGNED_BYTE, UNSIGNED_SHORT or UNSIGNED_INT"
-            ))
-            }
+            _ => return Err(AccessorProblem::SparseIndexComponent(role)),
         };
-        let sparse_what = format!("{what} (sparse)");
+        let sparse_role = Role {
+            sparse: true,
+            ..role
+        };
         let (indices, index_stride) = self.range(
             sparse.indices.buffer_view.value(),
             sparse.indices.byte_offset.0,
             n,
             index_size,
-            &sparse_what,
+            sparse_role,
         )?;
         let (values, value_stride) = self.range(
             sparse.values.buffer_view.value(),
             sparse.values.byte_offset.0,
             n,
             size,
-            &sparse_what,
+            sparse_role,
         )?;
         let mut previous = None;
         for k in 0..n {
             let at = index_stride * k;
             let i = unsigned(&indices[at..at + index_size]) as usize;
             if i >= count || previous.is_some_and(|p| p >= i) {
-                return Err(format!(
-                    "{what}: sparse index {i} (number {k}) is not below {count} and above the one before"
-                ));
+                return Err(AccessorProblem::SparseOrder {
+                    role,
+                    index: i,
+                    number: k,
+                    count,
+                });
             }
             previous = Some(i);
             let v = value_stride * k;
@@ -372,10 +678,10 @@ impl Data<'_> {
 }
 
 /// An accessor's component type, or an error for an invalid one.
-fn component_type(accessor: &json::Accessor, what: &str) -> Result<ComponentType, String> {
+fn component_type(accessor: &json::Accessor, role: Role) -> Result<ComponentType, AccessorProblem> {
     match accessor.component_type {
         Checked::Valid(json::accessor::GenericComponentType(c)) => Ok(c),
-        Checked::Invalid => Err(format!("{what} has an invalid component type")),
+        Checked::Invalid => Err(AccessorProblem::InvalidComponent(role)),
     }
 }
 
@@ -423,15 +729,13 @@ fn unsigned(bytes: &[u8]) -> u32 {
 pub(super) fn node_tree(
     root: &json::Root,
     roots: &[usize],
-) -> Result<Vec<(usize, Option<usize>)>, String> {
+) -> Result<Vec<(usize, Option<usize>)>, NodeProblem> {
     let mut reached: Vec<Option<Option<usize>>> = vec![None; root.nodes.len()];
     let mut order: Vec<(usize, Option<usize>)> = Vec::new();
     let mut stack: Vec<(usize, Option<usize>)> = roots.iter().rev().map(|&r| (r, None)).collect();
     while let Some((node, parent_at)) = stack.pop() {
         let parent = parent_at.map(|p| order[p].0);
-        let slot = reached
-            .get_mut(node)
-            .ok_or_else(|| format!("node {node} does not exist"))?;
+        let slot = reached.get_mut(node).ok_or(NodeProblem::Missing(node))?;
         if let Some(first) = *slot {
             return Err(reached_twice(node, first, parent_at, &order));
         }
@@ -457,6 +761,72 @@ pub(super) fn parentless_nodes(root: &json::Root) -> Vec<usize> {
     (0..root.nodes.len()).filter(|&k| !child[k]).collect()
 }
 
+/// Why the nodes under a scene's roots are no forest: a node that does not exist, or one reached twice.
+#[derive(Debug, thiserror::Error)]
+pub(super) enum NodeProblem {
+    /// A node index past the nodes.
+    #[error("node {0} does not exist")]
+    Missing(usize),
+    /// A root node listed twice.
+    #[error("its scene lists node {0} twice among its root nodes")]
+    RootTwice(usize),
+    /// A root node that is also a child.
+    #[error("node {node} is a root node of its scene and a child of node {parent}")]
+    RootAndChild {
+        /// The node.
+        node: usize,
+        /// Its parent.
+        parent: usize,
+    },
+    /// A node that is its own ancestor: the cycle, from the node down to the node again.
+    #[error(
+        "node {node} is its own ancestor (nodes {}): the node hierarchy has a cycle",
+        Chain(.cycle)
+    )]
+    Cycle {
+        /// The node.
+        node: usize,
+        /// The nodes of the cycle, from the node down to itself again.
+        cycle: Vec<usize>,
+    },
+    /// A node listed twice among one node's children.
+    #[error("node {node} is listed twice among the children of node {parent}; {TREES}")]
+    ChildTwice {
+        /// The node.
+        node: usize,
+        /// Its parent.
+        parent: usize,
+    },
+    /// A node with two parents.
+    #[error("node {node} is a child of node {first} and of node {second}; {TREES}")]
+    TwoParents {
+        /// The node.
+        node: usize,
+        /// The parent it was reached from first.
+        first: usize,
+        /// The other parent.
+        second: usize,
+    },
+}
+
+/// The rule the nodes of [`NodeProblem::ChildTwice`] and [`NodeProblem::TwoParents`] break.
+const TREES: &str = "glTF nodes form trees: each node has at most one parent";
+
+/// Node indices in a message: `1 -> 2 -> 1`.
+struct Chain<'a>(&'a [usize]);
+
+impl std::fmt::Display for Chain<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        for (k, node) in self.0.iter().enumerate() {
+            if k > 0 {
+                f.write_str(" -> ")?;
+            }
+            write!(f, "{node}")?;
+        }
+        Ok(())
+    }
+}
+
 /// Why a node was reached a second time: first from `first` (its parent then, `None` for a root), now
 /// from the node at `parent_at` in `order`.
 fn reached_twice(
@@ -464,12 +834,11 @@ fn reached_twice(
     first: Option<usize>,
     parent_at: Option<usize>,
     order: &[(usize, Option<usize>)],
-) -> String {
-    const TREES: &str = "glTF nodes form trees: each node has at most one parent";
+) -> NodeProblem {
     let Some(at) = parent_at else {
         return match first {
-            None => format!("its scene lists node {node} twice among its root nodes"),
-            Some(p) => format!("node {node} is a root node of its scene and a child of node {p}"),
+            None => NodeProblem::RootTwice(node),
+            Some(p) => NodeProblem::RootAndChild { node, parent: p },
         };
     };
     let mut chain = vec![order[at].0];
@@ -479,29 +848,25 @@ fn reached_twice(
         up = order[p].1;
     }
     if let Some(k) = chain.iter().position(|&n| n == node) {
-        let cycle: Vec<String> = chain[..=k]
+        let cycle: Vec<usize> = chain[..=k]
             .iter()
             .rev()
             .chain(std::iter::once(&node))
-            .map(|n| n.to_string())
+            .copied()
             .collect();
-        return format!(
-            "node {node} is its own ancestor (nodes {}): the node hierarchy has a cycle",
-            cycle.join(" -> ")
-        );
+        return NodeProblem::Cycle { node, cycle };
     }
     match first {
-        Some(p) if p == order[at].0 => {
-            format!("node {node} is listed twice among the children of node {p}; {TREES}")
-        }
-        Some(p) => format!(
-            "node {node} is a child of node {p} and of node {}; {TREES}",
-            order[at].0
-        ),
-        None => format!(
-            "node {node} is a root node of its scene and a child of node {}",
-            order[at].0
-        ),
+        Some(p) if p == order[at].0 => NodeProblem::ChildTwice { node, parent: p },
+        Some(p) => NodeProblem::TwoParents {
+            node,
+            first: p,
+            second: order[at].0,
+        },
+        None => NodeProblem::RootAndChild {
+            node,
+            parent: order[at].0,
+        },
     }
 }
 

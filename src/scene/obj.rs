@@ -6,7 +6,7 @@
 
 use std::path::Path;
 
-use super::read::{self, Fetched, Folder, ReadPolicy, RefError};
+use super::read::{self, Escape, Fetched, Folder, ReadError, ReadPolicy, RefError};
 use super::{Material, Scene, SceneBuilder, SceneError, SceneOptions};
 
 /// Loads an OBJ file (and its MTL library, if any, beside it) as a scene.
@@ -28,7 +28,8 @@ pub fn load_with_policy(
 ) -> Result<Scene, SceneError> {
     let shown = path.display().to_string();
     let file_error = |message: String| SceneError::in_file(&shown, message);
-    let bytes = read::read_scene_file(path, policy.max_bytes).map_err(file_error)?;
+    let bytes =
+        read::read_scene_file(path, policy.max_bytes).map_err(|e| file_error(e.to_string()))?;
     let text = String::from_utf8(bytes).map_err(|e| {
         file_error(format!(
             "not a text file (invalid UTF-8 at byte {})",
@@ -53,14 +54,11 @@ pub(crate) fn load_obj_text(
     )
 }
 
-/// The reason given when no library of an `mtllib` statement exists (the warning has always said so).
-const NO_LIBRARY: &str = "cannot open the file";
-
 /// The MTL text an `mtllib` statement names, read in the OBJ's folder. The statement may list several
 /// files (a space inside a name escaped as `\ `); `tobj` hands over the whole list, so when it is no
 /// file, each listed file that exists is read and their texts are joined. A library read before gives
 /// no text (its materials are there already). `Err` says why nothing was read.
-fn read_libraries(folder: &Folder, mtl: &Path) -> Result<(String, String), String> {
+fn read_libraries(folder: &Folder, mtl: &Path) -> Result<(String, String), MtlError> {
     let whole = match read_library(folder, &mtl.to_string_lossy()) {
         Ok(found) => return Ok(found),
         Err(why) => why,
@@ -71,7 +69,7 @@ fn read_libraries(folder: &Folder, mtl: &Path) -> Result<(String, String), Strin
     for name in listed.split_whitespace() {
         match read_library(folder, &name.replace('\u{0}', " ")) {
             Ok(library) => found.push(library),
-            Err(why) if why != NO_LIBRARY => {
+            Err(why) if !why.is_missing() => {
                 refused.get_or_insert(why);
             }
             Err(_) => {}
@@ -86,47 +84,137 @@ fn read_libraries(folder: &Folder, mtl: &Path) -> Result<(String, String), Strin
 }
 
 /// One MTL library: the name as written, in the OBJ's folder, else (as other readers of OBJ do, for
-/// files written with another machine's paths) its base name there. `Err` is [`NO_LIBRARY`] when
-/// neither exists, else why it was not read.
-fn read_library(folder: &Folder, written: &str) -> Result<(String, String), String> {
+/// files written with another machine's paths) its base name there. `Err` is [`MtlError::missing`]
+/// when neither exists, else why it was not read.
+fn read_library(folder: &Folder, written: &str) -> Result<(String, String), MtlError> {
     let as_written = match folder.fetch(Path::new(written)) {
-        Err(RefError::Missing(_)) => NO_LIBRARY.to_string(),
-        Err(e @ RefError::Outside(_)) => e.to_string(),
-        Err(e) => format!("`{written}`: {e}"),
         Ok(fetched) => return library_text(fetched),
+        Err(e) => MtlErrorKind::refused(written, e),
     };
     let Some(base) = read::base_name(written) else {
-        return Err(as_written);
+        return Err(as_written.into());
     };
     match folder.fetch(Path::new(base)) {
         Ok(fetched) => library_text(fetched),
-        Err(RefError::Missing(_)) if as_written == NO_LIBRARY => Err(NO_LIBRARY.into()),
-        Err(RefError::Missing(_)) => Err(format!(
-            "{as_written}; and there is no `{base}` in the scene's folder"
-        )),
-        Err(e @ RefError::Outside(_)) => Err(e.to_string()),
-        Err(e) => Err(format!("`{base}`: {e}")),
+        Err(RefError::Missing(_)) if matches!(as_written, MtlErrorKind::Missing) => {
+            Err(MtlErrorKind::Missing.into())
+        }
+        Err(RefError::Missing(_)) => Err(MtlErrorKind::NoBaseName {
+            written: Box::new(as_written),
+            base: base.to_string(),
+        }
+        .into()),
+        Err(e) => Err(MtlErrorKind::refused(base, e).into()),
     }
 }
 
 /// A library's name for messages and its text (empty when the scene named it before).
-fn library_text(fetched: Fetched) -> Result<(String, String), String> {
+fn library_text(fetched: Fetched) -> Result<(String, String), MtlError> {
     let name = fetched.shown.display().to_string();
     if !fetched.first {
         return Ok((name, String::new()));
     }
-    let text = String::from_utf8(fetched.bytes.to_vec()).map_err(|e| {
-        format!(
-            "`{name}` is not a text file (invalid UTF-8 at byte {})",
-            e.utf8_error().valid_up_to()
-        )
-    })?;
-    Ok((name, text))
+    match String::from_utf8(fetched.bytes.to_vec()) {
+        Ok(text) => Ok((name, text)),
+        Err(e) => Err(MtlErrorKind::NotText {
+            at: e.utf8_error().valid_up_to(),
+            name,
+        }
+        .into()),
+    }
 }
 
 /// Where an OBJ's MTL library comes from: given the name in `mtllib`, the library's name for messages
 /// and its text, or why it cannot be read.
-pub type MaterialSource<'a> = dyn Fn(&Path) -> Result<(String, String), String> + 'a;
+pub type MaterialSource<'a> = dyn Fn(&Path) -> Result<(String, String), MtlError> + 'a;
+
+/// Why an MTL library an OBJ names was not read: the reason its warning gives (the faces that use its
+/// materials get the default material). A [`MaterialSource`] returns [`MtlError::missing`] when there
+/// is no such library, or [`MtlError::other`] with a reason of its own; scx's own readers say what kept
+/// the file out (the reading policy, its size or kind, its encoding).
+#[derive(Debug, thiserror::Error)]
+#[error(transparent)]
+pub struct MtlError {
+    kind: MtlErrorKind,
+}
+
+impl MtlError {
+    /// No library of that name exists.
+    pub fn missing() -> Self {
+        MtlErrorKind::Missing.into()
+    }
+
+    /// The library could not be read, for a reason of the source's own (its message is the reason).
+    pub fn other(reason: impl Into<Box<dyn std::error::Error + Send + Sync>>) -> Self {
+        MtlErrorKind::Other(reason.into()).into()
+    }
+
+    /// Whether no library of that name exists (not that one exists and was refused or unreadable).
+    pub fn is_missing(&self) -> bool {
+        matches!(self.kind, MtlErrorKind::Missing)
+    }
+}
+
+/// What kept an MTL library from being read.
+#[derive(Debug, thiserror::Error)]
+enum MtlErrorKind {
+    /// No such file (neither the name as written nor its base name); the warning has always said so.
+    #[error("cannot open the file")]
+    Missing,
+    /// The reading policy keeps the name out of reach.
+    #[error(transparent)]
+    Outside(Escape),
+    /// The file is there but was not read (not a regular file, too large, a failure to read): the
+    /// name as written.
+    #[error("`{name}`: {error}")]
+    Unreadable {
+        /// The name as written.
+        name: String,
+        /// Why.
+        #[source]
+        error: ReadError,
+    },
+    /// The name as written was not read, and its base name is no file in the scene's folder.
+    #[error("{written}; and there is no `{base}` in the scene's folder")]
+    NoBaseName {
+        /// Why the name as written was not read.
+        #[source]
+        written: Box<MtlErrorKind>,
+        /// The base name looked for.
+        base: String,
+    },
+    /// The file is not UTF-8 text: its name for messages, and the offset of the first invalid byte.
+    #[error("`{name}` is not a text file (invalid UTF-8 at byte {at})")]
+    NotText {
+        /// The library's name for messages.
+        name: String,
+        /// The offset of the first invalid byte.
+        at: usize,
+    },
+    /// A reason a [`MaterialSource`] gave.
+    #[error(transparent)]
+    Other(Box<dyn std::error::Error + Send + Sync>),
+}
+
+impl MtlErrorKind {
+    /// Why the library named `name` (as written) was not fetched.
+    fn refused(name: &str, e: RefError) -> Self {
+        match e {
+            RefError::Missing(_) => MtlErrorKind::Missing,
+            RefError::Outside(escape) => MtlErrorKind::Outside(escape),
+            RefError::Unreadable(error) => MtlErrorKind::Unreadable {
+                name: name.to_string(),
+                error,
+            },
+        }
+    }
+}
+
+impl From<MtlErrorKind> for MtlError {
+    fn from(kind: MtlErrorKind) -> Self {
+        MtlError { kind }
+    }
+}
 
 /// Loads OBJ text as a scene called `shown` (messages name it), with `materials` giving the text of an
 /// MTL library from the name in the OBJ (a missing library is a warning, a malformed one an error).
@@ -160,7 +248,7 @@ pub fn load_text_with(
     // Where each material is defined (library and line), for messages about it.
     let defined: std::cell::RefCell<Vec<(String, String, usize)>> = Default::default();
     // Why libraries were not read, for the warning (tobj keeps only that one failed).
-    let unread: std::cell::RefCell<Vec<String>> = Default::default();
+    let unread: std::cell::RefCell<Vec<MtlError>> = Default::default();
     let load_mtl = |name: &Path| match materials(name) {
         Err(why) => {
             unread.borrow_mut().push(why);
@@ -211,7 +299,7 @@ pub fn load_text_with(
         }
         Err(e) => {
             let why = match e {
-                tobj::LoadError::OpenFileFailed => unread.borrow().first().cloned(),
+                tobj::LoadError::OpenFileFailed => unread.borrow().first().map(MtlError::to_string),
                 _ => None,
             };
             b.warn(format!(
@@ -316,11 +404,11 @@ fn no_faces(shown: &str, prepared: &super::obj_check::Prepared) -> SceneError {
 /// One warning for each library that was refused (outside the folder, not a regular file, too large)
 /// while other libraries were read: the faces that use its materials get the default material. When no
 /// library was read, the warning about that says why already.
-fn warn_refused_libraries(b: &mut SceneBuilder, shown: &str, unread: &[String], any_read: bool) {
+fn warn_refused_libraries(b: &mut SceneBuilder, shown: &str, unread: &[MtlError], any_read: bool) {
     if !any_read {
         return;
     }
-    for why in unread.iter().filter(|w| *w != NO_LIBRARY) {
+    for why in unread.iter().filter(|w| !w.is_missing()) {
         b.warn(format!(
             "{shown}: a material library was not read ({why}); faces using its materials get the \
              default material (reflectance 0.5, no emission)"

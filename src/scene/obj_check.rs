@@ -97,9 +97,9 @@ pub(crate) fn material_lines(text: &str) -> Vec<(String, usize)> {
 
 /// The line numbers (1-based) of the `f` statements, in file order; or the first problem found.
 pub(crate) fn scan(shown: &str, text: &str) -> Result<Vec<usize>, SceneError> {
-    let error = |line: usize, message: String| SceneError::File {
+    let error = |line: usize, problem: StatementProblem| SceneError::File {
         path: format!("{shown}:{line}"),
-        message,
+        message: problem.to_string(),
     };
     let vertices = text.lines().filter(|l| keyword(l) == Some("v")).count();
     let mut seen = 0usize;
@@ -126,22 +126,76 @@ fn keyword(line: &str) -> Option<&str> {
     line.split_whitespace().next()
 }
 
+/// What is wrong with a `v` or `f` statement (the message follows the file's name and the line).
+#[derive(Debug, thiserror::Error)]
+pub(crate) enum StatementProblem {
+    /// A vertex with fewer than three coordinates: its number (1-based) and how many it has.
+    #[error("vertex {index} (`v`) has {found} coordinate(s); a vertex needs x, y and z")]
+    VertexTooShort {
+        /// The vertex's number (1-based).
+        index: usize,
+        /// How many coordinates it has.
+        found: usize,
+    },
+    /// A vertex coordinate that is not a number: the vertex's number and the token.
+    #[error("vertex {index} (`v`): `{token}` is not a number")]
+    NotANumber {
+        /// The vertex's number (1-based).
+        index: usize,
+        /// The token where a coordinate should be.
+        token: String,
+    },
+    /// A vertex with an infinite or NaN coordinate: its number and its coordinates.
+    #[error("vertex {index} has a non-finite coordinate ({}, {}, {})", .xyz[0], .xyz[1], .xyz[2])]
+    NotFinite {
+        /// The vertex's number (1-based).
+        index: usize,
+        /// Its coordinates.
+        xyz: [f64; 3],
+    },
+    /// A face of fewer than three corners: how many it has.
+    #[error("a face (`f`) needs at least 3 vertices, it has {0}")]
+    FaceTooSmall(usize),
+    /// A face corner whose vertex is not an integer: the corner and its vertex part.
+    #[error("face corner `{corner}`: `{vertex}` is not a vertex index")]
+    NotAnIndex {
+        /// The corner as written (`v`, `v/vt`, ...).
+        corner: String,
+        /// Its vertex part.
+        vertex: String,
+    },
+    /// A face corner naming a vertex that does not exist: the corner, the vertex it resolves to, and
+    /// how many vertices the file has.
+    #[error(
+        "face corner `{corner}` refers to vertex {resolved}, but the file has {total} vertices"
+    )]
+    NoSuchVertex {
+        /// The corner as written.
+        corner: String,
+        /// The vertex number it resolves to (a negative index counted back from the last vertex).
+        resolved: i64,
+        /// How many vertices the file has.
+        total: usize,
+    },
+}
+
 /// A `v` statement: three finite numbers (a fourth, or colours, may follow).
-fn check_vertex<'a>(mut tokens: impl Iterator<Item = &'a str>, index: usize) -> Result<(), String> {
+fn check_vertex<'a>(
+    mut tokens: impl Iterator<Item = &'a str>,
+    index: usize,
+) -> Result<(), StatementProblem> {
     let mut xyz = [0.0f64; 3];
     for (a, c) in xyz.iter_mut().enumerate() {
-        let token = tokens.next().ok_or_else(|| {
-            format!("vertex {index} (`v`) has {a} coordinate(s); a vertex needs x, y and z")
+        let token = tokens
+            .next()
+            .ok_or(StatementProblem::VertexTooShort { index, found: a })?;
+        *c = token.parse().map_err(|_| StatementProblem::NotANumber {
+            index,
+            token: token.to_string(),
         })?;
-        *c = token
-            .parse()
-            .map_err(|_| format!("vertex {index} (`v`): `{token}` is not a number"))?;
     }
     if xyz.iter().any(|c| !c.is_finite()) {
-        return Err(format!(
-            "vertex {index} has a non-finite coordinate ({}, {}, {})",
-            xyz[0], xyz[1], xyz[2]
-        ));
+        return Err(StatementProblem::NotFinite { index, xyz });
     }
     Ok(())
 }
@@ -152,28 +206,28 @@ fn check_face<'a>(
     tokens: impl Iterator<Item = &'a str>,
     seen: usize,
     total: usize,
-) -> Result<(), String> {
+) -> Result<(), StatementProblem> {
     let corners: Vec<&str> = tokens.collect();
     if corners.len() < 3 {
-        return Err(format!(
-            "a face (`f`) needs at least 3 vertices, it has {}",
-            corners.len()
-        ));
+        return Err(StatementProblem::FaceTooSmall(corners.len()));
     }
     for corner in corners {
         let first = corner.split('/').next().unwrap_or("");
-        let index: i64 = first
-            .parse()
-            .map_err(|_| format!("face corner `{corner}`: `{first}` is not a vertex index"))?;
+        let index: i64 = first.parse().map_err(|_| StatementProblem::NotAnIndex {
+            corner: corner.to_string(),
+            vertex: first.to_string(),
+        })?;
         let resolved = if index < 0 {
             seen as i64 + index + 1
         } else {
             index
         };
         if resolved < 1 || resolved > total as i64 {
-            return Err(format!(
-                "face corner `{corner}` refers to vertex {resolved}, but the file has {total} vertices"
-            ));
+            return Err(StatementProblem::NoSuchVertex {
+                corner: corner.to_string(),
+                resolved,
+                total,
+            });
         }
     }
     Ok(())

@@ -73,72 +73,76 @@ pub fn size_text(bytes: u64) -> String {
     format!("{bytes} bytes")
 }
 
-/// The message for a file over the size limit.
-pub(crate) fn too_large(size: u64, max_bytes: u64) -> String {
-    format!(
-        "the file is {} ({size} bytes), more than the {} scx reads (--max-file-size raises the limit)",
-        size_text(size),
-        size_text(max_bytes)
-    )
-}
-
 /// Reads the scene file itself: it must exist, be a regular file and hold at most `max_bytes`. The
-/// error is a sentence for the message after the file's name.
-pub(crate) fn read_scene_file(path: &Path, max_bytes: u64) -> Result<Vec<u8>, String> {
+/// error's message follows the file's name.
+pub(crate) fn read_scene_file(path: &Path, max_bytes: u64) -> Result<Vec<u8>, SceneFileError> {
     let meta = std::fs::metadata(path).map_err(|e| match e.kind() {
-        std::io::ErrorKind::NotFound => "no such file".to_string(),
-        _ => format!("cannot read the file: {e}"),
+        std::io::ErrorKind::NotFound => SceneFileError::Missing,
+        _ => SceneFileError::Unreadable(ReadError::Io(e)),
     })?;
     if meta.is_dir() {
-        return Err("is a directory, not a scene file".into());
+        return Err(SceneFileError::Directory);
     }
-    read_regular(path, &meta, max_bytes).map_err(|e| e.to_string())
+    Ok(read_regular(path, &meta, max_bytes)?)
+}
+
+/// Why the scene file itself could not be read.
+#[derive(Debug, thiserror::Error)]
+pub(crate) enum SceneFileError {
+    /// Nothing is there.
+    #[error("no such file")]
+    Missing,
+    /// A directory is there.
+    #[error("is a directory, not a scene file")]
+    Directory,
+    /// It is there but could not be read.
+    #[error(transparent)]
+    Unreadable(#[from] ReadError),
 }
 
 /// Why a file could not be read.
-#[derive(Debug)]
+#[derive(Debug, thiserror::Error)]
 pub(crate) enum ReadError {
     /// Not a regular file: a FIFO, a device, a socket or a directory (described).
-    NotRegular(String),
-    /// Larger than the limit: its size.
-    TooLarge(u64, u64),
+    #[error("it is {0}, not a regular file: scx reads regular files only")]
+    NotRegular(&'static str),
+    /// Larger than the limit.
+    #[error(
+        "the file is {} ({size} bytes), more than the {} scx reads (--max-file-size raises the limit)",
+        size_text(*.size),
+        size_text(*.max)
+    )]
+    TooLarge {
+        /// Its size, in bytes.
+        size: u64,
+        /// The limit, in bytes.
+        max: u64,
+    },
     /// The system refused or failed.
-    Io(std::io::Error),
-}
-
-impl std::fmt::Display for ReadError {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self {
-            ReadError::NotRegular(what) => write!(
-                f,
-                "it is {what}, not a regular file: scx reads regular files only"
-            ),
-            ReadError::TooLarge(size, max) => f.write_str(&too_large(*size, *max)),
-            ReadError::Io(e) => write!(f, "cannot read the file: {e}"),
-        }
-    }
+    #[error("cannot read the file: {0}")]
+    Io(#[source] std::io::Error),
 }
 
 /// What kind of file metadata describes, for a message (`a FIFO (named pipe)`).
-fn kind_of(meta: &std::fs::Metadata) -> String {
+fn kind_of(meta: &std::fs::Metadata) -> &'static str {
     let ft = meta.file_type();
     if ft.is_dir() {
-        return "a directory".into();
+        return "a directory";
     }
     #[cfg(unix)]
     {
         use std::os::unix::fs::FileTypeExt;
         if ft.is_fifo() {
-            return "a FIFO (named pipe)".into();
+            return "a FIFO (named pipe)";
         }
         if ft.is_char_device() || ft.is_block_device() {
-            return "a device".into();
+            return "a device";
         }
         if ft.is_socket() {
-            return "a socket".into();
+            return "a socket";
         }
     }
-    "not a regular file".into()
+    "not a regular file"
 }
 
 /// Reads a file whose metadata (following links) is `meta`: only a regular file of at most `max_bytes`.
@@ -154,7 +158,10 @@ fn read_regular(
         return Err(ReadError::NotRegular(kind_of(meta)));
     }
     if meta.len() > max_bytes {
-        return Err(ReadError::TooLarge(meta.len(), max_bytes));
+        return Err(ReadError::TooLarge {
+            size: meta.len(),
+            max: max_bytes,
+        });
     }
     let file = open_nonblocking(path).map_err(ReadError::Io)?;
     let opened = file.metadata().map_err(ReadError::Io)?;
@@ -166,7 +173,10 @@ fn read_regular(
         .read_to_end(&mut bytes)
         .map_err(ReadError::Io)?;
     if bytes.len() as u64 > max_bytes {
-        return Err(ReadError::TooLarge(bytes.len() as u64, max_bytes));
+        return Err(ReadError::TooLarge {
+            size: bytes.len() as u64,
+            max: max_bytes,
+        });
     }
     Ok(bytes)
 }
@@ -184,29 +194,38 @@ fn open_nonblocking(path: &Path) -> std::io::Result<File> {
 }
 
 /// Why a reference was not read.
-#[derive(Debug)]
+#[derive(Debug, thiserror::Error)]
 pub(crate) enum RefError {
-    /// The policy keeps it out: why (`an absolute path`, `` `..` leaves the scene's folder``).
-    Outside(String),
+    /// The policy keeps it out: how it leaves the scene's folder.
+    #[error(transparent)]
+    Outside(#[from] Escape),
     /// Nothing is there.
-    Missing(std::io::Error),
+    #[error("{0}")]
+    Missing(#[source] std::io::Error),
     /// It is there but could not be read.
-    Unreadable(ReadError),
+    #[error("{0}")]
+    Unreadable(#[source] ReadError),
 }
 
-impl std::fmt::Display for RefError {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self {
-            RefError::Outside(why) => write!(
-                f,
-                "{why}, outside the scene's folder: scx reads the files a scene names only inside its \
-                 folder (--read-anywhere lifts this)"
-            ),
-            RefError::Missing(e) => write!(f, "{e}"),
-            RefError::Unreadable(e) => write!(f, "{e}"),
-        }
-    }
+/// How a name a scene gives leaves the scene's folder, which the policy keeps it in. The message says
+/// so and how to lift the limit.
+#[derive(Debug, thiserror::Error)]
+pub(crate) enum Escape {
+    /// An absolute path: the name as written.
+    #[error("`{}` is an absolute path, {OUTSIDE}", .0.display())]
+    Absolute(PathBuf),
+    /// A `..` climbing above the folder: the name as written.
+    #[error("`{}` climbs out with `..`, {OUTSIDE}", .0.display())]
+    ClimbsOut(PathBuf),
+    /// A link out of the folder: where it leads (canonical).
+    #[error("it leads to `{}` through a link, {OUTSIDE}", .0.display())]
+    Link(PathBuf),
 }
+
+/// The end of every [`Escape`] message.
+const OUTSIDE: &str =
+    "outside the scene's folder: scx reads the files a scene names only inside its \
+                       folder (--read-anywhere lifts this)";
 
 /// A file a scene names, read.
 pub(crate) struct Fetched {
@@ -278,7 +297,7 @@ impl Folder {
     /// the policy reaches anywhere.
     fn resolve(&self, written: &Path) -> Result<PathBuf, RefError> {
         if self.policy.reach == Reach::SceneFolder {
-            stays_inside(written).map_err(RefError::Outside)?;
+            stays_inside(written)?;
         }
         let joined = self.dir.join(written);
         let canonical = joined.canonicalize().map_err(RefError::Missing)?;
@@ -290,10 +309,7 @@ impl Folder {
             };
             let folder = dir.canonicalize().map_err(RefError::Missing)?;
             if !canonical.starts_with(&folder) {
-                return Err(RefError::Outside(format!(
-                    "it leads to `{}` through a link",
-                    canonical.display()
-                )));
+                return Err(Escape::Link(canonical).into());
             }
         }
         Ok(canonical)
@@ -301,19 +317,19 @@ impl Folder {
 }
 
 /// Whether a relative path, as written, stays inside the folder it is relative to: not absolute, and no
-/// `..` climbing above its start. `Err` says why not.
-fn stays_inside(written: &Path) -> Result<(), String> {
+/// `..` climbing above its start. `Err` says how it leaves.
+fn stays_inside(written: &Path) -> Result<(), Escape> {
     let mut depth = 0usize;
     for c in written.components() {
         match c {
             Component::Prefix(_) | Component::RootDir => {
-                return Err(format!("`{}` is an absolute path", written.display()))
+                return Err(Escape::Absolute(written.to_path_buf()))
             }
             Component::CurDir => {}
             Component::ParentDir => {
                 depth = depth
                     .checked_sub(1)
-                    .ok_or_else(|| format!("`{}` climbs out with `..`", written.display()))?;
+                    .ok_or_else(|| Escape::ClimbsOut(written.to_path_buf()))?;
             }
             Component::Normal(_) => depth += 1,
         }
@@ -361,13 +377,16 @@ mod tests {
         assert_eq!(read_scene_file(&file, 100).unwrap().len(), 100);
         assert!(read_scene_file(&file, 99)
             .unwrap_err()
+            .to_string()
             .contains("more than the 99 bytes"));
         assert!(read_scene_file(dir.path(), 100)
             .unwrap_err()
+            .to_string()
             .contains("directory"));
         #[cfg(target_os = "linux")]
         assert!(read_scene_file(Path::new("/dev/zero"), 100)
             .unwrap_err()
+            .to_string()
             .contains("a device"));
     }
 }

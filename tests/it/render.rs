@@ -41,7 +41,7 @@ fn the_default_view_of_a_room_is_from_inside() {
 fn a_box() -> Scene {
     let text = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nv 0 0 1\nv 1 0 1\nv 0 1 1\nv 1 1 1\n\
                 f 1 5 7 3\nf 2 4 8 6\nf 1 2 6 5\nf 3 7 8 4\nf 1 3 4 2\nf 5 6 8 7\n";
-    obj::load_text("box.obj", text, &|_| Err("no MTL".into())).unwrap()
+    obj::load_text("box.obj", text, &|_| Err(obj::MtlError::other("no MTL"))).unwrap()
 }
 
 #[test]
