@@ -22,6 +22,10 @@ pub const GROUPS: usize = crate::run::DEFAULT_GROUPS;
 pub struct Reading {
     /// Its value and standard error.
     pub estimate: Estimate,
+    /// The 95% interval the run states for it ([`Analysis::interval_95`]: value ± Student's t for the
+    /// groups less one, times the standard error); `None` without a standard error. The suite judges
+    /// this interval, the one users read, rather than one of its own making.
+    pub interval_95: Option<(f64, f64)>,
     /// The run's verdict on it (`None`: the run gives none, as for the radiosity H_p, exact given the
     /// solution).
     pub verdict: Option<Verdict>,
@@ -37,6 +41,8 @@ pub struct SeedReadings {
     /// The standard-error groups that had lines: the interval's Student-t multiplier has one degree of
     /// freedom less (a standard error from G groups is itself estimated from G values).
     pub groups: usize,
+    /// The half-width of its stated intervals in standard errors ([`Analysis::interval_quantile`]).
+    pub interval_quantile: f64,
     /// With a precision target: whether the run declared it met.
     pub target_met: Option<bool>,
     /// Every reading the run gave, by measure.
@@ -107,10 +113,12 @@ pub fn readings_of(a: &Analysis) -> SeedReadings {
         seed: a.spec.seed,
         lines: a.lines,
         groups: a.groups,
+        interval_quantile: a.interval_quantile(),
         target_met: a.target.map(|t| t.met()),
         readings: ByMeasure::from_fn(|m| {
             Some(Reading {
                 estimate: a.estimate(m)?,
+                interval_95: a.interval_95(m),
                 verdict: a.verdict(m),
             })
         }),

@@ -8,11 +8,11 @@
 //! one), holds the exact value, how often the reading is `ok` and how often an `ok` reading covers, and
 //! the mean and spread of `(value - exact) / se` ([`summary`]).
 //!
-//! * [`truth`]: the exact values, from closed-form form factors ([`rectangles`]) and quadrature of the
+//! * [`mod@truth`]: the exact values, from closed-form form factors ([`rectangles`]) and quadrature of the
 //!   point-to-point form factor over pairs of triangles ([`kernel`], [`quadrature`]);
 //! * [`scenes`]: the scenes with exact values, built-ins and four made here (open scenes, a flipped
 //!   face, an emitting face);
-//! * [`suite`]: cells and the built-in lists (`small`, `standard`, `full`);
+//! * [`mod@suite`]: cells and the built-in lists (`small`, `standard`, `full`);
 //! * [`driver`]: the only module that touches the run engine: a cell in, per-seed readings out;
 //! * [`summary`] and [`report`]: coverage per cell and measure, as Markdown and CSV.
 
@@ -32,7 +32,7 @@ use std::time::Instant;
 pub use driver::{Reading, SeedReadings};
 pub use scenes::CalibrationScene;
 pub use suite::{suite, Cell, CellMeasures, CellTarget, SuiteLevel};
-pub use summary::{StudentQuantiles, Summary};
+pub use summary::Summary;
 pub use truth::{truth, Basis, ExactValue, Truth, TruthError};
 
 use crate::analysis::AnalysisError;
@@ -90,14 +90,13 @@ pub fn run_cells(
     on_cell: &mut dyn FnMut(&CellReport),
 ) -> Result<Vec<CellReport>, CalibrationError> {
     let mut truths: HashMap<String, Truth> = HashMap::new();
-    let mut quantiles = StudentQuantiles::default();
     let mut reports = Vec::with_capacity(cells.len());
     for cell in cells {
         let name = cell.scene.name();
         if !truths.contains_key(&name) {
             truths.insert(name.clone(), truth(&cell.scene)?);
         }
-        let report = run_cell_with(cell, &truths[&name], backend, &mut quantiles)?;
+        let report = run_cell(cell, &truths[&name], backend)?;
         on_cell(&report);
         reports.push(report);
     }
@@ -110,16 +109,6 @@ pub fn run_cell(
     truth: &Truth,
     backend: Backend,
 ) -> Result<CellReport, CalibrationError> {
-    run_cell_with(cell, truth, backend, &mut StudentQuantiles::default())
-}
-
-/// [`run_cell`] with the quantiles already computed for earlier cells.
-fn run_cell_with(
-    cell: &Cell,
-    truth: &Truth,
-    backend: Backend,
-    quantiles: &mut StudentQuantiles,
-) -> Result<CellReport, CalibrationError> {
     let scene = cell.scene.build()?;
     let tracer = make_tracer(backend, &scene, Query::Single)?;
     let started = Instant::now();
@@ -127,7 +116,7 @@ fn run_cell_with(
     let seconds = started.elapsed().as_secs_f64();
     Ok(CellReport {
         cell: *cell,
-        summaries: summary::summarize(cell, truth, &runs, quantiles),
+        summaries: summary::summarize(cell, truth, &runs),
         runs,
         seconds,
     })

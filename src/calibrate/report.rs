@@ -4,10 +4,10 @@
 use std::fmt::Write as _;
 
 use super::driver::GROUPS;
-use super::summary::{student_t_quantile, Summary, NORMAL_95};
+use super::summary::{Summary, NORMAL_95};
 use super::truth::Basis;
 use super::CellReport;
-use crate::measure::Measure;
+use crate::measure::{student_t_975, Measure};
 
 /// `x` with `digits` significant digits, without an exponent for the magnitudes of the measures.
 fn significant(x: f64, digits: usize) -> String {
@@ -68,7 +68,7 @@ pub fn markdown_header() -> String {
          of those that cover.\n\n\
          | scene | lines | runs | measure | exact | mean value | mean se | cover | cover 1.96 | ok | cover if ok | mean z | sd z | met |\n\
          |---|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|\n",
-        student_t_quantile(0.975, dof as f64),
+        student_t_975(dof),
         NORMAL_95,
         (dof as f64 / (dof as f64 - 2.0)).sqrt(),
     )

@@ -113,8 +113,8 @@ pub fn short_count(n: u64) -> String {
 /// The built-in lists of cells.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum SuiteLevel {
-    /// Cheap cells of every kind, 100 to 200 seeds each: about 20 s on two cores, under a minute on
-    /// two loaded ones (what CI runs, through `tests/it/calibration.rs`).
+    /// Cheap cells of every kind, 60 to 200 seeds each: about 25 s on two idle cores, 40 s on two
+    /// loaded ones (what CI runs, through `tests/it/calibration.rs`).
     Small,
     /// The cube from 4 x 4 to 30 x 30 patches per face at 1e5 to 1e8 lines, the regular solids, the open
     /// scenes, the flipped face, the lit cube and precision targets: hours, for the docs and before
@@ -187,11 +187,13 @@ fn small() -> Vec<Cell> {
     vec![
         Cell::new(cube(4), 100_000, 200),
         Cell::new(solid(Solid::Tetrahedron, 1), 20_000, 200),
-        Cell::new(parallel_squares(1), 20_000, 200),
-        Cell::new(perpendicular_squares(1), 20_000, 200),
+        // 5e4 lines: about 2000 pairs between the squares, enough for I_s^c to be judged (a run with
+        // fewer than 1000 calls it unusable).
+        Cell::new(parallel_squares(1), 50_000, 200),
+        Cell::new(perpendicular_squares(1), 50_000, 200),
         Cell::new(CalibrationScene::FlippedCube(1), 20_000, 200),
         Cell::new(CalibrationScene::LitCube(1), 20_000, 200),
-        Cell::new(cube(1), 10_000_000, 100)
+        Cell::new(cube(1), 10_000_000, 60)
             .continuous_only()
             .with_target(Measure::ContinuousMutualInformation, 0.005),
         Cell::new(cube(4), 10_000_000, 60).with_target(Measure::MutualInformationCorrected, 0.004),

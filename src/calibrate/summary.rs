@@ -2,15 +2,12 @@
 //! how often the stated 95% interval covers the truth, how often the reading is marked `ok` and how often
 //! an `ok` reading covers, and how far off the readings are in standard errors.
 //!
-//! The stated interval is `value ± t se`, with `t` Student's 97.5% quantile for the run's groups with
-//! lines less one degree of freedom (a standard error from G groups is itself estimated from G values:
-//! 2.131 for the default 16 groups). The normal 1.96 is counted beside it, to show what the multiplier
-//! alone changes.
-
-use std::collections::HashMap;
+//! The stated interval is the one each run reports ([`crate::Analysis::interval_95`]): `value ± t se`, with
+//! `t` Student's 97.5% quantile for the run's groups with lines less one degree of freedom (a standard
+//! error from G groups is itself estimated from G values: 2.131 for the default 16 groups). The normal
+//! 1.96 is counted beside it, to show what the multiplier alone changes.
 
 use super::driver::SeedReadings;
-use super::quadrature::Rule;
 use super::suite::Cell;
 use super::truth::{Basis, ExactValue, Truth};
 use crate::analysis::Verdict;
@@ -18,51 +15,6 @@ use crate::measure::Measure;
 
 /// The normal 97.5% quantile: `value ± 1.96 se`, the interval of a standard error known exactly.
 pub const NORMAL_95: f64 = 1.959_963_984_540_054;
-
-/// The `p` quantile (`p` in (0.5, 1)) of Student's t distribution with `dof` degrees of freedom, by
-/// bisection on its distribution function, itself a quadrature of the density (no special-function
-/// crate needed for one number per degree of freedom).
-pub fn student_t_quantile(p: f64, dof: f64) -> f64 {
-    let rule = Rule::tanh_sinh(6);
-    let density = |t: f64| (1.0 + t * t / dof).powf(-(dof + 1.0) / 2.0);
-    // The half line by t = s / (1 - s).
-    let half = rule.integrate(0.0, 1.0, |s| {
-        let t = s / (1.0 - s);
-        density(t) / ((1.0 - s) * (1.0 - s))
-    });
-    let upper_tail = 1.0 - p;
-    // 64 halvings of [0, 1000] reach below the f64 spacing near the quantiles asked for (2 to 13).
-    let (mut lo, mut hi) = (0.0, 1000.0);
-    for _ in 0..64 {
-        let mid = 0.5 * (lo + hi);
-        let inner = rule.integrate(0.0, mid, density);
-        let tail = 0.5 * (1.0 - inner / half);
-        if tail > upper_tail {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-    }
-    0.5 * (lo + hi)
-}
-
-/// Student's 97.5% quantiles by degrees of freedom, each computed once (a cell's runs share a few).
-#[derive(Clone, Debug, Default)]
-pub struct StudentQuantiles {
-    known: HashMap<usize, f64>,
-}
-
-impl StudentQuantiles {
-    /// The multiplier of the stated 95% interval of a standard error from `groups` groups:
-    /// Student's t with `groups - 1` degrees of freedom (at least 1).
-    pub fn multiplier(&mut self, groups: usize) -> f64 {
-        let dof = groups.saturating_sub(1).max(1);
-        *self
-            .known
-            .entry(dof)
-            .or_insert_with(|| student_t_quantile(0.975, dof as f64))
-    }
-}
 
 /// The judgement of one measure of one cell against one exact value.
 #[derive(Clone, Debug, PartialEq)]
@@ -164,12 +116,7 @@ impl Judged {
 }
 
 /// Every measure of a cell's runs against every exact value the truth has for it, in catalogue order.
-pub fn summarize(
-    cell: &Cell,
-    truth: &Truth,
-    runs: &[SeedReadings],
-    quantiles: &mut StudentQuantiles,
-) -> Vec<Summary> {
+pub fn summarize(cell: &Cell, truth: &Truth, runs: &[SeedReadings]) -> Vec<Summary> {
     let mean_lines = runs.iter().map(|r| r.lines as f64).sum::<f64>() / runs.len().max(1) as f64;
     let target_measure = cell.target.map(|t| t.measure);
     let mut out = Vec::new();
@@ -189,7 +136,9 @@ pub fn summarize(
                     value: r.estimate.value,
                     stderr: se,
                     dof: run.groups.saturating_sub(1),
-                    covered: error.abs() <= quantiles.multiplier(run.groups) * se,
+                    covered: r
+                        .interval_95
+                        .is_some_and(|(lo, hi)| lo <= exact.value && exact.value <= hi),
                     covered_normal: error.abs() <= NORMAL_95 * se,
                     verdict: r.verdict,
                     met: run.target_met.filter(|_| target_measure == Some(measure)),
@@ -261,24 +210,46 @@ fn summary_of(
 
 #[cfg(test)]
 mod tests {
-    use super::*;
+    use crate::calibrate::quadrature::Rule;
+    use crate::measure::student_t_975;
 
-    /// Student's t quantiles against the tables, and the first term of the Cornish–Fisher expansion
-    /// `z + (z^3 + z) / (4 dof)` for many degrees of freedom.
-    #[test]
-    fn student_quantiles_match_the_tables() {
-        let z = NORMAL_95;
-        let large = 1e6;
-        for (dof, q) in [
-            (1.0, 12.706_204_736),
-            (15.0, 2.131_449_546),
-            (large, z + (z.powi(3) + z) / (4.0 * large)),
-        ] {
-            let got = student_t_quantile(0.975, dof);
-            assert!((got - q).abs() < 1e-6, "dof {dof}: {got} vs {q}");
+    /// The `p` quantile (`p` in (0.5, 1)) of Student's t distribution with `dof` degrees of freedom, by
+    /// bisection on its distribution function, itself a tanh–sinh quadrature of the density: a second
+    /// way to the multiplier of the stated intervals.
+    fn student_t_quantile(p: f64, dof: f64) -> f64 {
+        let rule = Rule::tanh_sinh(6);
+        let density = |t: f64| (1.0 + t * t / dof).powf(-(dof + 1.0) / 2.0);
+        // The half line by t = s / (1 - s).
+        let half = rule.integrate(0.0, 1.0, |s| {
+            let t = s / (1.0 - s);
+            density(t) / ((1.0 - s) * (1.0 - s))
+        });
+        let (mut lo, mut hi) = (0.0, 1000.0);
+        for _ in 0..64 {
+            let mid = 0.5 * (lo + hi);
+            let tail = 0.5 * (1.0 - rule.integrate(0.0, mid, density) / half);
+            if tail > 1.0 - p {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
         }
-        let mut cache = StudentQuantiles::default();
-        assert!((cache.multiplier(16) - 2.131_449_546).abs() < 1e-6);
-        assert_eq!(cache.multiplier(1), cache.multiplier(2), "at least 1 dof");
+        0.5 * (lo + hi)
+    }
+
+    /// The multiplier of the stated intervals, the library's table and expansion, against the quantile
+    /// by quadrature for every degree of freedom a run of up to 1024 groups can have, and the tables'
+    /// 2.131 for 15.
+    #[test]
+    fn the_stated_intervals_multiplier_is_students_quantile() {
+        assert!((student_t_quantile(0.975, 15.0) - 2.131_449_546).abs() < 1e-6);
+        assert!((student_t_quantile(0.975, 1.0) - 12.706_204_736).abs() < 1e-6);
+        for dof in (1..=64).chain([100, 255, 1023]) {
+            let (table, quadrature) = (student_t_975(dof), student_t_quantile(0.975, dof as f64));
+            assert!(
+                (table - quadrature).abs() < 2e-6,
+                "{dof} degrees of freedom: {table} vs {quadrature}"
+            );
+        }
     }
 }
