@@ -65,7 +65,7 @@ const NEARLY_STRAIGHT: f64 = 1e-4;
 /// [`LARGE_POLYGON`] corners needs (about n^2 / 2), and a bound on the time a polygon can take.
 const EAR_CLIP_BUDGET: u64 = 1 << 28;
 
-/// A polygon that ear clipping could not cut within [`EAR_CLIP_BUDGET`] steps.
+/// A polygon that ear clipping could not cut within its budget of steps (2^28).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct TooIntricate {
     /// Its corners.
