@@ -35,8 +35,8 @@
 //!   is saved with [`save_state`], read with [`load_state`], and parts of one run merge with
 //!   [`RunState::absorb`];
 //! * the applications: [`reproduce`] (the paper's tables), [`mod@refine`] (meshing strategies),
-//!   [`render`] (pictures of the per-patch results) and [`mod@crosscheck`] (the two tracers, hit for
-//!   hit).
+//!   [`render`] (pictures of the per-patch results), [`mod@crosscheck`] (the two tracers, hit for
+//!   hit) and [`calibrate`] (how often the standard errors' intervals cover exact values).
 //!
 //! Inside, the layers in the order data flows (each imports only from the layers before it; a test
 //! checks it): `geom` (points, directions, shapes), `scene` (the scene model, its builder and readers),
@@ -62,6 +62,7 @@ mod scenes;
 mod trace;
 
 // The applications, public modules of their own.
+pub mod calibrate;
 pub mod crosscheck;
 pub mod refine;
 pub mod render;

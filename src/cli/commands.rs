@@ -4,7 +4,9 @@
 use clap::{Parser, Subcommand};
 
 use super::exit::{Exit, Failure};
-use super::{analyze, convergence, crosscheck, docs, export, merge, refine, render, reproduce};
+use super::{
+    analyze, calibrate, convergence, crosscheck, docs, export, merge, refine, render, reproduce,
+};
 use super::{args, output};
 
 /// The exit codes as `--help` lists them.
@@ -89,6 +91,15 @@ pub enum Command {
     /// Regenerate the paper's Tables 1 to 9 and print each beside the published values (Markdown).
     #[command(after_help = "Example:\n  scx reproduce --table 4 --lines x0.1 -o table4.md")]
     Reproduce(reproduce::ReproduceArgs),
+    /// Run scenes with exact values over many seeds: how often each reading's stated 95% interval
+    /// covers the truth, how often readings are ok and ok ones cover, and how far off they are in
+    /// standard errors (Markdown, CSV).
+    #[command(after_help = concat!(
+        "Examples:\n",
+        "  scx calibrate --suite small\n",
+        "  scx calibrate --scene @cube:10 --lines 1e6,1e7 --seeds 60 --csv cube10.csv"
+    ))]
+    Calibrate(calibrate::CalibrateArgs),
     /// Print a shell completion script (bash, zsh, fish, elvish, powershell).
     #[command(after_help = concat!(
         "Example:\n",

@@ -44,7 +44,8 @@ macro_rules! input_errors {
 input_errors!(
     scene_complexity::AnalysisError,
     scene_complexity::refine::RefineError,
-    scene_complexity::reproduce::ReproduceError
+    scene_complexity::reproduce::ReproduceError,
+    scene_complexity::calibrate::CalibrationError
 );
 
 impl Failure {

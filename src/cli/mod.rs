@@ -2,6 +2,7 @@
 
 mod analyze;
 mod args;
+mod calibrate;
 mod commands;
 mod convergence;
 mod crosscheck;
@@ -41,6 +42,7 @@ pub fn main() -> ExitCode {
         Command::Render(args) => render::run(&args),
         Command::Crosscheck(args) => crosscheck::run(&args),
         Command::Reproduce(args) => reproduce::run(&args),
+        Command::Calibrate(args) => calibrate::run(&args),
         Command::Merge(args) => merge::run(&args),
         Command::Completions(args) => docs::completions(&args, Cli::command()),
         Command::Man(args) => docs::man(&args, Cli::command()),

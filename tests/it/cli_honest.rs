@@ -303,6 +303,7 @@ fn convergence_json_completions_man_and_help() {
         "refine",
         "crosscheck",
         "reproduce",
+        "calibrate",
         "completions",
         "man",
     ] {

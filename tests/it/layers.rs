@@ -24,7 +24,7 @@ const LAYERS: &[(&str, &[&str])] = &[
     ("analysis", &["analysis"]),
     (
         "applications",
-        &["reproduce", "refine", "crosscheck", "render"],
+        &["reproduce", "refine", "crosscheck", "render", "calibrate"],
     ),
     ("cli", &[]),
 ];

@@ -5,6 +5,7 @@ mod support;
 
 // The library against independent truth.
 mod bundles;
+mod calibration;
 mod crosscheck;
 #[cfg(feature = "embree")]
 mod embree_backend;

@@ -1,0 +1,182 @@
+//! `scx calibrate`: the calibration suite (see [`scene_complexity::calibrate`]), its table printed as
+//! Markdown on stdout as each cell finishes; one log line per cell on stderr.
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use scene_complexity::calibrate::{
+    self, report, suite, CalibrationScene, Cell, CellMeasures, CellReport, CellTarget, SuiteLevel,
+};
+use scene_complexity::Measure;
+
+use super::args::{
+    parse_count, parse_positive, parse_seed, target_measure_parser, ReportOutput, Threads, Tracer,
+    TracerArg,
+};
+use super::exit::{Exit, Failure};
+use super::output::{self, check_all};
+use super::runner::thread_pool;
+
+/// Arguments of `scx calibrate`.
+#[derive(clap::Args, Debug)]
+pub struct CalibrateArgs {
+    /// A built-in list of cells: `small` (under a minute on two cores; what CI runs), `standard`
+    /// (hours: the cube from 4 to 30 patches a side up to 1e8 lines, the regular solids, open scenes,
+    /// a flipped face, a lit cube, precision targets), or `full` (standard and the expensive cells, up
+    /// to 2e8 lines and a target capped at 2e9). Default `small`, unless `--scene` names the cells.
+    #[arg(long, value_parser = parse_suite, conflicts_with = "scene")]
+    suite: Option<SuiteLevel>,
+    /// Scenes with exact values, comma separated: @cube[:N], @tetrahedron[:k], @octahedron[:k],
+    /// @icosahedron[:k], @dodecahedron[:k], two-squares:parallel[:N[:D]], two-squares:perpendicular[:N],
+    /// flipped-cube[:N], lit-cube[:N]. One cell per scene and line count.
+    #[arg(long, value_delimiter = ',', value_parser = parse_scene)]
+    scene: Vec<CalibrationScene>,
+    /// Lines per run, comma separated (with `--scene`; a cap with a target).
+    #[arg(long, value_delimiter = ',', value_parser = parse_count, default_value = "1e5")]
+    lines: Vec<u64>,
+    /// Runs per cell (with `--scene`), seeds `first-seed..first-seed + seeds`.
+    #[arg(long, value_parser = parse_count, default_value = "200")]
+    seeds: u64,
+    /// The first seed (with `--scene`).
+    #[arg(long, value_parser = parse_seed, default_value = "1")]
+    first_seed: u64,
+    /// Measures of the runs (with `--scene`): `all`, or `continuous` (I_s^c alone, as
+    /// `scx analyze --measures continuous`).
+    #[arg(long, default_value = "all", value_parser = parse_measures)]
+    measures: CellMeasures,
+    /// A precision target for every run (with `--scene`): stop when the standard error of
+    /// `--target-measure` reaches this on an ok reading, or at `--lines`.
+    #[arg(long, value_parser = parse_positive)]
+    target_stderr: Option<f64>,
+    /// The measure the target watches.
+    #[arg(long, default_value = Measure::DEFAULT_TARGET.key(), value_parser = target_measure_parser())]
+    target_measure: Measure,
+    /// Print the cells and exit.
+    #[arg(long)]
+    list: bool,
+    #[command(flatten)]
+    threads: Threads,
+    #[command(flatten)]
+    tracer: Tracer,
+    /// Also write the table as CSV (one row per cell, measure and basis).
+    #[arg(long, value_name = "FILE")]
+    csv: Option<PathBuf>,
+    /// Also write every run's readings as CSV (one row per run and measure).
+    #[arg(long, value_name = "FILE")]
+    readings: Option<PathBuf>,
+    #[command(flatten)]
+    out: ReportOutput,
+}
+
+fn parse_suite(s: &str) -> Result<SuiteLevel, String> {
+    SuiteLevel::parse(s).ok_or_else(|| format!("`{s}`: expected small, standard or full"))
+}
+
+fn parse_scene(s: &str) -> Result<CalibrationScene, String> {
+    CalibrationScene::parse(s).map_err(|e| e.to_string())
+}
+
+fn parse_measures(s: &str) -> Result<CellMeasures, String> {
+    match s {
+        "all" => Ok(CellMeasures::All),
+        "continuous" => Ok(CellMeasures::ContinuousOnly),
+        _ => Err(format!("`{s}`: expected all or continuous")),
+    }
+}
+
+/// The cells the arguments ask for.
+fn cells(args: &CalibrateArgs) -> Vec<Cell> {
+    if args.scene.is_empty() {
+        return suite(args.suite.unwrap_or(SuiteLevel::Small));
+    }
+    let target = args.target_stderr.map(|stderr| CellTarget {
+        measure: args.target_measure,
+        stderr,
+    });
+    args.scene
+        .iter()
+        .flat_map(|&scene| {
+            args.lines.iter().map(move |&lines| Cell {
+                scene,
+                lines,
+                first_seed: args.first_seed,
+                seeds: args.seeds,
+                measures: args.measures,
+                target,
+            })
+        })
+        .collect()
+}
+
+/// Runs `scx calibrate`.
+pub fn run(args: &CalibrateArgs) -> Result<Exit, Failure> {
+    let paths = [&args.out.output, &args.csv, &args.readings];
+    check_all(paths.iter().filter_map(|p| p.as_deref()))?;
+    let cells = cells(args);
+    if args.list {
+        let list: String = cells
+            .iter()
+            .map(|c| {
+                format!(
+                    "{} {} x {} seeds\n",
+                    c.scene.name(),
+                    c.lines_label(),
+                    c.seeds
+                )
+            })
+            .collect();
+        output::emit(args.out.output.as_deref(), &list)?;
+        return Ok(Exit::Ok);
+    }
+    let backend = TracerArg::backend(args.tracer.value);
+    let (threads, pool) = thread_pool(args.threads.value)?;
+    let to_file = args.out.output.is_some();
+    let mut document = format!(
+        "`scx calibrate`: {} cells, tracer {}, {threads} threads.\n\n",
+        cells.len(),
+        match backend {
+            scene_complexity::Backend::Embree => "embree",
+            scene_complexity::Backend::Rust => "rust",
+        }
+    );
+    document.push_str(&report::markdown_header());
+    if !to_file {
+        output::emit(None, &document)?;
+    }
+    let start = Instant::now();
+    let mut printed: Result<(), Failure> = Ok(());
+    let mut on_cell = |r: &CellReport| {
+        output::note(&format!(
+            "calibrate: {} {} x {} seeds in {:.1} s",
+            r.cell.scene.name(),
+            r.cell.lines_label(),
+            r.cell.seeds,
+            r.seconds
+        ));
+        let rows = report::markdown_rows(r);
+        if to_file {
+            document.push_str(&rows);
+        } else if printed.is_ok() {
+            printed = output::emit(None, &rows);
+        }
+    };
+    let reports = pool
+        .install(|| calibrate::run_cells(&cells, backend, &mut on_cell))
+        .map_err(Failure::of)?;
+    printed?;
+    output::note(&format!(
+        "calibrate: {} cells in {:.1} s",
+        reports.len(),
+        start.elapsed().as_secs_f64()
+    ));
+    if let Some(path) = &args.out.output {
+        output::write_file(path, document.as_bytes())?;
+    }
+    if let Some(path) = &args.csv {
+        output::write_file(path, report::summary_csv(&reports).as_bytes())?;
+    }
+    if let Some(path) = &args.readings {
+        output::write_file(path, report::readings_csv(&reports).as_bytes())?;
+    }
+    Ok(Exit::Ok)
+}
