@@ -363,7 +363,8 @@ pub fn run(args: &AnalyzeArgs) -> Result<Exit, Failure> {
     let scope = Scope::of(identity.shard);
     let mut checkpoints = Checkpoints {
         path: checkpoint,
-        every: Duration::from_secs_f64(args.checkpoint_every),
+        // Longer than the clock can count (`--checkpoint-every 1e30`): a checkpoint at the end only.
+        every: Duration::try_from_secs_f64(args.checkpoint_every).unwrap_or(Duration::MAX),
         last: Instant::now(),
         failed: None,
         before,

@@ -33,7 +33,57 @@ use exit::Exit;
 pub fn main() -> ExitCode {
     let cli = Cli::parse();
     output::set_quiet(cli.quiet);
-    let result = match cli.command {
+    // A panic is a bug in scx, never the user's to read as a backtrace: the hook keeps its message
+    // quiet (a reader that catches a dependency's panic has already said what went wrong), and one that
+    // reaches here, from this thread or a worker's, ends the program with a sentence and exit code 1.
+    std::panic::set_hook(Box::new(|info| {
+        let message = info
+            .payload()
+            .downcast_ref::<&str>()
+            .map(|s| s.to_string())
+            .or_else(|| info.payload().downcast_ref::<String>().cloned())
+            .unwrap_or_default();
+        let place = info
+            .location()
+            .map(|l| format!(" ({}:{})", l.file(), l.line()))
+            .unwrap_or_default();
+        if let Ok(mut last) = LAST_PANIC.lock() {
+            *last = Some(format!("{message}{place}"));
+        }
+    }));
+    let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| dispatch(cli)))
+        .unwrap_or_else(|_| {
+            let what = LAST_PANIC
+                .lock()
+                .ok()
+                .and_then(|mut m| m.take())
+                .unwrap_or_default();
+            Err(exit::Failure {
+                code: Exit::Failed,
+                message: format!(
+                    "internal error, a bug in scx: {what}; please report it with the command line"
+                ),
+            })
+        });
+    match result {
+        Ok(Exit::Interrupted) => {
+            eprintln!("scx: interrupted: the report covers the lines gathered so far");
+            ExitCode::from(Exit::Interrupted as u8)
+        }
+        Ok(code) => ExitCode::from(code as u8),
+        Err(f) => {
+            eprintln!("scx: error: {}", f.message);
+            ExitCode::from(f.code as u8)
+        }
+    }
+}
+
+/// The message and place of the last panic (for the sentence that ends the program).
+static LAST_PANIC: std::sync::Mutex<Option<String>> = std::sync::Mutex::new(None);
+
+/// Runs the command.
+fn dispatch(cli: Cli) -> Result<Exit, exit::Failure> {
+    match cli.command {
         Command::Scenes(args) => commands::scenes(&args),
         Command::Analyze(args) => analyze::run(&args),
         Command::Export(args) => export::run(&args),
@@ -46,16 +96,5 @@ pub fn main() -> ExitCode {
         Command::Merge(args) => merge::run(&args),
         Command::Completions(args) => docs::completions(&args, Cli::command()),
         Command::Man(args) => docs::man(&args, Cli::command()),
-    };
-    match result {
-        Ok(Exit::Interrupted) => {
-            eprintln!("scx: interrupted: the report covers the lines gathered so far");
-            ExitCode::from(Exit::Interrupted as u8)
-        }
-        Ok(code) => ExitCode::from(code as u8),
-        Err(f) => {
-            eprintln!("scx: error: {}", f.message);
-            ExitCode::from(f.code as u8)
-        }
     }
 }

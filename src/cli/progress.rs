@@ -28,10 +28,19 @@ pub fn while_running<T>(
         if !quiet() {
             s.spawn(|| draw(control, base, total, label, &done));
         }
-        let result = work();
-        done.store(true, Ordering::Relaxed);
-        result
+        // Set however `work` ends: a panic in it must not leave the scope waiting for the bar forever.
+        let _finished = Finished(&done);
+        work()
     })
+}
+
+/// Sets its flag when dropped, also while a panic unwinds.
+struct Finished<'a>(&'a AtomicBool);
+
+impl Drop for Finished<'_> {
+    fn drop(&mut self) {
+        self.0.store(true, Ordering::Relaxed);
+    }
 }
 
 /// `1.23 M lines/s, 12 s left`.
@@ -101,6 +110,17 @@ fn draw(control: &RunControl, base: u64, total: Option<u64>, label: &str, done: 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A panic in the work (a worker's, carried over by the pool) comes out of `while_running` instead
+    /// of leaving it waiting for the progress bar's thread.
+    #[test]
+    fn a_panic_in_the_work_does_not_leave_the_bar_waiting() {
+        let control = RunControl::default();
+        let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+            while_running(&control, Some(10), "", || -> u32 { panic!("in the work") })
+        }));
+        assert!(result.is_err());
+    }
 
     #[test]
     fn rate_and_time_left_read_sensibly() {

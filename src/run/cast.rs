@@ -151,10 +151,13 @@ pub fn cast(
         source: cfg.source,
         seed: cfg.seed,
     };
-    let deadline = cfg
-        .budget
-        .seconds
-        .map(|s| start + Duration::from_secs_f64(s.max(0.0)));
+    // A budget longer than the clock can count (`--seconds 1e30`) is no limit: the run ends with its
+    // lines, as it would long before such a deadline.
+    let deadline = cfg.budget.seconds.and_then(|s| {
+        Duration::try_from_secs_f64(s.max(0.0))
+            .ok()
+            .and_then(|d| start.checked_add(d))
+    });
     let stop = |b: u64| {
         let late = deadline.is_some_and(|d| Instant::now() >= d);
         if control.stop_requested() || late {

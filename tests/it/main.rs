@@ -40,6 +40,8 @@ mod cli_scene_files;
 #[cfg(feature = "cli")]
 mod hostile;
 #[cfg(feature = "cli")]
+mod outputs;
+#[cfg(feature = "cli")]
 mod runs;
 
 // The source's structure.
