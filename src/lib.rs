@@ -72,9 +72,10 @@ pub mod reproduce;
 pub use geom::{Direction, Normal, Point, Vector};
 pub use scene::format::load_stream;
 pub use scene::{
-    gltf::write as write_gltf, obj::load_text_with as load_obj_text, obj::write as write_obj,
-    obj::MaterialSource, obj::MtlError, Material, Normalization, ObjectSet, Patch, Planarity,
-    Scene, SceneBuilder, SceneError, SceneOptions, DEFAULT_PLANARITY,
+    gltf::to_bytes as gltf_bytes, gltf::write as write_gltf, obj::load_text_with as load_obj_text,
+    obj::to_text as obj_text, obj::write as write_obj, obj::MaterialSource, obj::MtlError,
+    Material, Normalization, ObjectSet, Patch, Planarity, Scene, SceneBuilder, SceneError,
+    SceneOptions, DEFAULT_PLANARITY,
 };
 pub use scene::{Reach, ReadPolicy};
 pub use scenes::{load, load_with, load_with_policy, Builtin, CATALOGUE};
@@ -85,7 +86,11 @@ pub use trace::{make_tracer, Backend, Query, QueryError, TraceError, Tracer};
 // What a run is, and how it is cast, saved, merged and resumed.
 pub use measure::estimators::EntropyEstimator;
 pub use measure::radiosity::{MaterialError, MaterialProblem, PatchMaterials, SolveOptions};
-pub use run::persist::{load as load_state, save as save_state};
+pub use run::files;
+pub use run::persist::{
+    check_save as check_state_save, encode as encode_state, load as load_state, save as save_state,
+    save_bytes as save_state_bytes,
+};
 pub use run::{
     remaining_lines, start, Budget, CastOptions, ErrorMethod, ExtendError, Measures, MergeError,
     PersistError, RunControl, RunIdentity, RunSpec, RunState, SavedRun, SceneRef, Scope, Shard,

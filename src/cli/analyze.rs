@@ -9,8 +9,8 @@ use scene_complexity::Measure;
 use scene_complexity::Query;
 use scene_complexity::{cast, finish};
 use scene_complexity::{
-    remaining_lines, start, Budget, CastOptions, Measures, PersistError, RunControl, RunIdentity,
-    RunSpec, RunState, SceneRef, Scope, Shard, StopReason, Target,
+    remaining_lines, start, Budget, CastOptions, Measures, RunControl, RunIdentity, RunSpec,
+    RunState, SceneRef, Scope, Shard, StopReason, Target,
 };
 
 use super::args::{parse_count, parse_positive, target_measure_parser, ReportOutput, RunOptions};
@@ -287,17 +287,7 @@ pub fn check_same_scene(
     Ok(())
 }
 
-/// A state file that cannot be read or written: bad input (2) or I/O (3).
-pub fn persist_failure(e: PersistError) -> Failure {
-    Failure {
-        code: if e.is_bad_input() {
-            Exit::BadInput
-        } else {
-            Exit::Io
-        },
-        message: e.to_string(),
-    }
-}
+pub use super::output::persist_failure;
 
 /// Saves checkpoints every so often while a run goes on, and remembers a failed save (the run then
 /// stops, since its work could no longer be kept).
@@ -339,11 +329,11 @@ pub fn run(args: &AnalyzeArgs) -> Result<Exit, Failure> {
         ));
     }
     let checkpoint = args.checkpoint.as_deref().or(args.resume.as_deref());
-    output::check_all(
-        [args.out.output.as_deref(), args.save.as_deref(), checkpoint]
-            .into_iter()
-            .flatten(),
-    )?;
+    let save = args.save.as_deref();
+    output::check_all(args.out.output.as_deref())?;
+    for path in save.into_iter().chain(checkpoint) {
+        output::check_state(path)?;
+    }
     check_patch_files(args)?;
     let Prepared {
         runner,
@@ -392,13 +382,11 @@ pub fn run(args: &AnalyzeArgs) -> Result<Exit, Failure> {
             message: e.to_string(),
         })?;
     let seconds = checkpoints.seconds();
-    if let Some(f) = checkpoints.failed {
-        return Err(f);
-    }
-    for path in [args.save.as_deref(), checkpoint].into_iter().flatten() {
-        scene_complexity::save_state(path, &identity, &state, seconds).map_err(persist_failure)?;
-        output::wrote(path);
-    }
+    // The state's bytes are taken now (the analysis consumes the state) and saved after the report, so
+    // that a save that fails never costs the report of the finished work.
+    let saves: Vec<&Path> = save.into_iter().chain(checkpoint).collect();
+    let bytes =
+        (!saves.is_empty()).then(|| scene_complexity::encode_state(&identity, &state, seconds));
     // In the run's pool: the measures use the threads asked for, like the tracing.
     let analysis = runner
         .pool
@@ -411,11 +399,32 @@ pub fn run(args: &AnalyzeArgs) -> Result<Exit, Failure> {
         shard: identity.shard,
         ..runner.info()
     };
-    runner
-        .pool
-        .install(|| args.files.write(&runner.scene, &analysis))?;
     let text = report::render(args.format, &run, &analysis);
-    output::emit(args.out.output.as_deref(), &text)?;
+    let mut failures = Vec::new();
+    failures.extend(output::emit(args.out.output.as_deref(), &text).err());
+    failures.extend(
+        runner
+            .pool
+            .install(|| args.files.write(&runner.scene, &analysis))
+            .err(),
+    );
+    for path in saves {
+        let bytes = bytes.as_deref().unwrap_or_default();
+        match scene_complexity::save_state_bytes(path, bytes) {
+            Ok(()) => output::wrote(path),
+            Err(e) => failures.push(persist_failure(e)),
+        }
+    }
+    // A checkpoint that failed during the run stopped it: the report covers the lines cast until then.
+    if let Some(mut f) = checkpoints.failed {
+        f.message.push_str(
+            "; the run stopped there, and the report printed covers the lines cast until then",
+        );
+        failures.insert(0, f);
+    }
+    if let Some(first) = failures.into_iter().next() {
+        return Err(first);
+    }
     Ok(if analysis.stop_reason == StopReason::Interrupted {
         Exit::Interrupted
     } else {

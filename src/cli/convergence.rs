@@ -102,15 +102,11 @@ fn mean(xs: impl Iterator<Item = f64>) -> f64 {
 
 /// Runs `scx convergence`.
 pub fn run(args: &ConvergenceArgs) -> Result<Exit, Failure> {
-    check_all(
-        [
-            args.out.output.as_deref(),
-            args.csv.as_deref(),
-            args.plot.as_deref(),
-        ]
-        .into_iter()
-        .flatten(),
-    )?;
+    let mut outputs: Vec<(&str, &std::path::Path)> = Vec::new();
+    outputs.extend(args.out.output.as_deref().map(|p| ("-o", p)));
+    outputs.extend(args.csv.as_deref().map(|p| ("--csv", p)));
+    outputs.extend(args.plot.as_deref().map(|p| ("--plot", p)));
+    check_all(outputs.iter().map(|(_, p)| *p))?;
     if let Some(p) = &args.plot {
         plot::check_target(p).map_err(Failure::bad_input)?;
     }

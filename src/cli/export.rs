@@ -1,8 +1,8 @@
 //! `scx export`: a scene (built-in or file) written as OBJ + MTL, or as glTF 2.0.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
-use scene_complexity::{write_gltf, write_obj};
+use scene_complexity::{gltf_bytes, obj_text, Scene};
 
 use super::args::SceneArgs;
 use super::exit::{Exit, Failure};
@@ -27,20 +27,20 @@ pub fn run(args: &ExportArgs) -> Result<Exit, Failure> {
     let gltf = is_gltf(&args.output);
     let mtl = args.output.with_extension("mtl");
     if gltf {
-        check_all([args.output.as_path()])?;
+        check_outputs(&args.output, None, &args.scene)?;
     } else {
-        check_all([args.output.as_path(), mtl.as_path()])?;
+        check_outputs(&args.output, Some(&mtl), &args.scene)?;
     }
     let scene = load_scene(&args.scene, &args.input.options(), &args.input.policy())?;
-    let written = if gltf {
-        write_gltf(&scene, &args.output)
+    if gltf {
+        let binary = args
+            .output
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("glb"));
+        output::write_silently(&args.output, &gltf_bytes(&scene, binary))?;
     } else {
-        write_obj(&scene, &args.output)
-    };
-    written.map_err(|e| Failure {
-        code: Exit::Io,
-        message: e.to_string(),
-    })?;
+        write_obj_files(&scene, &args.output, &mtl)?;
+    }
     let beside = if gltf {
         String::new()
     } else {
@@ -58,4 +58,21 @@ pub fn run(args: &ExportArgs) -> Result<Exit, Failure> {
 fn is_gltf(path: &std::path::Path) -> bool {
     path.extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("gltf") || e.eq_ignore_ascii_case("glb"))
+}
+
+/// Checks, before any work, the files a scene is written to: the OBJ (or glTF) `output` and the MTL
+/// library `mtl` beside an OBJ, each writable.
+pub fn check_outputs(output: &Path, mtl: Option<&Path>, _scene: &str) -> Result<(), Failure> {
+    check_all(std::iter::once(output).chain(mtl))
+}
+
+/// Writes a scene as OBJ to `path` and its MTL library to `mtl`, each whole or not at all.
+pub fn write_obj_files(scene: &Scene, path: &Path, mtl: &Path) -> Result<(), Failure> {
+    let mtl_name = mtl
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "scene.mtl".into());
+    let (obj, library) = obj_text(scene, &mtl_name);
+    output::write_silently(mtl, library.as_bytes())?;
+    output::write_silently(path, obj.as_bytes())
 }

@@ -96,11 +96,10 @@ fn merged(args: &MergeArgs) -> Result<Merged, Failure> {
 
 /// Runs `scx merge`.
 pub fn run(args: &MergeArgs) -> Result<Exit, Failure> {
-    check_all(
-        [args.out.output.as_deref(), args.save.as_deref()]
-            .into_iter()
-            .flatten(),
-    )?;
+    check_all(args.out.output.as_deref())?;
+    if let Some(path) = &args.save {
+        output::check_state(path)?;
+    }
     args.files.check()?;
     let Merged {
         run: SavedRun {
@@ -159,10 +158,11 @@ pub fn run(args: &MergeArgs) -> Result<Exit, Failure> {
         per_patch: !args.files.patches.is_empty(),
         ..identity.spec.clone()
     };
-    if let Some(path) = &args.save {
-        scene_complexity::save_state(path, &identity, &state, seconds).map_err(persist_failure)?;
-        output::wrote(path);
-    }
+    // Saved after the report, so that a save that fails never costs it.
+    let bytes = args
+        .save
+        .as_ref()
+        .map(|_| scene_complexity::encode_state(&identity, &state, seconds));
     let analysis = runner
         .in_pool(None, "", || {
             finish(&runner.scene, &cfg, state, StopReason::Lines, seconds)
@@ -172,10 +172,23 @@ pub fn run(args: &MergeArgs) -> Result<Exit, Failure> {
         warn(&w.message);
     }
     let info = runner.info();
-    runner
-        .pool
-        .install(|| args.files.write(&runner.scene, &analysis))?;
     let text = report::render(args.format, &info, &analysis);
-    output::emit(args.out.output.as_deref(), &text)?;
-    Ok(Exit::Ok)
+    let mut failures = Vec::new();
+    failures.extend(output::emit(args.out.output.as_deref(), &text).err());
+    failures.extend(
+        runner
+            .pool
+            .install(|| args.files.write(&runner.scene, &analysis))
+            .err(),
+    );
+    if let (Some(path), Some(bytes)) = (&args.save, &bytes) {
+        match scene_complexity::save_state_bytes(path, bytes) {
+            Ok(()) => output::wrote(path),
+            Err(e) => failures.push(persist_failure(e)),
+        }
+    }
+    match failures.into_iter().next() {
+        Some(f) => Err(f),
+        None => Ok(Exit::Ok),
+    }
 }

@@ -1,9 +1,13 @@
 //! Where results go: standard output or files, every file path checked before any line is cast, and a
-//! "wrote FILE" line on stderr for each file written (unless `--quiet`).
+//! "wrote FILE" line on stderr for each file written (unless `--quiet`). Every file is written whole or
+//! not at all (a temporary beside it, renamed over it), a device or FIFO is written into, a symbolic link
+//! to a file is written through, a directory is refused.
 
 use std::io::Write;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::sync::atomic::{AtomicBool, Ordering};
+
+use scene_complexity::files::{self, Destination, DestinationError};
 
 use super::exit::{Exit, Failure};
 
@@ -51,40 +55,36 @@ fn os_reason(e: &std::io::Error) -> String {
     }
 }
 
-/// Checks, before any work, that `path` can be written: its folder exists and takes a new file, or the
-/// file exists and can be opened for writing. Nothing is left behind.
+/// What writing `path` will do, or why it cannot take an output (a directory, a dangling link).
+fn destination_of(path: &Path) -> Result<Destination, Failure> {
+    files::destination(path).map_err(|e| match e {
+        DestinationError::Io(e) => io_failure(path, "write", &e),
+        other => Failure {
+            code: Exit::Io,
+            message: format!("cannot write {}: {other}", path.display()),
+        },
+    })
+}
+
+/// Checks, before any work, that `path` can be written: a file's folder exists and takes a new file and
+/// a rename (every file is written to a temporary beside it, then renamed over it), an existing file is
+/// writable; a device is opened for writing; a directory is refused. Nothing is left behind.
 pub fn check_writable(path: &Path) -> Result<(), Failure> {
-    if path.is_dir() {
-        return Err(Failure {
-            code: Exit::Io,
-            message: format!("cannot write {}: it is a directory", path.display()),
-        });
+    let destination = destination_of(path)?;
+    if let Destination::File(real) = &destination {
+        let dir = files::folder_of(real);
+        if !dir.is_dir() {
+            return Err(Failure {
+                code: Exit::Io,
+                message: format!(
+                    "cannot write {}: the folder {} does not exist",
+                    path.display(),
+                    dir.display()
+                ),
+            });
+        }
     }
-    if path.exists() {
-        return std::fs::OpenOptions::new()
-            .append(true)
-            .open(path)
-            .map(drop)
-            .map_err(|e| io_failure(path, "write", &e));
-    }
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
-        _ => PathBuf::from("."),
-    };
-    if !dir.is_dir() {
-        return Err(Failure {
-            code: Exit::Io,
-            message: format!(
-                "cannot write {}: the folder {} does not exist",
-                path.display(),
-                dir.display()
-            ),
-        });
-    }
-    let probe = dir.join(format!(".scx-write-test-{}", std::process::id()));
-    std::fs::File::create(&probe).map_err(|e| io_failure(path, "write", &e))?;
-    let _ = std::fs::remove_file(&probe);
-    Ok(())
+    files::check(&destination).map_err(|e| io_failure(path, "write", &e))
 }
 
 /// Checks every path given (see [`check_writable`]).
@@ -92,11 +92,97 @@ pub fn check_all<'a>(paths: impl IntoIterator<Item = &'a Path>) -> Result<(), Fa
     paths.into_iter().try_for_each(check_writable)
 }
 
+/// Checks, before any work, that a run state can be saved to `path`: a regular file (never a device,
+/// a FIFO or standard output: a state is renamed into place whole), in a folder that takes it.
+pub fn check_state(path: &Path) -> Result<(), Failure> {
+    if let Destination::File(real) = destination_of(path)? {
+        let dir = files::folder_of(&real);
+        if !dir.is_dir() {
+            return Err(Failure {
+                code: Exit::Io,
+                message: format!(
+                    "cannot write {}: the folder {} does not exist",
+                    path.display(),
+                    dir.display()
+                ),
+            });
+        }
+    }
+    scene_complexity::check_state_save(path).map_err(persist_failure)
+}
+
+/// A state file that cannot be read or written: bad input (2) or I/O (3).
+pub fn persist_failure(e: scene_complexity::PersistError) -> Failure {
+    Failure {
+        code: if e.is_bad_input() {
+            Exit::BadInput
+        } else {
+            Exit::Io
+        },
+        message: without_os_error(&e.to_string()),
+    }
+}
+
+/// A message without Rust's ` (os error N)` decoration.
+fn without_os_error(text: &str) -> String {
+    match text.find(" (os error ") {
+        Some(k) => {
+            let end = text[k..].find(')').map_or(text.len(), |e| k + e + 1);
+            format!("{}{}", &text[..k], &text[end..])
+        }
+        None => text.to_string(),
+    }
+}
+
+/// Writes a file whole or not at all (a temporary beside it, renamed over it; into a device or FIFO as
+/// a stream) from what `fill` writes, and says so.
+pub fn write_with(
+    path: &Path,
+    mut fill: impl FnMut(&mut dyn Write) -> std::io::Result<()>,
+) -> Result<(), Failure> {
+    let destination = destination_of(path)?;
+    files::write(&destination, &|_| false, &mut fill).map_err(|e| write_failure(path, e))?;
+    wrote(path);
+    Ok(())
+}
+
+/// Writes a file whole or not at all through a writer that takes a path (a plot, a picture): it writes
+/// a temporary whose name ends with `.EXT`, renamed over `path` (a device or FIFO it writes itself).
+/// Does not say so.
+pub fn write_via(
+    path: &Path,
+    extension: &str,
+    mut make: impl FnMut(&Path) -> Result<(), String>,
+) -> Result<(), Failure> {
+    let mut run = |p: &Path| make(p).map_err(std::io::Error::other);
+    match destination_of(path)? {
+        Destination::Stream(p) => run(&p).map_err(|e| io_failure(path, "write", &e)),
+        Destination::File(real) => {
+            files::write_file_via(&real, Some(extension), &|_| false, &mut run)
+                .map_err(|e| write_failure(path, e))
+        }
+    }
+}
+
+fn write_failure(path: &Path, e: files::WriteError) -> Failure {
+    let mut f = io_failure(path, "write", &e.source);
+    if let Some(kept) = e.kept {
+        f.message
+            .push_str(&format!("; the whole file is kept in {}", kept.display()));
+    }
+    f
+}
+
+/// Writes a file whole or not at all, without saying so (the caller says what it wrote).
+pub fn write_silently(path: &Path, contents: &[u8]) -> Result<(), Failure> {
+    let destination = destination_of(path)?;
+    files::write(&destination, &|_| false, &mut |w| w.write_all(contents))
+        .map_err(|e| write_failure(path, e))
+}
+
 /// Writes a file and says so.
 pub fn write_file(path: &Path, contents: &[u8]) -> Result<(), Failure> {
-    std::fs::write(path, contents).map_err(|e| io_failure(path, "write", &e))?;
-    note(&format!("wrote {}", path.display()));
-    Ok(())
+    write_with(path, |w| w.write_all(contents))
 }
 
 /// Says that a file written elsewhere (a mesh, a plot) was written.

@@ -8,7 +8,7 @@
 //! * `--form-factors x.mtx`: the same matrix as Matrix Market coordinates (`scipy.io.mmread`), 1-based.
 
 use std::fmt::Write as _;
-use std::io::{BufWriter, Write};
+use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use rayon::prelude::*;
@@ -22,7 +22,7 @@ use scene_complexity::Wanted;
 use scene_complexity::{Analysis, PatchResult};
 
 use super::exit::Failure;
-use super::output::{self, io_failure, warn, wrote};
+use super::output::{self, warn};
 
 /// The per-patch files of `scx analyze` and `scx merge`.
 #[derive(clap::Args, Debug)]
@@ -191,18 +191,16 @@ fn write_form_factors(paths: &[PathBuf], scene: &Scene, a: &Analysis) -> Result<
     Ok(())
 }
 
-/// Creates `path`, hands a buffered writer to `fill`, and says so.
+/// Writes `path` whole or not at all from what `fill` writes, and says so.
 fn write_with(
     path: &Path,
     fill: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
 ) -> Result<(), Failure> {
-    let file = std::fs::File::create(path).map_err(|e| io_failure(path, "write", &e))?;
-    let mut w = BufWriter::new(file);
-    fill(&mut w)
-        .and_then(|()| w.flush())
-        .map_err(|e| io_failure(path, "write", &e))?;
-    wrote(path);
-    Ok(())
+    let mut fill = Some(fill);
+    output::write_with(path, |w| match fill.take() {
+        Some(f) => f(w),
+        None => Ok(()),
+    })
 }
 
 /// Every `(i, j, N_ij)` with `N_ij > 0`, both directions of each pair, sorted by `i` then `j`; a

@@ -88,9 +88,18 @@ pub(super) fn register_font() -> Result<(), String> {
 pub fn write(path: &Path, title: &str, curves: &[Curve]) -> Result<(), String> {
     check_target(path)?;
     register_font()?;
+    let ext = extension(path);
+    super::output::write_via(path, &ext, |temporary| {
+        draw_to(temporary, &ext, title, curves)
+    })
+    .map_err(|f| f.message)
+}
+
+/// Draws the plot into `path`, as SVG or PNG by `ext`.
+fn draw_to(path: &Path, ext: &str, title: &str, curves: &[Curve]) -> Result<(), String> {
     let shown = path.display().to_string();
     let fail = |e: &dyn std::fmt::Display| format!("cannot draw {shown}: {e}");
-    if extension(path) == "svg" {
+    if ext == "svg" {
         draw(
             SVGBackend::new(path, (1000, 680)).into_drawing_area(),
             title,

@@ -4,7 +4,6 @@ use std::path::PathBuf;
 
 use clap::ValueEnum;
 use scene_complexity::refine::{refine, RefineConfig, RefineRound, Strategy};
-use scene_complexity::write_obj;
 use scene_complexity::RunControl;
 use scene_complexity::SolveOptions;
 use scene_complexity::{make_tracer, Query};
@@ -14,7 +13,7 @@ use super::args::SceneArgs;
 use super::args::{parse_count, parse_positive, Seed, Threads, Tracer, TracerArg};
 use super::exit::{Exit, Failure};
 use super::input::load_scene;
-use super::output::{self, check_all, note};
+use super::output::{self, note};
 use super::runner::{thread_pool, watch_ctrl_c};
 
 /// Arguments of `scx refine`.
@@ -59,7 +58,7 @@ enum StrategyArg {
 /// Runs `scx refine`.
 pub fn run(args: &RefineArgs) -> Result<Exit, Failure> {
     let mtl = args.output.with_extension("mtl");
-    check_all([args.output.as_path(), mtl.as_path()])?;
+    super::export::check_outputs(&args.output, Some(&mtl), &args.scene)?;
     let scene = load_scene(&args.scene, &args.input.options(), &args.input.policy())?;
     let backend = TracerArg::backend(args.tracer.value);
     // Check the backend once up front, so that an unavailable one is a clear input error.
@@ -103,10 +102,7 @@ pub fn run(args: &RefineArgs) -> Result<Exit, Failure> {
             )
         })
         .map_err(Failure::of)?;
-    write_obj(&refined.scene, &args.output).map_err(|e| Failure {
-        code: Exit::Io,
-        message: e.to_string(),
-    })?;
+    super::export::write_obj_files(&refined.scene, &args.output, &mtl)?;
     let lines: u64 = refined.rounds.iter().map(|r| r.lines).sum();
     output::note(&format!(
         "wrote {} ({} patches) and {}: {} rounds, {lines} lines, {:.2} s",

@@ -1,7 +1,6 @@
 //! `scx render`: a picture of the scene with each patch coloured by a per-patch result of a run, with a
 //! labelled colour bar (PNG), and optionally the coloured mesh (PLY).
 
-use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 
 use plotters::prelude::*;
@@ -16,7 +15,7 @@ use scene_complexity::{Point, Vector};
 
 use super::args::{parse_count, RunOptions};
 use super::exit::{Exit, Failure};
-use super::output::{self, io_failure, warn};
+use super::output::{self, warn};
 use super::plot::{font_path, register_font};
 use super::runner::Runner;
 
@@ -141,7 +140,9 @@ pub fn run(args: &RenderArgs) -> Result<Exit, Failure> {
         check_extension(ply, "ply", "--patches-mesh")?;
     }
     font_path().map_err(Failure::bad_input)?;
-    output::check_all(std::iter::once(args.output.as_path()).chain(args.patches_mesh.as_deref()))?;
+    let mut outputs = vec![("-o", args.output.as_path())];
+    outputs.extend(args.patches_mesh.as_deref().map(|p| ("--patches-mesh", p)));
+    output::check_all(outputs.iter().map(|(_, p)| *p))?;
     if args.per_area && !args.color.is_share() {
         return Err(Failure::bad_input(format!(
             "--per-area applies to the shares of a sum over patches, not to {}",
@@ -229,7 +230,11 @@ pub fn run(args: &RenderArgs) -> Result<Exit, Failure> {
         args.color.unit(args.per_area),
         grouped(analysis.lines)
     );
-    draw_png(&args.output, (pw, ph, pixels), &title, &scale, &shown)?;
+    let mut picture = Some((pw, ph, pixels));
+    output::write_via(&args.output, "png", |temporary| {
+        let picture = picture.take().unwrap_or_default();
+        draw_png(temporary, picture, &title, &scale, &shown).map_err(|f| f.message)
+    })?;
     output::wrote(&args.output);
     if let Some(ply) = &args.patches_mesh {
         let comment = format!(
@@ -242,12 +247,9 @@ pub fn run(args: &RenderArgs) -> Result<Exit, Failure> {
             scale.hi,
             env!("CARGO_PKG_VERSION")
         );
-        let file = std::fs::File::create(ply).map_err(|e| io_failure(ply, "write", &e))?;
-        let mut out = BufWriter::new(file);
-        write_ply(&mut out, scene, &colours, &values, &comment)
-            .and_then(|()| out.flush())
-            .map_err(|e| io_failure(ply, "write", &e))?;
-        output::wrote(ply);
+        output::write_with(ply, |out| {
+            write_ply(out, scene, &colours, &values, &comment)
+        })?;
     }
     Ok(if analysis.stop_reason == StopReason::Interrupted {
         Exit::Interrupted

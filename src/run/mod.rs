@@ -10,7 +10,8 @@
 //!   the run;
 //! * [`errors`]: standard errors from the groups (batch means, the delete-a-group jackknife);
 //! * [`control`]: budgets, stop reasons and the handle that watches and stops a run;
-//! * [`persist`]: run states saved to files, to resume or merge.
+//! * [`persist`]: run states saved to files, to resume or merge;
+//! * [`files`]: files written whole or not at all, streams written into, locks beside states.
 //!
 //! What is computed from a run is [`crate::analysis`]'s.
 
@@ -18,6 +19,7 @@ pub mod batches;
 pub mod cast;
 pub mod control;
 pub mod errors;
+pub mod files;
 pub mod persist;
 pub mod plan;
 pub mod spec;

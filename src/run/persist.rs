@@ -13,14 +13,16 @@
 //! them.
 //!
 //! Files are written atomically (a temporary file beside the target, synced, then renamed over it), so a
-//! run killed while saving leaves the previous state intact.
+//! run killed while saving leaves the previous state intact ([`super::files`]). A state goes only to a
+//! regular file (or through a symbolic link to one): never into a device or FIFO, never renamed over
+//! one.
 
-use std::io::Write;
 use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
 use super::cast::Shard;
+use super::files::{self, Destination, DestinationError};
 use super::plan::{BatchPlan, BatchSet};
 use super::spec::{RunSpec, SpecDifference};
 use super::state::RunState;
@@ -168,6 +170,25 @@ pub enum PersistError {
         /// The system's reason.
         source: std::io::Error,
     },
+    /// The whole state was written to a temporary beside the file, but it could not be renamed into
+    /// place: the temporary is kept.
+    #[error("cannot write {path}: {source}; the state is kept whole in {kept}")]
+    Kept {
+        /// The file.
+        path: String,
+        /// The temporary holding the state.
+        kept: String,
+        /// The system's reason.
+        source: std::io::Error,
+    },
+    /// The path cannot take a state: a directory, a device, a FIFO.
+    #[error("cannot save a run state to {path}: {problem}")]
+    NotAFile {
+        /// The file.
+        path: String,
+        /// What it is.
+        problem: String,
+    },
     /// The file is not a state file, or is damaged.
     #[error("{path}: {problem}")]
     Bad {
@@ -181,7 +202,10 @@ pub enum PersistError {
 impl PersistError {
     /// Whether the file's contents are at fault (not the file system).
     pub fn is_bad_input(&self) -> bool {
-        matches!(self, PersistError::Bad { .. })
+        matches!(
+            self,
+            PersistError::Bad { .. } | PersistError::NotAFile { .. }
+        )
     }
 }
 
@@ -500,31 +524,78 @@ pub fn save(
     state: &RunState,
     seconds: f64,
 ) -> Result<(), PersistError> {
-    let io = |source| PersistError::Io {
+    save_bytes(path, &encode(identity, state, seconds))
+}
+
+/// Where a state for `path` is written: a regular file (the path, or the target of the symbolic link
+/// it is); anything else is refused with a sentence.
+pub fn state_destination(path: &Path) -> Result<std::path::PathBuf, PersistError> {
+    let refuse = |problem: String| PersistError::NotAFile {
+        path: path.display().to_string(),
+        problem,
+    };
+    match files::destination(path) {
+        Ok(Destination::File(real)) => Ok(real),
+        Ok(Destination::Stream(_)) => Err(refuse(
+            "it is not a regular file (a device, a FIFO or a standard stream); a state is written \
+             whole and renamed into place, so name a file"
+                .into(),
+        )),
+        Err(DestinationError::Io(source)) => Err(PersistError::Io {
+            doing: "write",
+            path: path.display().to_string(),
+            source,
+        }),
+        Err(e) => Err(refuse(e.to_string())),
+    }
+}
+
+/// Checks, before any work, that a state can be saved to `path` (see [`state_destination`]; its folder
+/// takes a new file and a rename).
+pub fn check_save(path: &Path) -> Result<(), PersistError> {
+    let real = state_destination(path)?;
+    files::check(&Destination::File(real)).map_err(|source| PersistError::Io {
         doing: "write",
         path: path.display().to_string(),
         source,
+    })
+}
+
+/// Writes the bytes of a state file ([`encode`]) to `path`, atomically. A failed write removes its
+/// temporary, unless only the rename failed: then the temporary holds the whole state and the error
+/// names it ([`PersistError::Kept`]). Temporaries of this file left by processes of this host that are
+/// gone are removed first, unless they hold a whole state.
+pub fn save_bytes(path: &Path, bytes: &[u8]) -> Result<(), PersistError> {
+    let real = state_destination(path)?;
+    let shown = path.display().to_string();
+    files::write_file_via(&real, None, &is_whole_state, &mut |t| {
+        std::fs::write(t, bytes)
+    })
+    .map_err(|e| match e.kept {
+        Some(kept) => PersistError::Kept {
+            path: shown.clone(),
+            kept: kept.display().to_string(),
+            source: e.source,
+        },
+        None => PersistError::Io {
+            doing: "write",
+            path: shown.clone(),
+            source: e.source,
+        },
+    })
+}
+
+/// Whether the file at `path` is a whole state file: its header, its length and its checksum agree.
+fn is_whole_state(path: &Path) -> bool {
+    let Ok(bytes) = std::fs::read(path) else {
+        return false;
     };
-    let bytes = encode(identity, state, seconds);
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
-        _ => std::path::PathBuf::from("."),
-    };
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_else(|| "state".into());
-    let temporary = dir.join(format!(".{name}.{}.tmp", std::process::id()));
-    let mut file = std::fs::File::create(&temporary).map_err(io)?;
-    file.write_all(&bytes).map_err(io)?;
-    file.sync_all().map_err(io)?;
-    drop(file);
-    std::fs::rename(&temporary, path).map_err(io)?;
-    // The rename itself is durable once the folder is synced (where the system allows it).
-    if let Ok(d) = std::fs::File::open(&dir) {
-        let _ = d.sync_all();
-    }
-    Ok(())
+    bytes.len() >= HEADER
+        && &bytes[..8] == MAGIC
+        && u64::from_le_bytes(bytes[12..20].try_into().expect("8 bytes"))
+            == (bytes.len() - HEADER) as u64
+        && u32::from_le_bytes(bytes[20..24].try_into().expect("4 bytes"))
+            == crc32fast::hash(&bytes[HEADER..])
 }
 
 /// Reads a state file.

@@ -351,11 +351,20 @@ fn determinant3(m: &Matrix) -> f64 {
 /// Writes a scene as glTF 2.0: binary (`.glb`) when the path ends so, else JSON with the buffer in a
 /// data URI (one self-contained file).
 pub fn write(scene: &Scene, path: &Path) -> Result<(), SceneError> {
-    let (document, buffer) = document(scene);
     let binary = path
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("glb"));
-    let bytes = if binary {
+    std::fs::write(path, to_bytes(scene, binary)).map_err(|e| SceneError::File {
+        path: path.display().to_string(),
+        message: format!("cannot write: {e}"),
+    })
+}
+
+/// The bytes of a scene as glTF 2.0 (see [`write`]): binary glTF when `binary`, else JSON with the
+/// buffer in a data URI.
+pub fn to_bytes(scene: &Scene, binary: bool) -> Vec<u8> {
+    let (document, buffer) = document(scene);
+    if binary {
         glb(&document, &buffer)
     } else {
         let mut doc = document;
@@ -366,11 +375,7 @@ pub fn write(scene: &Scene, path: &Path) -> Result<(), SceneError> {
         let mut text = serde_json::to_string_pretty(&doc).expect("a JSON value always serialises");
         text.push('\n');
         text.into_bytes()
-    };
-    std::fs::write(path, bytes).map_err(|e| SceneError::File {
-        path: path.display().to_string(),
-        message: format!("cannot write: {e}"),
-    })
+    }
 }
 
 /// The glTF JSON and its one buffer: per object a node and a mesh, per material in it a primitive with

@@ -558,7 +558,6 @@ fn describe_tobj_error(e: &tobj::LoadError) -> String {
 /// (`Kd` = reflectance, `Ke` = emission, RGB), so that [`load`] reads back the same patches and
 /// materials. A scene of several objects gets an `o` statement per object, so that they keep their names.
 pub fn write(scene: &Scene, path: &Path) -> Result<(), SceneError> {
-    use std::fmt::Write as _;
     let io_error = |p: &Path, e: std::io::Error| SceneError::File {
         path: p.display().to_string(),
         message: format!("cannot write: {e}"),
@@ -568,7 +567,16 @@ pub fn write(scene: &Scene, path: &Path) -> Result<(), SceneError> {
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_else(|| "scene.mtl".into());
+    let (obj, mtl) = to_text(scene, &mtl_name);
+    std::fs::write(&mtl_path, mtl).map_err(|e| io_error(&mtl_path, e))?;
+    std::fs::write(path, obj).map_err(|e| io_error(path, e))?;
+    Ok(())
+}
 
+/// The OBJ text of a scene and the text of its MTL library, which the OBJ names `mtl_name` (see
+/// [`write`]), for a caller that writes the files its own way.
+pub fn to_text(scene: &Scene, mtl_name: &str) -> (String, String) {
+    use std::fmt::Write as _;
     let mut mtl = String::from("# written by scx\n");
     for (k, m) in scene.materials.iter().enumerate() {
         let [r, g, b] = m.reflectance_rgb;
@@ -607,9 +615,7 @@ pub fn write(scene: &Scene, path: &Path) -> Result<(), SceneError> {
         let idx: Vec<String> = p.polygon.iter().map(|v| (v + 1).to_string()).collect();
         let _ = writeln!(obj, "f {}", idx.join(" "));
     }
-    std::fs::write(&mtl_path, mtl).map_err(|e| io_error(&mtl_path, e))?;
-    std::fs::write(path, obj).map_err(|e| io_error(path, e))?;
-    Ok(())
+    (obj, mtl)
 }
 
 /// A material name safe for MTL (no spaces), unique by index.

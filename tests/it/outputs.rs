@@ -66,3 +66,271 @@ fn durations_beyond_the_clock_are_no_limit() {
     }
     assert!(dir.path().join("c.scx").is_file());
 }
+
+/// The machine's name as scx records it in temporaries and locks.
+fn host() -> String {
+    std::fs::read_to_string("/proc/sys/kernel/hostname")
+        .map(|s| s.trim().to_string())
+        .unwrap_or_default()
+}
+
+/// The id of a process that has ended.
+fn dead_pid() -> u32 {
+    let mut child = Command::new("true").spawn().expect("true runs");
+    let pid = child.id();
+    child.wait().unwrap();
+    pid
+}
+
+fn read(path: &Path) -> Vec<u8> {
+    std::fs::read(path).unwrap_or_default()
+}
+
+/// Devices are written into as streams, states refused there; directories are refused before work;
+/// a symbolic link to a file is written through (the link stays, its target holds the output).
+#[test]
+fn devices_directories_and_links_are_what_they_are() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let out = scx_in(
+        d,
+        &["analyze", "@cube:2", "--lines", "1e4", "-o", "/dev/null"],
+    );
+    assert_eq!(code(&out), Some(0), "{}", stderr(&out));
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt;
+        let null = Path::new("/dev/null").metadata().unwrap();
+        assert!(
+            null.file_type().is_char_device(),
+            "/dev/null is still a device"
+        );
+    }
+    for flag in ["--save", "--checkpoint"] {
+        let out = scx_in(
+            d,
+            &["analyze", "@cube:2", "--lines", "1e4", flag, "/dev/null"],
+        );
+        assert_eq!(code(&out), Some(2), "{}", stderr(&out));
+        assert!(
+            stderr(&out).contains("not a regular file"),
+            "{}",
+            stderr(&out)
+        );
+        assert!(out.stdout.is_empty(), "refused before work");
+    }
+    std::fs::create_dir(d.join("folder")).unwrap();
+    for args in [
+        &["analyze", "@cube:2", "--lines", "1e4", "-o", "folder"][..],
+        &["analyze", "@cube:2", "--lines", "1e4", "--save", "folder"],
+        &["export", "@cube:2", "-o", "folder"],
+    ] {
+        let out = scx_in(d, args);
+        assert_ne!(code(&out), Some(0), "{args:?}");
+        assert!(
+            stderr(&out).contains("directory"),
+            "{args:?}: {}",
+            stderr(&out)
+        );
+        assert!(out.stdout.is_empty(), "{args:?}: refused before work");
+    }
+    assert!(d.join("folder").is_dir());
+
+    std::fs::write(d.join("target.txt"), "old").unwrap();
+    std::fs::write(d.join("target.scx"), "old").unwrap();
+    #[cfg(unix)]
+    {
+        std::os::unix::fs::symlink("target.txt", d.join("link.txt")).unwrap();
+        std::os::unix::fs::symlink("target.scx", d.join("link.scx")).unwrap();
+        let out = scx_in(
+            d,
+            &[
+                "analyze", "@cube:2", "--lines", "1e4", "-o", "link.txt", "--save", "link.scx",
+            ],
+        );
+        assert_eq!(code(&out), Some(0), "{}", stderr(&out));
+        for (link, target) in [("link.txt", "target.txt"), ("link.scx", "target.scx")] {
+            let meta = std::fs::symlink_metadata(d.join(link)).unwrap();
+            assert!(meta.file_type().is_symlink(), "{link} is still a link");
+            assert_ne!(read(&d.join(target)), b"old", "{target} holds the output");
+        }
+        assert!(String::from_utf8_lossy(&read(&d.join("target.txt"))).contains("@cube:2"));
+        let out = scx_in(d, &["merge", "link.scx"]);
+        assert_eq!(
+            code(&out),
+            Some(0),
+            "the state behind the link: {}",
+            stderr(&out)
+        );
+    }
+}
+
+/// A save that fails (here the file-size limit, `ulimit -f`, with the signal ignored so that writes
+/// fail with EFBIG) comes after the report: the report is printed whole, the failure is exit 3 naming
+/// the file, and no temporary is left.
+#[cfg(unix)]
+#[test]
+fn a_failed_save_keeps_the_report() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::write(d.join("s.scx"), "old state").unwrap();
+    let out = Command::new("sh")
+        .arg("-c")
+        .arg("trap '' XFSZ; ulimit -f 4; exec \"$0\" analyze @cube:2 --lines 1e4 --save s.scx")
+        .arg(env!("CARGO_BIN_EXE_scx"))
+        .current_dir(d)
+        .output()
+        .unwrap();
+    let err = stderr(&out);
+    assert_eq!(code(&out), Some(3), "{err}");
+    assert!(err.contains("cannot write s.scx"), "{err}");
+    let report = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        report.contains("@cube:2") && report.contains("mutual"),
+        "{report}"
+    );
+    assert_eq!(read(&d.join("s.scx")), b"old state");
+    let left: Vec<String> = std::fs::read_dir(d)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n != "s.scx")
+        .collect();
+    assert!(left.is_empty(), "left behind: {left:?}");
+
+    // A report that cannot be written (a full device) does not cost the state either.
+    let out = scx_in(
+        d,
+        &[
+            "analyze",
+            "@cube:2",
+            "--lines",
+            "1e4",
+            "-o",
+            "/dev/full",
+            "--save",
+            "t.scx",
+        ],
+    );
+    assert_eq!(code(&out), Some(3), "{}", stderr(&out));
+    assert!(stderr(&out).contains("/dev/full"));
+    assert_eq!(code(&scx_in(d, &["merge", "t.scx"])), Some(0));
+}
+
+/// Temporaries of scx's naming whose process is gone on this host are removed at the next save; those
+/// of a live process, of another host, or holding a whole state are kept.
+#[cfg(target_os = "linux")]
+#[test]
+fn stale_temporaries_are_cleaned_at_the_next_save() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let out = scx_in(
+        d,
+        &[
+            "analyze",
+            "@cube:2",
+            "--lines",
+            "1e4",
+            "--save",
+            "whole.scx",
+        ],
+    );
+    assert_eq!(code(&out), Some(0), "{}", stderr(&out));
+    let (host, dead, live) = (host(), dead_pid(), std::process::id());
+    let stale = [
+        format!(".s.scx.{dead}@{host}.scx-tmp"),
+        format!(".s.scx.{dead}.tmp"),
+    ];
+    let kept = [
+        format!(".s.scx.{live}@{host}.scx-tmp"),
+        format!(".s.scx.{dead}@another-host.scx-tmp"),
+        format!(".t.scx.{dead}@{host}.scx-tmp"),
+        format!(".s.scx.{}@{host}.scx-tmp", dead_pid()),
+    ];
+    for name in stale.iter().chain(&kept[..3]) {
+        std::fs::write(d.join(name), "cut short").unwrap();
+    }
+    std::fs::copy(d.join("whole.scx"), d.join(&kept[3])).unwrap();
+    let out = scx_in(
+        d,
+        &["analyze", "@cube:2", "--lines", "1e4", "--save", "s.scx"],
+    );
+    assert_eq!(code(&out), Some(0), "{}", stderr(&out));
+    for name in &stale {
+        assert!(!d.join(name).exists(), "{name} should be cleaned");
+    }
+    for name in &kept {
+        assert!(d.join(name).exists(), "{name} should be kept");
+    }
+}
+
+/// Every output is written to a temporary and renamed into place: an existing file is replaced whole
+/// (its permissions kept), and no temporary stays beside it.
+#[test]
+fn outputs_are_renamed_into_place() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    for name in ["r.json", "p.csv", "ff.mtx", "m.obj", "m.mtl", "c.csv"] {
+        std::fs::write(d.join(name), "old").unwrap();
+    }
+    let runs: &[&[&str]] = &[
+        &[
+            "analyze",
+            "@cube:2",
+            "--lines",
+            "1e4",
+            "--format",
+            "json",
+            "-o",
+            "r.json",
+            "--patches",
+            "p.csv",
+            "--form-factors",
+            "ff.mtx",
+        ],
+        &["export", "@cube:2", "-o", "m.obj"],
+        &["export", "@cube:2", "-o", "m.glb"],
+        &[
+            "convergence",
+            "@cube:2",
+            "--lines",
+            "1e3,2e3",
+            "--csv",
+            "c.csv",
+        ],
+    ];
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        let mode = std::fs::Permissions::from_mode(0o640);
+        std::fs::set_permissions(d.join("r.json"), mode).unwrap();
+    }
+    for args in runs {
+        let out = scx_in(d, args);
+        assert_eq!(code(&out), Some(0), "{args:?}: {}", stderr(&out));
+    }
+    for name in [
+        "r.json", "p.csv", "ff.mtx", "m.obj", "m.mtl", "c.csv", "m.glb",
+    ] {
+        let bytes = read(&d.join(name));
+        assert!(bytes.len() > 10 && bytes != b"old", "{name}");
+    }
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        let mode = std::fs::metadata(d.join("r.json"))
+            .unwrap()
+            .permissions()
+            .mode();
+        assert_eq!(
+            mode & 0o777,
+            0o640,
+            "the replaced file keeps its permissions"
+        );
+    }
+    let left: Vec<String> = std::fs::read_dir(d)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.starts_with('.'))
+        .collect();
+    assert!(left.is_empty(), "temporaries left: {left:?}");
+}

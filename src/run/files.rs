@@ -1,0 +1,292 @@
+//! Writing files so that none is ever partial and nothing that is not ours is replaced: a file goes to a
+//! temporary beside it, synced, then renamed over it; a device or FIFO is written into as a stream; a
+//! symbolic link to a regular file is written through (its target replaced, the link kept); a
+//! directory is refused. Temporaries are named `.NAME.PID@HOST.scx-tmp` (with the target's extension
+//! after it when a writer needs one), so that those of a process gone on this host are recognised and
+//! cleaned at the next write beside them.
+//!
+//! Every function here is std only; the CLI and [`super::persist`] share them.
+
+use std::fs::{File, OpenOptions};
+use std::io::{BufWriter, Write};
+use std::path::{Path, PathBuf};
+
+/// Where the bytes meant for a path go.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Destination {
+    /// A regular file (new or existing) at this path, the path as given or the target of the symbolic
+    /// link given: replaced atomically.
+    File(PathBuf),
+    /// A device, a FIFO, or a file behind `/dev/stdout`-like links (`/dev/...`, `/proc/...`): written
+    /// into as a stream, never renamed over.
+    Stream(PathBuf),
+}
+
+/// Why a path cannot take an output.
+#[derive(Debug, thiserror::Error)]
+pub enum DestinationError {
+    /// It is a directory.
+    #[error("it is a directory")]
+    Directory,
+    /// A symbolic link whose target does not exist.
+    #[error("it is a symbolic link to a missing file")]
+    DanglingLink,
+    /// The system refused to say what it is.
+    #[error("{0}")]
+    Io(#[from] std::io::Error),
+}
+
+/// What writing to `path` will do (see [`Destination`]).
+pub fn destination(path: &Path) -> Result<Destination, DestinationError> {
+    let link = match std::fs::symlink_metadata(path) {
+        Ok(m) => m,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+            return Ok(Destination::File(path.to_path_buf()))
+        }
+        Err(e) => return Err(e.into()),
+    };
+    let meta = match std::fs::metadata(path) {
+        Ok(m) => m,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+            return Err(DestinationError::DanglingLink)
+        }
+        Err(e) => return Err(e.into()),
+    };
+    if meta.is_dir() {
+        return Err(DestinationError::Directory);
+    }
+    if !meta.is_file() {
+        return Ok(Destination::Stream(path.to_path_buf()));
+    }
+    if !link.file_type().is_symlink() {
+        return Ok(Destination::File(path.to_path_buf()));
+    }
+    // `/dev/stdout` and `/proc/self/fd/1` lead to whatever the shell opened: write into it.
+    let system = path.is_absolute() && (path.starts_with("/dev") || path.starts_with("/proc"));
+    if system {
+        return Ok(Destination::Stream(path.to_path_buf()));
+    }
+    Ok(Destination::File(std::fs::canonicalize(path)?))
+}
+
+/// This machine's name, as temporaries and locks record it.
+pub fn this_host() -> String {
+    ["/proc/sys/kernel/hostname", "/etc/hostname"]
+        .iter()
+        .find_map(|p| std::fs::read_to_string(p).ok())
+        .map(|s| s.trim().to_string())
+        .filter(|s| !s.is_empty())
+        .or_else(|| std::env::var("HOSTNAME").ok().filter(|s| !s.is_empty()))
+        .unwrap_or_else(|| "localhost".into())
+}
+
+/// Whether process `pid` of this host is running. Where the system cannot tell (no `/proc`), every
+/// process counts as running, so nothing of a live process is ever taken.
+pub fn process_alive(pid: u32) -> bool {
+    if pid == std::process::id() {
+        return true;
+    }
+    if cfg!(target_os = "linux") && Path::new("/proc/self").exists() {
+        return Path::new(&format!("/proc/{pid}")).exists();
+    }
+    true
+}
+
+/// The folder of `path` (`.` for a bare name).
+pub fn folder_of(path: &Path) -> PathBuf {
+    match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+        _ => PathBuf::from("."),
+    }
+}
+
+fn name_of(path: &Path) -> String {
+    path.file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "output".into())
+}
+
+const TEMPORARY: &str = ".scx-tmp";
+
+/// The temporary that a write of `path` by this process uses, ending with `.EXT` when `extension` is
+/// given (for writers that choose their format by it).
+pub fn temporary_for(path: &Path, extension: Option<&str>) -> PathBuf {
+    let ext = extension.map(|e| format!(".{e}")).unwrap_or_default();
+    folder_of(path).join(format!(
+        ".{}.{}@{}{TEMPORARY}{ext}",
+        name_of(path),
+        std::process::id(),
+        this_host()
+    ))
+}
+
+/// The process and host of a temporary of `path`, when `file` (a name in its folder) is one. The
+/// temporaries of scx before this naming (`.NAME.PID.tmp`) are recognised too, as of this host.
+fn temporary_owner(path: &Path, file: &str) -> Option<(u32, String)> {
+    let prefix = format!(".{}.", name_of(path));
+    let rest = file.strip_prefix(&prefix)?;
+    if let Some(k) = rest.find(TEMPORARY) {
+        let (pid, host) = rest[..k].split_once('@')?;
+        return Some((pid.parse().ok()?, host.to_string()));
+    }
+    let pid = rest.strip_suffix(".tmp")?;
+    Some((pid.parse().ok()?, this_host()))
+}
+
+/// Removes the temporaries of `path` left by processes of this host that are gone (killed while
+/// writing), except those that `keep` says hold finished work.
+pub fn clean_stale_temporaries(path: &Path, keep: &dyn Fn(&Path) -> bool) {
+    let folder = folder_of(path);
+    let Ok(entries) = std::fs::read_dir(&folder) else {
+        return;
+    };
+    let host = this_host();
+    for entry in entries.flatten() {
+        let file = entry.file_name().to_string_lossy().into_owned();
+        let Some((pid, owner)) = temporary_owner(path, &file) else {
+            continue;
+        };
+        let temporary = folder.join(&file);
+        let regular = entry.file_type().is_ok_and(|t| t.is_file());
+        if owner == host && regular && !process_alive(pid) && !keep(&temporary) {
+            let _ = std::fs::remove_file(&temporary);
+        }
+    }
+}
+
+/// Checks, before any work, that `destination` can be written as [`write`] will: a stream opened for
+/// writing (a FIFO is not opened, which would wait for its reader); a file's folder takes a new file and
+/// a rename, and an existing file is writable.
+pub fn check(destination: &Destination) -> std::io::Result<()> {
+    match destination {
+        Destination::Stream(path) => {
+            let fifo = {
+                #[cfg(unix)]
+                {
+                    use std::os::unix::fs::FileTypeExt;
+                    std::fs::metadata(path).is_ok_and(|m| m.file_type().is_fifo())
+                }
+                #[cfg(not(unix))]
+                {
+                    false
+                }
+            };
+            if !fifo {
+                OpenOptions::new().append(true).open(path)?;
+            }
+            Ok(())
+        }
+        Destination::File(path) => {
+            if path.exists() {
+                OpenOptions::new().append(true).open(path)?;
+            }
+            let probe = temporary_for(path, None);
+            let moved = temporary_for(path, Some("probe"));
+            File::create(&probe)?;
+            let renamed = std::fs::rename(&probe, &moved);
+            let _ = std::fs::remove_file(&probe);
+            let _ = std::fs::remove_file(&moved);
+            renamed
+        }
+    }
+}
+
+/// A write that failed: the system's reason, and the temporary kept when it holds the whole output
+/// (the rename failed).
+#[derive(Debug)]
+pub struct WriteError {
+    /// Why.
+    pub source: std::io::Error,
+    /// The complete temporary left in place.
+    pub kept: Option<PathBuf>,
+}
+
+impl From<std::io::Error> for WriteError {
+    fn from(source: std::io::Error) -> Self {
+        WriteError { source, kept: None }
+    }
+}
+
+/// Writes what `fill` produces to `destination`: into a stream as it comes, or to a temporary beside a
+/// file, synced and renamed over it (the file keeps its permissions). On failure the temporary is
+/// removed, unless only the rename failed (then it is whole, and [`WriteError::kept`] names it).
+/// `keep` spares the stale temporaries cleaned first that hold finished work.
+pub fn write(
+    destination: &Destination,
+    keep: &dyn Fn(&Path) -> bool,
+    fill: &mut dyn FnMut(&mut dyn Write) -> std::io::Result<()>,
+) -> Result<(), WriteError> {
+    match destination {
+        Destination::Stream(path) => {
+            let file = OpenOptions::new().append(true).open(path)?;
+            let mut out = BufWriter::new(file);
+            fill(&mut out)?;
+            out.flush()?;
+            Ok(())
+        }
+        Destination::File(path) => write_file_via(path, None, keep, &mut |temporary| {
+            let mut out = BufWriter::new(File::create(temporary)?);
+            fill(&mut out)?;
+            out.flush()?;
+            Ok(())
+        }),
+    }
+}
+
+/// Writes the file `path` atomically through a writer that takes a path (`make` writes the temporary
+/// it is given, whose name ends with `.EXT` when `extension` is given), then syncs it and renames it
+/// over `path` (see [`write`]).
+pub fn write_file_via(
+    path: &Path,
+    extension: Option<&str>,
+    keep: &dyn Fn(&Path) -> bool,
+    make: &mut dyn FnMut(&Path) -> std::io::Result<()>,
+) -> Result<(), WriteError> {
+    clean_stale_temporaries(path, keep);
+    let temporary = temporary_for(path, extension);
+    let written = make(&temporary).and_then(|()| {
+        let file = OpenOptions::new().read(true).write(true).open(&temporary)?;
+        if let Ok(old) = std::fs::metadata(path) {
+            let _ = file.set_permissions(old.permissions());
+        }
+        file.sync_all()
+    });
+    if let Err(e) = written {
+        let _ = std::fs::remove_file(&temporary);
+        return Err(e.into());
+    }
+    if let Err(e) = std::fs::rename(&temporary, path) {
+        return Err(WriteError {
+            source: e,
+            kept: Some(temporary),
+        });
+    }
+    // The rename itself is durable once the folder is synced (where the system allows it).
+    if let Ok(d) = File::open(folder_of(path)) {
+        let _ = d.sync_all();
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn temporaries_are_recognised_with_their_owner() {
+        let path = Path::new("dir/s.scx");
+        let t = temporary_for(path, None);
+        let name = t.file_name().unwrap().to_str().unwrap();
+        assert_eq!(
+            temporary_owner(path, name),
+            Some((std::process::id(), this_host()))
+        );
+        let t = temporary_for(path, Some("png"));
+        let name = t.file_name().unwrap().to_str().unwrap();
+        assert!(name.ends_with(".png"));
+        assert_eq!(temporary_owner(path, name).unwrap().0, std::process::id());
+        assert_eq!(temporary_owner(path, ".s.scx.77.tmp").unwrap().0, 77);
+        assert_eq!(temporary_owner(path, ".t.scx.77.tmp"), None);
+        assert_eq!(temporary_owner(path, "s.scx"), None);
+    }
+}
