@@ -329,7 +329,38 @@ pub fn run(args: &AnalyzeArgs) -> Result<Exit, Failure> {
         ));
     }
     let checkpoint = args.checkpoint.as_deref().or(args.resume.as_deref());
-    let save = args.save.as_deref();
+    // `--resume F --save F` saves F once.
+    let same = |a: &Path, b: &Path| {
+        a == b
+            || std::fs::canonicalize(a)
+                .is_ok_and(|x| std::fs::canonicalize(b).is_ok_and(|y| x == y))
+    };
+    let save = args.save.as_deref().filter(|s| {
+        !(args.resume.as_deref().is_some_and(|r| same(s, r))
+            && checkpoint == args.resume.as_deref())
+    });
+    let checkpoint_flag = if args.checkpoint.is_some() {
+        "--checkpoint"
+    } else {
+        "--resume"
+    };
+    let mut outputs: Vec<(&str, &Path)> = Vec::new();
+    outputs.extend(args.out.output.as_deref().map(|p| ("-o", p)));
+    outputs.extend(save.map(|p| ("--save", p)));
+    outputs.extend(checkpoint.map(|p| (checkpoint_flag, p)));
+    outputs.extend(args.files.outputs());
+    let mut inputs: Vec<(&str, &Path)> = Vec::new();
+    inputs.extend(args.scene.as_deref().map(|s| ("scene", Path::new(s))));
+    inputs.extend(args.resume.as_deref().map(|p| ("--resume", p)));
+    output::check_distinct(
+        &outputs,
+        &inputs,
+        &[
+            ("--resume", "--resume"),
+            ("--checkpoint", "--resume"),
+            ("--save", "--resume"),
+        ],
+    )?;
     output::check_all(args.out.output.as_deref())?;
     for path in save.into_iter().chain(checkpoint) {
         output::check_state(path)?;

@@ -106,6 +106,8 @@ pub fn run(args: &ConvergenceArgs) -> Result<Exit, Failure> {
     outputs.extend(args.out.output.as_deref().map(|p| ("-o", p)));
     outputs.extend(args.csv.as_deref().map(|p| ("--csv", p)));
     outputs.extend(args.plot.as_deref().map(|p| ("--plot", p)));
+    let scene = std::path::Path::new(&args.scene);
+    output::check_distinct(&outputs, &[("scene", scene)], &[])?;
     check_all(outputs.iter().map(|(_, p)| *p))?;
     if let Some(p) = &args.plot {
         plot::check_target(p).map_err(Failure::bad_input)?;

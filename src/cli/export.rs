@@ -61,9 +61,22 @@ fn is_gltf(path: &std::path::Path) -> bool {
 }
 
 /// Checks, before any work, the files a scene is written to: the OBJ (or glTF) `output` and the MTL
-/// library `mtl` beside an OBJ, each writable.
-pub fn check_outputs(output: &Path, mtl: Option<&Path>, _scene: &str) -> Result<(), Failure> {
-    check_all(std::iter::once(output).chain(mtl))
+/// library `mtl` beside an OBJ must be two files, neither of them the scene `scene` read, each writable.
+pub fn check_outputs(output: &Path, mtl: Option<&Path>, scene: &str) -> Result<(), Failure> {
+    if mtl.is_some()
+        && output
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("mtl"))
+    {
+        return Err(Failure::bad_input(format!(
+            "-o {}: the OBJ and its MTL library would be one file; name the OBJ .obj",
+            output.display()
+        )));
+    }
+    let mut outputs = vec![("-o", output)];
+    outputs.extend(mtl.map(|m| ("its MTL library", m)));
+    output::check_distinct(&outputs, &[("scene", Path::new(scene))], &[])?;
+    check_all(outputs.iter().map(|(_, p)| *p))
 }
 
 /// Writes a scene as OBJ to `path` and its MTL library to `mtl`, each whole or not at all.

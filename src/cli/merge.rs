@@ -1,7 +1,7 @@
 //! `scx merge`: the saved states of a run's shards (or of any parts of one run) joined into its report,
 //! identical to the report of the whole run cast at once.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use scene_complexity::finish;
 use scene_complexity::{RunSpec, RunState, SavedRun, StopReason};
@@ -96,6 +96,14 @@ fn merged(args: &MergeArgs) -> Result<Merged, Failure> {
 
 /// Runs `scx merge`.
 pub fn run(args: &MergeArgs) -> Result<Exit, Failure> {
+    let mut outputs: Vec<(&str, &Path)> = Vec::new();
+    outputs.extend(args.out.output.as_deref().map(|p| ("-o", p)));
+    outputs.extend(args.save.as_deref().map(|p| ("--save", p)));
+    outputs.extend(args.files.outputs());
+    let mut inputs: Vec<(&str, &Path)> =
+        args.states.iter().map(|p| ("state", p.as_path())).collect();
+    inputs.extend(args.scene.as_deref().map(|s| ("--scene", Path::new(s))));
+    output::check_distinct(&outputs, &inputs, &[])?;
     check_all(args.out.output.as_deref())?;
     if let Some(path) = &args.save {
         output::check_state(path)?;

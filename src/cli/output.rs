@@ -1,10 +1,11 @@
 //! Where results go: standard output or files, every file path checked before any line is cast, and a
 //! "wrote FILE" line on stderr for each file written (unless `--quiet`). Every file is written whole or
 //! not at all (a temporary beside it, renamed over it), a device or FIFO is written into, a symbolic link
-//! to a file is written through, a directory is refused.
+//! to a file is written through, a directory is refused; two outputs with one path, and an output that
+//! is an input, are refused before any work.
 
 use std::io::Write;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use scene_complexity::files::{self, Destination, DestinationError};
@@ -132,6 +133,61 @@ fn without_os_error(text: &str) -> String {
         }
         None => text.to_string(),
     }
+}
+
+/// The file a path names, for comparing paths: none for a device or a stream (they may take several
+/// outputs), the real path of a file (links resolved; a new file's folder resolved).
+fn identity(path: &Path) -> Option<PathBuf> {
+    match files::destination(path).ok()? {
+        Destination::Stream(_) => None,
+        Destination::File(real) => std::fs::canonicalize(&real).ok().or_else(|| {
+            let folder = std::fs::canonicalize(files::folder_of(&real)).ok()?;
+            Some(folder.join(real.file_name()?))
+        }),
+    }
+}
+
+/// Refuses, before any work, two outputs that are one file and an output that is an input (a scene, a
+/// state), naming both. Each entry is the option that names the file and the file; built-in scenes
+/// (`@...`) and standard input (`-`) are not files. `allowed` pairs an output with the input it may be
+/// (the state that `--resume` continues and saves back).
+pub fn check_distinct(
+    outputs: &[(&str, &Path)],
+    inputs: &[(&str, &Path)],
+    allowed: &[(&str, &str)],
+) -> Result<(), Failure> {
+    let known = |(flag, path): &(&str, &Path)| {
+        let shown = path.to_string_lossy();
+        (shown != "-" && !shown.starts_with('@'))
+            .then(|| identity(path).map(|id| (flag.to_string(), path.to_path_buf(), id)))
+            .flatten()
+    };
+    let outs: Vec<_> = outputs.iter().filter_map(known).collect();
+    for (k, (flag, path, id)) in outs.iter().enumerate() {
+        if let Some((other_flag, other, _)) = outs[..k].iter().find(|(_, _, i)| i == id) {
+            return Err(Failure::bad_input(format!(
+                "{other_flag} {} and {flag} {} are one file: each output needs a file of its own",
+                other.display(),
+                path.display()
+            )));
+        }
+    }
+    for (in_flag, input) in inputs {
+        let Some(input_id) = std::fs::canonicalize(input).ok() else {
+            continue;
+        };
+        for (flag, path, id) in &outs {
+            if *id == input_id && !allowed.contains(&(flag.as_str(), *in_flag)) {
+                return Err(Failure::bad_input(format!(
+                    "{flag} {} is the {in_flag} {}: writing it would replace what is read; name \
+                     another file",
+                    path.display(),
+                    input.display()
+                )));
+            }
+        }
+    }
+    Ok(())
 }
 
 /// Writes a file whole or not at all (a temporary beside it, renamed over it; into a device or FIFO as

@@ -41,6 +41,16 @@ pub struct PatchFiles {
 }
 
 impl PatchFiles {
+    /// The files asked for, each with its option (for [`output::check_distinct`]).
+    pub fn outputs(&self) -> Vec<(&'static str, &Path)> {
+        let patches = self.patches.iter().map(|p| ("--patches", p.as_path()));
+        let matrices = self
+            .form_factors
+            .iter()
+            .map(|p| ("--form-factors", p.as_path()));
+        patches.chain(matrices).collect()
+    }
+
     /// Whether no per-patch file was asked for.
     pub fn is_empty(&self) -> bool {
         self.patches.is_empty() && self.form_factors.is_empty()

@@ -142,6 +142,7 @@ pub fn run(args: &RenderArgs) -> Result<Exit, Failure> {
     font_path().map_err(Failure::bad_input)?;
     let mut outputs = vec![("-o", args.output.as_path())];
     outputs.extend(args.patches_mesh.as_deref().map(|p| ("--patches-mesh", p)));
+    output::check_distinct(&outputs, &[("scene", Path::new(&args.scene))], &[])?;
     output::check_all(outputs.iter().map(|(_, p)| *p))?;
     if args.per_area && !args.color.is_share() {
         return Err(Failure::bad_input(format!(

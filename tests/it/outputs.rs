@@ -86,6 +86,99 @@ fn read(path: &Path) -> Vec<u8> {
     std::fs::read(path).unwrap_or_default()
 }
 
+/// Two outputs with one path, and an output that is an input, are refused before any work (exit 2,
+/// both named), and no file is touched; the state that `--resume` continues is saved back by design.
+#[test]
+fn one_path_for_two_outputs_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::write(d.join("s.scx"), "old state").unwrap();
+    std::fs::write(d.join("p.csv"), "old csv").unwrap();
+    let out = scx_in(d, &["export", "@cube:2", "-o", "cube.obj"]);
+    assert_eq!(code(&out), Some(0), "{}", stderr(&out));
+    let scene = read(&d.join("cube.obj"));
+    let cases: &[(&[&str], &[&str])] = &[
+        (
+            &[
+                "analyze", "@cube:2", "--lines", "1e4", "-o", "s.scx", "--save", "s.scx",
+            ],
+            &["-o s.scx", "--save s.scx"],
+        ),
+        (
+            &[
+                "analyze",
+                "@cube:2",
+                "--lines",
+                "1e4",
+                "--patches",
+                "p.csv",
+                "--form-factors",
+                "./p.csv",
+            ],
+            &["--patches p.csv", "--form-factors ./p.csv"],
+        ),
+        (
+            &["analyze", "cube.obj", "--lines", "1e4", "-o", "cube.obj"],
+            &["-o cube.obj", "scene cube.obj"],
+        ),
+        (
+            &[
+                "analyze",
+                "cube.obj",
+                "--lines",
+                "1e4",
+                "--patches",
+                "cube.obj",
+            ],
+            &["--patches cube.obj", "scene cube.obj"],
+        ),
+        (
+            &["export", "@cube:3", "-o", "cube.mtl"],
+            &["cube.mtl", "MTL"],
+        ),
+        (
+            &["export", "cube.obj", "-o", "./cube.obj"],
+            &["./cube.obj", "scene cube.obj"],
+        ),
+        (
+            &["merge", "s.scx", "--save", "s.scx"],
+            &["--save s.scx", "state s.scx"],
+        ),
+        (
+            &["merge", "s.scx", "-o", "s.scx"],
+            &["-o s.scx", "state s.scx"],
+        ),
+    ];
+    for (args, names) in cases {
+        let out = scx_in(d, args);
+        let err = stderr(&out);
+        assert_eq!(code(&out), Some(2), "{args:?}: {err}");
+        for name in *names {
+            assert!(err.contains(name), "{args:?} should name {name}: {err}");
+        }
+    }
+    assert_eq!(read(&d.join("s.scx")), b"old state");
+    assert_eq!(read(&d.join("p.csv")), b"old csv");
+    assert_eq!(read(&d.join("cube.obj")), scene);
+
+    // The state --resume continues is its own output.
+    let out = scx_in(
+        d,
+        &["analyze", "@cube:2", "--lines", "1e4", "--save", "r.scx"],
+    );
+    assert_eq!(code(&out), Some(0), "{}", stderr(&out));
+    for args in [
+        &["analyze", "--resume", "r.scx"][..],
+        &["analyze", "--resume", "r.scx", "--save", "r.scx"],
+        &["analyze", "--resume", "r.scx", "--checkpoint", "r.scx"],
+    ] {
+        let out = scx_in(d, args);
+        assert_eq!(code(&out), Some(0), "{args:?}: {}", stderr(&out));
+    }
+    let out = scx_in(d, &["analyze", "--resume", "r.scx", "-o", "r.scx"]);
+    assert_eq!(code(&out), Some(2), "{}", stderr(&out));
+}
+
 /// Devices are written into as streams, states refused there; directories are refused before work;
 /// a symbolic link to a file is written through (the link stays, its target holds the output).
 #[test]
