@@ -366,6 +366,7 @@ pub fn run(args: &AnalyzeArgs) -> Result<Exit, Failure> {
         output::check_state(path)?;
     }
     check_patch_files(args)?;
+    let _locks = output::lock_states(save.into_iter().chain(checkpoint))?;
     let Prepared {
         runner,
         identity,

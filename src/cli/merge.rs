@@ -109,6 +109,7 @@ pub fn run(args: &MergeArgs) -> Result<Exit, Failure> {
         output::check_state(path)?;
     }
     args.files.check()?;
+    let _lock = output::lock_states(args.save.as_deref())?;
     let Merged {
         run: SavedRun {
             identity,

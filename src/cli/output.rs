@@ -135,6 +135,27 @@ fn without_os_error(text: &str) -> String {
     }
 }
 
+/// Takes the lock of every state file a run writes (`FILE.lock` beside the file itself, links
+/// resolved): a second run on a live state is refused (exit 3), naming the host and process that hold
+/// it.
+pub fn lock_states<'a>(
+    paths: impl IntoIterator<Item = &'a Path>,
+) -> Result<Vec<files::Lock>, Failure> {
+    let mut locks = Vec::new();
+    for path in paths {
+        let real = match files::destination(path) {
+            Ok(Destination::File(real)) => real,
+            _ => path.to_path_buf(),
+        };
+        let locked = files::lock(&real).map_err(|e| Failure {
+            code: Exit::Io,
+            message: without_os_error(&e.to_string()),
+        })?;
+        locks.push(locked);
+    }
+    Ok(locks)
+}
+
 /// The file a path names, for comparing paths: none for a device or a stream (they may take several
 /// outputs), the real path of a file (links resolved; a new file's folder resolved).
 fn identity(path: &Path) -> Option<PathBuf> {

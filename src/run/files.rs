@@ -3,7 +3,8 @@
 //! symbolic link to a regular file is written through (its target replaced, the link kept); a
 //! directory is refused. Temporaries are named `.NAME.PID@HOST.scx-tmp` (with the target's extension
 //! after it when a writer needs one), so that those of a process gone on this host are recognised and
-//! cleaned at the next write beside them.
+//! cleaned at the next write beside them. A lock file beside a state (`FILE.lock`, holding host and
+//! pid) keeps two live runs from writing one state.
 //!
 //! Every function here is std only; the CLI and [`super::persist`] share them.
 
@@ -266,6 +267,107 @@ pub fn write_file_via(
         let _ = d.sync_all();
     }
     Ok(())
+}
+
+/// A lock on a state file (`FILE.lock` beside it, holding `host pid`), released when dropped.
+#[derive(Debug)]
+pub struct Lock {
+    path: PathBuf,
+    mine: String,
+}
+
+/// Why a lock was not taken.
+#[derive(Debug, thiserror::Error)]
+pub enum LockError {
+    /// A running process holds it.
+    #[error("{state} is in use by process {pid} on {host} (its lock {lock}); wait for that run to end, or remove the lock if it is not running")]
+    Held {
+        /// The state file.
+        state: String,
+        /// The lock file.
+        lock: String,
+        /// The holder's host.
+        host: String,
+        /// The holder's process.
+        pid: String,
+    },
+    /// The lock file could not be made or read.
+    #[error("cannot lock {state} with {lock}: {source}")]
+    Io {
+        /// The state file.
+        state: String,
+        /// The lock file.
+        lock: String,
+        /// The system's reason.
+        source: std::io::Error,
+    },
+}
+
+/// The lock file of a state.
+pub fn lock_path(state: &Path) -> PathBuf {
+    let mut name = state.as_os_str().to_owned();
+    name.push(".lock");
+    PathBuf::from(name)
+}
+
+/// Takes the lock of the state `state`: refused while a live process holds it (another host's always
+/// counts as live); one left by a process of this host that is gone is taken over.
+pub fn lock(state: &Path) -> Result<Lock, LockError> {
+    let path = lock_path(state);
+    let host = this_host();
+    let mine = format!("{host} {}\n", std::process::id());
+    let io = |source| LockError::Io {
+        state: state.display().to_string(),
+        lock: path.display().to_string(),
+        source,
+    };
+    for _ in 0..2 {
+        match OpenOptions::new().write(true).create_new(true).open(&path) {
+            Ok(mut f) => {
+                f.write_all(mine.as_bytes()).map_err(io)?;
+                return Ok(Lock { path, mine });
+            }
+            Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => {
+                let held = std::fs::read_to_string(&path).unwrap_or_default();
+                let mut words = held.split_whitespace();
+                let (holder, pid) = (words.next().unwrap_or(""), words.next().unwrap_or(""));
+                let gone = holder == host && pid.parse().is_ok_and(|p| !process_alive(p));
+                if !gone {
+                    return Err(LockError::Held {
+                        state: state.display().to_string(),
+                        lock: path.display().to_string(),
+                        host: if holder.is_empty() {
+                            "an unknown host".into()
+                        } else {
+                            holder.into()
+                        },
+                        pid: if pid.is_empty() {
+                            "unknown".into()
+                        } else {
+                            pid.into()
+                        },
+                    });
+                }
+                // Stale: its process is gone. Removed only if it still holds what was read (another
+                // run may have taken it over meanwhile).
+                if std::fs::read_to_string(&path).is_ok_and(|now| now == held) {
+                    std::fs::remove_file(&path).map_err(io)?;
+                }
+            }
+            Err(e) => return Err(io(e)),
+        }
+    }
+    Err(io(std::io::Error::other(
+        "another process took it meanwhile",
+    )))
+}
+
+impl Drop for Lock {
+    fn drop(&mut self) {
+        if std::fs::read_to_string(&self.path).is_ok_and(|s| s == self.mine) {
+            let _ = std::fs::remove_file(&self.path);
+        }
+    }
 }
 
 #[cfg(test)]

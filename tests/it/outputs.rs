@@ -356,6 +356,43 @@ fn stale_temporaries_are_cleaned_at_the_next_save() {
     }
 }
 
+/// A lock beside a state: a second run on a live one is refused naming the host and process; a lock
+/// whose process is gone is taken over; the lock goes when the run ends.
+#[cfg(target_os = "linux")]
+#[test]
+fn a_live_state_is_locked() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let (host, live) = (host(), std::process::id());
+    std::fs::write(d.join("c.scx.lock"), format!("{host} {live}\n")).unwrap();
+    for flag in ["--checkpoint", "--save"] {
+        let out = scx_in(d, &["analyze", "@cube:2", "--lines", "1e4", flag, "c.scx"]);
+        let err = stderr(&out);
+        assert_eq!(code(&out), Some(3), "{err}");
+        assert!(
+            err.contains(&host) && err.contains(&live.to_string()),
+            "{err}"
+        );
+        assert!(out.stdout.is_empty());
+    }
+    assert!(!d.join("c.scx").exists());
+    std::fs::write(d.join("c.scx.lock"), format!("{host} {}\n", dead_pid())).unwrap();
+    let out = scx_in(
+        d,
+        &[
+            "analyze",
+            "@cube:2",
+            "--lines",
+            "1e4",
+            "--checkpoint",
+            "c.scx",
+        ],
+    );
+    assert_eq!(code(&out), Some(0), "{}", stderr(&out));
+    assert!(d.join("c.scx").is_file());
+    assert!(!d.join("c.scx.lock").exists(), "the lock is released");
+}
+
 /// Every output is written to a temporary and renamed into place: an existing file is replaced whole
 /// (its permissions kept), and no temporary stays beside it.
 #[test]
