@@ -284,6 +284,8 @@ impl Sparse {
         Sparse { key_steps, values }
     }
 
+    /// The entries, or none when the keys are not strictly increasing (a key stored twice would be
+    /// counted twice: a forged or damaged state).
     fn entries(&self) -> Option<Vec<(u64, u64)>> {
         if self.key_steps.len() != self.values.len() {
             return None;
@@ -292,7 +294,11 @@ impl Sparse {
         self.key_steps
             .iter()
             .zip(&self.values)
-            .map(|(&step, &v)| {
+            .enumerate()
+            .map(|(k, (&step, &v))| {
+                if k > 0 && step == 0 {
+                    return None;
+                }
                 key = key.checked_add(step)?;
                 Some((key, v))
             })
@@ -322,9 +328,18 @@ fn tally_wire(t: &Tally) -> TallyWire {
     }
 }
 
+/// `n` zeros, or none when that much memory cannot be had (a state claiming 2^64 patches is refused,
+/// not a panic).
+fn zeros(n: usize) -> Option<Vec<u64>> {
+    let mut v = Vec::new();
+    v.try_reserve_exact(n).ok()?;
+    v.resize(n, 0);
+    Some(v)
+}
+
 fn tally_of(w: &TallyWire, patches: usize, wanted: Wanted) -> Option<Tally> {
     let mut escapes_by_patch = if wanted.discrete {
-        vec![0; patches]
+        zeros(patches)?
     } else {
         Vec::new()
     };
@@ -335,7 +350,7 @@ fn tally_of(w: &TallyWire, patches: usize, wanted: Wanted) -> Option<Tally> {
     let mut absorbed_by_patch = if absorbed.is_empty() {
         Vec::new()
     } else {
-        vec![0; patches]
+        zeros(patches)?
     };
     for (i, e) in absorbed {
         *absorbed_by_patch.get_mut(usize::try_from(i).ok()?)? = e;
@@ -482,6 +497,10 @@ fn state_of(w: Wire) -> Option<SavedRun> {
         continuous: w.continuous,
         per_patch: w.per_patch,
     };
+    // Patch indices are u32 everywhere: a state claiming more patches is forged or damaged.
+    if w.identity.scene.patches > u64::from(u32::MAX) {
+        return None;
+    }
     let patches = usize::try_from(w.identity.scene.patches).ok()?;
     let groups = w
         .groups
@@ -672,6 +691,22 @@ mod tests {
             assert!(message(&flipped).contains("checksum"));
             assert!(message(b"v 0 0 0\nf 1 2 3\n").contains("not an scx run state"));
         }
+    }
+
+    /// A key stored twice (a step of 0 after the first entry) is refused: it would be counted twice.
+    #[test]
+    fn repeated_keys_are_refused() {
+        let ok = Sparse {
+            key_steps: vec![0, 1, 2],
+            values: vec![5, 6, 7],
+        };
+        assert_eq!(ok.entries(), Some(vec![(0, 5), (1, 6), (3, 7)]));
+        let repeated = Sparse {
+            key_steps: vec![3, 0],
+            values: vec![5, 6],
+        };
+        assert_eq!(repeated.entries(), None);
+        assert!(zeros(usize::MAX).is_none());
     }
 
     /// A run of `cfg` on `@cube:3`, cast at once, its scene and state.

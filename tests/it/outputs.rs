@@ -464,3 +464,58 @@ fn outputs_are_renamed_into_place() {
         .collect();
     assert!(left.is_empty(), "temporaries left: {left:?}");
 }
+
+/// A state edited with its checksum recomputed: a pair key stored twice, or 2^64 - 1 patches, is
+/// refused (exit 2, "inconsistent"), never counted twice nor a panic.
+#[test]
+fn forged_states_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let out = scx_in(
+        d,
+        &["analyze", "@cube:2", "--lines", "1e4", "--save", "s.scx"],
+    );
+    assert_eq!(code(&out), Some(0), "{}", stderr(&out));
+    let bytes = read(&d.join("s.scx"));
+    let (header, payload) = bytes.split_at(24);
+    let doc: ciborium::Value = ciborium::from_reader(payload).unwrap();
+    let forge = |name: &str, change: &dyn Fn(&mut ciborium::Value)| {
+        let mut doc = doc.clone();
+        change(&mut doc);
+        let mut payload = Vec::new();
+        ciborium::into_writer(&doc, &mut payload).unwrap();
+        let mut out = header[..12].to_vec();
+        out.extend_from_slice(&(payload.len() as u64).to_le_bytes());
+        out.extend_from_slice(&crc32fast::hash(&payload).to_le_bytes());
+        out.extend_from_slice(&payload);
+        std::fs::write(d.join(name), out).unwrap();
+    };
+    forge("repeated.scx", &|doc| {
+        let tally = &mut field(doc, "groups").as_array_mut().unwrap()[0];
+        let steps = field(field(tally, "counts"), "key_steps");
+        steps.as_array_mut().unwrap()[1] = ciborium::Value::Integer(0.into());
+    });
+    forge("huge.scx", &|doc| {
+        let scene = field(field(doc, "identity"), "scene");
+        *field(scene, "patches") = ciborium::Value::Integer(u64::MAX.into());
+    });
+    for name in ["repeated.scx", "huge.scx"] {
+        let out = scx_in(d, &["merge", name]);
+        let err = stderr(&out);
+        assert_eq!(code(&out), Some(2), "{name}: {err}");
+        assert!(
+            err.contains(name) && err.contains("inconsistent"),
+            "{name}: {err}"
+        );
+    }
+}
+
+/// The value of `key` in the CBOR map `v`.
+fn field<'a>(v: &'a mut ciborium::Value, key: &str) -> &'a mut ciborium::Value {
+    let map = v.as_map_mut().unwrap();
+    &mut map
+        .iter_mut()
+        .find(|(k, _)| k.as_text() == Some(key))
+        .unwrap()
+        .1
+}
