@@ -110,8 +110,17 @@ fn cells(args: &CalibrateArgs) -> Vec<Cell> {
 
 /// Runs `scx calibrate`.
 pub fn run(args: &CalibrateArgs) -> Result<Exit, Failure> {
-    let paths = [&args.out.output, &args.csv, &args.readings];
-    check_all(paths.iter().filter_map(|p| p.as_deref()))?;
+    let named = [
+        ("-o", &args.out.output),
+        ("--csv", &args.csv),
+        ("--readings", &args.readings),
+    ];
+    let outputs: Vec<(&str, &std::path::Path)> = named
+        .iter()
+        .filter_map(|(flag, p)| p.as_deref().map(|p| (*flag, p)))
+        .collect();
+    output::check_distinct(&outputs, &[], &[])?;
+    check_all(outputs.iter().map(|(_, p)| *p))?;
     let cells = cells(args);
     if args.list {
         let list: String = cells
