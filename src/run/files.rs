@@ -155,7 +155,7 @@ pub fn clean_stale_temporaries(path: &Path, keep: &dyn Fn(&Path) -> bool) {
     }
 }
 
-/// Checks, before any work, that `destination` can be written as [`write`] will: a stream opened for
+/// Checks, before any work, that `destination` can be written as [`write()`] will: a stream opened for
 /// writing (a FIFO is not opened, which would wait for its reader); a file's folder takes a new file and
 /// a rename, and an existing file is writable.
 pub fn check(destination: &Destination) -> std::io::Result<()> {
@@ -236,7 +236,7 @@ pub fn write(
 
 /// Writes the file `path` atomically through a writer that takes a path (`make` writes the temporary
 /// it is given, whose name ends with `.EXT` when `extension` is given), then syncs it and renames it
-/// over `path` (see [`write`]).
+/// over `path` (see [`write()`]).
 pub fn write_file_via(
     path: &Path,
     extension: Option<&str>,

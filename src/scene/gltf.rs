@@ -360,7 +360,7 @@ pub fn write(scene: &Scene, path: &Path) -> Result<(), SceneError> {
     })
 }
 
-/// The bytes of a scene as glTF 2.0 (see [`write`]): binary glTF when `binary`, else JSON with the
+/// The bytes of a scene as glTF 2.0 (see [`write()`]): binary glTF when `binary`, else JSON with the
 /// buffer in a data URI.
 pub fn to_bytes(scene: &Scene, binary: bool) -> Vec<u8> {
     let (document, buffer) = document(scene);

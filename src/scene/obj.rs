@@ -574,7 +574,7 @@ pub fn write(scene: &Scene, path: &Path) -> Result<(), SceneError> {
 }
 
 /// The OBJ text of a scene and the text of its MTL library, which the OBJ names `mtl_name` (see
-/// [`write`]), for a caller that writes the files its own way.
+/// [`write()`]), for a caller that writes the files its own way.
 pub fn to_text(scene: &Scene, mtl_name: &str) -> (String, String) {
     use std::fmt::Write as _;
     let mut mtl = String::from("# written by scx\n");
