@@ -21,7 +21,7 @@ pub use reliability::{Reliability, SamplingReport, Verdict, COVERAGE_OK, COVERAG
 pub use warnings::{RunWarning, RunWarningKind};
 
 use patch_results as per_patch;
-use values::visibility_estimates;
+use values::{visibility_estimates, VisibilityOfRun};
 
 use crate::measure::estimators::EntropyEstimator;
 use crate::measure::radiosity::{MaterialError, PatchMaterials};
@@ -30,7 +30,7 @@ use crate::run::{
     BatchPlan, BatchSet, CastHooks, CastOptions, ErrorMethod, FinishedRun, RunControl, RunSpec,
     RunState, StopReason, TargetReading,
 };
-use crate::sample::tally::{ObjectSides, Tally};
+use crate::sample::tally::{ObjectSides, Tally, Wanted};
 use crate::scene::Scene;
 use crate::trace::{TraceError, Tracer};
 
@@ -282,15 +282,7 @@ pub fn finish(
     let plan = state.plan();
     let covered = state.done().clone();
     let run = state.finish(scene);
-    let enclose = cfg.enclose && run.groups.iter().any(|t| t.counters.escapes > 0);
-    let visibility = visibility_estimates(
-        scene,
-        &run,
-        cfg.estimator,
-        enclose,
-        replication(cfg, &run, enclose),
-        wanted,
-    );
+    let (visibility, enclose) = judged_visibility(scene, &run, cfg, wanted);
     let target = cfg.budget.target.map(|t| TargetOutcome {
         measure: t.measure,
         stderr_goal: t.stderr,
@@ -386,6 +378,20 @@ pub fn finish(
     })
 }
 
+/// The visibility measures of a run and their verdicts, as both the finished run and a precision
+/// target's checks judge them; and whether the run is enclosed (`--enclose` on a scene lines escaped).
+fn judged_visibility(
+    scene: &Scene,
+    run: &FinishedRun,
+    cfg: &RunSpec,
+    wanted: Wanted,
+) -> (VisibilityOfRun, bool) {
+    let enclose = cfg.enclose && run.groups.iter().any(|t| t.counters.escapes > 0);
+    let replication = replication(cfg, run, enclose);
+    let v = visibility_estimates(scene, run, cfg.estimator, enclose, replication, wanted);
+    (v, enclose)
+}
+
 /// Whether a run's delete-a-group replicates can be computed (for the bias estimates behind the
 /// verdicts), and whether they also give the standard errors (`--errors jackknife`). Not with
 /// `--enclose` nor Chao–Shen (its second pass needs every count of the replicate), and not with fewer
@@ -407,17 +413,8 @@ fn current_reading(
     cfg: &RunSpec,
     measure: Measure,
 ) -> TargetReading {
-    let wanted = state.wanted();
     let run = state.snapshot(scene);
-    let enclose = cfg.enclose && run.groups.iter().any(|t| t.counters.escapes > 0);
-    let v = visibility_estimates(
-        scene,
-        &run,
-        cfg.estimator,
-        enclose,
-        replication(cfg, &run, enclose),
-        wanted,
-    );
+    let (v, _) = judged_visibility(scene, &run, cfg, state.wanted());
     TargetReading {
         stderr: v.estimates.get(measure).and_then(|e| e.stderr),
         reliable: v.reliability.get(measure).map(|r| r.verdict) == Some(Verdict::Ok),
