@@ -32,7 +32,8 @@
 //!   [`Measure`] (the catalogue of measures, [`MEASURES`]), each an [`Estimate`] with its standard error
 //!   and a [`Verdict`];
 //! * runs in parts: [`start`], [`cast`] and [`finish`] are [`analyze`]'s three steps; a [`RunState`]
-//!   is saved with [`save_state`], read with [`load_state`], and parts of one run merge with
+//!   is saved with [`save_state`], read with [`read_state`] and checked against its scene with
+//!   [`load_state`], and parts of one run merge with
 //!   [`RunState::absorb`];
 //! * the applications: [`reproduce`] (the paper's tables), [`mod@refine`] (meshing strategies),
 //!   [`render`] (pictures of the per-patch results), [`mod@crosscheck`] (the two tracers, hit for
@@ -88,8 +89,9 @@ pub use measure::estimators::EntropyEstimator;
 pub use measure::radiosity::{MaterialError, MaterialProblem, PatchMaterials, SolveOptions};
 pub use run::files;
 pub use run::persist::{
-    check_save as check_state_save, encode as encode_state, load as load_state, save as save_state,
-    save_bytes as save_state_bytes,
+    check_save as check_state_save, decode as decode_state, encode as encode_state,
+    load as load_state, read as read_state, save as save_state, save_bytes as save_state_bytes,
+    StateFile,
 };
 pub use run::{
     remaining_lines, start, Budget, CastOptions, ErrorMethod, ExtendError, Measures, MergeError,

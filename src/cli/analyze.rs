@@ -224,8 +224,8 @@ fn new_run(args: &AnalyzeArgs, name: &str) -> Result<Prepared, Failure> {
 /// A saved run to continue, to `--lines` when given, traced as `--tracer`/`--query` ask or else as it
 /// was.
 fn resumed_run(args: &AnalyzeArgs, file: &Path) -> Result<Prepared, Failure> {
-    let saved = scene_complexity::load_state(file).map_err(persist_failure)?;
-    let mut identity = saved.identity;
+    let stored = scene_complexity::read_state(file).map_err(persist_failure)?;
+    let mut identity = stored.identity().clone();
     let name = args
         .scene
         .clone()
@@ -242,7 +242,7 @@ fn resumed_run(args: &AnalyzeArgs, file: &Path) -> Result<Prepared, Failure> {
     )?;
     identity.tracing = runner.tracing;
     let shown = file.display().to_string();
-    check_same_scene(&shown, &identity, &runner)?;
+    let saved = stored.into_run(&runner.scene).map_err(persist_failure)?;
     // A state keeps the per-patch sums when its first run was asked for --patches, and a resumed run
     // goes on gathering what its state holds: without them from the start, they cannot be had now.
     let wanted = saved.state.wanted();
@@ -266,25 +266,6 @@ fn resumed_run(args: &AnalyzeArgs, file: &Path) -> Result<Prepared, Failure> {
         state,
         seconds: saved.seconds,
     })
-}
-
-/// Refuses a scene that is not the one a state was made of.
-pub fn check_same_scene(
-    file: &str,
-    identity: &RunIdentity,
-    runner: &Runner,
-) -> Result<(), Failure> {
-    let fingerprint = runner.scene.fingerprint();
-    let saved = &identity.scene.fingerprint;
-    if &fingerprint != saved {
-        return Err(Failure::bad_input(format!(
-            "{file}: the state is of another scene than {} (fingerprint {} against {})",
-            runner.scene.name,
-            &saved[..12.min(saved.len())],
-            &fingerprint[..12]
-        )));
-    }
-    Ok(())
 }
 
 pub use super::output::persist_failure;

@@ -4,9 +4,9 @@
 use std::path::{Path, PathBuf};
 
 use scene_complexity::finish;
-use scene_complexity::{RunSpec, RunState, SavedRun, StopReason};
+use scene_complexity::{RunSpec, RunState, SavedRun, Scene, StateFile, StopReason};
 
-use super::analyze::{check_same_scene, persist_failure};
+use super::analyze::persist_failure;
 use super::args::{ReadArgs, ReportOutput, Threads};
 use super::exit::{Exit, Failure};
 use super::output::{self, check_all, warn};
@@ -53,17 +53,37 @@ struct Merged {
     without_sums: Vec<String>,
 }
 
-/// Loads every state, refusing, with the files named, states of different runs and overlapping ones.
-fn merged(args: &MergeArgs) -> Result<Merged, Failure> {
-    let mut seconds = 0.0;
-    let mut runs = Vec::new();
-    for path in &args.states {
-        runs.push((
-            path.display().to_string(),
-            scene_complexity::load_state(path).map_err(persist_failure)?,
-        ));
+/// Reads every state file, refusing, with the files named, states of different runs.
+fn read_states(args: &MergeArgs) -> Result<Vec<StateFile>, Failure> {
+    let files = args
+        .states
+        .iter()
+        .map(|path| scene_complexity::read_state(path).map_err(persist_failure))
+        .collect::<Result<Vec<_>, _>>()?;
+    let first = &files[0];
+    for file in &files[1..] {
+        if let Some(d) = first.identity().difference(file.identity(), false) {
+            return Err(Failure::bad_input(format!(
+                "{} and {} are not parts of one run: their {} differs ({} against {})",
+                file.path(),
+                first.path(),
+                d.setting,
+                d.theirs,
+                d.ours
+            )));
+        }
     }
-    seconds += runs.iter().map(|(_, r)| r.seconds).sum::<f64>();
+    Ok(files)
+}
+
+/// The states, checked against their scene, joined into one, refusing overlapping ones.
+fn merged(files: Vec<StateFile>, scene: &Scene) -> Result<Merged, Failure> {
+    let seconds = files.iter().map(StateFile::seconds).sum::<f64>();
+    let mut runs = Vec::new();
+    for file in files {
+        let name = file.path().to_string();
+        runs.push((name, file.into_run(scene).map_err(persist_failure)?));
+    }
     let without_sums = runs
         .iter()
         .filter(|(_, r)| !r.state.wanted().per_patch)
@@ -71,21 +91,14 @@ fn merged(args: &MergeArgs) -> Result<Merged, Failure> {
         .collect();
     let (first_name, first) = runs.remove(0);
     let mut state: RunState = first.state;
-    let identity = first.identity;
     for (name, run) in runs {
-        if let Some(d) = identity.difference(&run.identity, false) {
-            return Err(Failure::bad_input(format!(
-                "{name} and {first_name} are not parts of one run: their {} differs ({} against {})",
-                d.setting, d.theirs, d.ours
-            )));
-        }
         state
             .absorb(run.state)
             .map_err(|e| Failure::bad_input(format!("{name} cannot join {first_name}: {e}")))?;
     }
     Ok(Merged {
         run: SavedRun {
-            identity,
+            identity: first.identity,
             state,
             seconds,
         },
@@ -110,6 +123,18 @@ pub fn run(args: &MergeArgs) -> Result<Exit, Failure> {
     }
     args.files.check()?;
     let _lock = output::lock_states(args.save.as_deref())?;
+    let files = read_states(args)?;
+    let first_identity = files[0].identity().clone();
+    let name = args
+        .scene
+        .clone()
+        .unwrap_or_else(|| first_identity.scene.name.clone());
+    let runner = Runner::with(
+        &name,
+        (&first_identity.scene.reading, &args.reading.policy()),
+        first_identity.tracing,
+        args.threads.value,
+    )?;
     let Merged {
         run: SavedRun {
             identity,
@@ -118,7 +143,7 @@ pub fn run(args: &MergeArgs) -> Result<Exit, Failure> {
         },
         first,
         without_sums,
-    } = merged(args)?;
+    } = merged(files, &runner.scene)?;
     let plan = state.plan();
     let missing = state.done().missing(plan.batches());
     if !missing.is_empty() {
@@ -150,17 +175,6 @@ pub fn run(args: &MergeArgs) -> Result<Exit, Failure> {
         }
         warn(&message);
     }
-    let name = args
-        .scene
-        .clone()
-        .unwrap_or_else(|| identity.scene.name.clone());
-    let runner = Runner::with(
-        &name,
-        (&identity.scene.reading, &args.reading.policy()),
-        identity.tracing,
-        args.threads.value,
-    )?;
-    check_same_scene(&first, &identity, &runner)?;
     args.files
         .check_saved(&first, &identity, state.wanted(), &without_sums)?;
     let cfg = RunSpec {

@@ -17,6 +17,7 @@
 
 pub mod batches;
 pub mod cast;
+mod consistency;
 pub mod control;
 pub mod errors;
 pub mod files;

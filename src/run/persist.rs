@@ -22,14 +22,16 @@ use std::path::Path;
 use serde::{Deserialize, Serialize};
 
 use super::cast::Shard;
+use super::consistency;
 use super::files::{self, Destination, DestinationError};
-use super::plan::{BatchPlan, BatchSet};
+use super::plan::BatchPlan;
 use super::spec::{RunSpec, SpecDifference};
 use super::state::RunState;
 use crate::sample::counts::{pair_key, split_key, PairCounts};
 use crate::sample::exact::ExactSum;
 use crate::sample::kernel_sums::PatchKernelSums;
 use crate::sample::tally::{Counters, ObjectSides, Tally, Wanted};
+use crate::scene::read as scene_read;
 use crate::scene::{Scene, SceneOptions};
 use crate::trace::{Backend, Query};
 
@@ -328,8 +330,7 @@ fn tally_wire(t: &Tally) -> TallyWire {
     }
 }
 
-/// `n` zeros, or none when that much memory cannot be had (a state claiming 2^64 patches is refused,
-/// not a panic).
+/// `n` zeros, or none when that much memory cannot be had.
 fn zeros(n: usize) -> Option<Vec<u64>> {
     let mut v = Vec::new();
     v.try_reserve_exact(n).ok()?;
@@ -337,36 +338,93 @@ fn zeros(n: usize) -> Option<Vec<u64>> {
     Some(v)
 }
 
-fn tally_of(w: &TallyWire, patches: usize, wanted: Wanted) -> Option<Tally> {
-    let mut escapes_by_patch = if wanted.discrete {
-        zeros(patches)?
-    } else {
-        Vec::new()
-    };
-    for (i, e) in w.escapes.entries()? {
-        *escapes_by_patch.get_mut(usize::try_from(i).ok()?)? = e;
+/// A dense per-patch list from sparse entries, each within the scene's patches.
+fn dense(entries: &[(u64, u64)], patches: usize, what: &str) -> Result<Vec<u64>, String> {
+    let mut list = zeros(patches).ok_or_else(|| format!("no memory for {patches} patches"))?;
+    for &(i, e) in entries {
+        let slot = usize::try_from(i).ok().and_then(|i| list.get_mut(i));
+        *slot.ok_or_else(|| {
+            format!("{what} of patch {i}, beyond the scene's {patches} patches")
+        })? = e;
     }
-    let absorbed = w.absorbed.entries()?;
-    let mut absorbed_by_patch = if absorbed.is_empty() {
+    Ok(list)
+}
+
+/// The sorted, unique entries of a sparse list, refused by name when they are not.
+fn entries_of(sparse: &Sparse, what: &str) -> Result<Vec<(u64, u64)>, String> {
+    sparse
+        .entries()
+        .ok_or_else(|| format!("its {what} are not a sorted list of distinct keys"))
+}
+
+/// The sum of the values of some entries, which must equal a counter of the same tally.
+fn check_sum(entries: &[(u64, u64)], counter: u64, what: &str) -> Result<(), String> {
+    let sum = entries.iter().map(|&(_, v)| u128::from(v)).sum::<u128>();
+    if sum != u128::from(counter) {
+        return Err(format!(
+            "its {what} add up to {sum}, its counter says {counter}"
+        ));
+    }
+    Ok(())
+}
+
+/// A group's (or the partial last batch's) tally from its stored form, checked against the scene and
+/// against `lines`, the lines its batches hold.
+fn tally_of(w: &TallyWire, scene: &SceneSize, wanted: Wanted, lines: u64) -> Result<Tally, String> {
+    let patches = scene.patches;
+    consistency::check_counters(&w.counters, lines, scene.triangles)?;
+    let escapes = entries_of(&w.escapes, "escapes")?;
+    let absorbed = entries_of(&w.absorbed, "absorbed segments")?;
+    let escapes_by_patch = if wanted.discrete {
+        check_sum(&escapes, w.counters.escapes, "escapes per patch")?;
+        dense(&escapes, patches, "escapes")?
+    } else if escapes.is_empty() {
         Vec::new()
     } else {
-        zeros(patches)?
+        return Err("it lists escapes per patch for a run that keeps none".into());
     };
-    for (i, e) in absorbed {
-        *absorbed_by_patch.get_mut(usize::try_from(i).ok()?)? = e;
+    let absorbed_by_patch = if absorbed.is_empty() {
+        Vec::new()
+    } else {
+        check_sum(
+            &absorbed,
+            w.counters.absorbed,
+            "absorbed segments per patch",
+        )?;
+        dense(&absorbed, patches, "absorbed segments")?
+    };
+    if wanted.discrete && absorbed.is_empty() && w.counters.absorbed > 0 {
+        return Err(format!(
+            "it counts {} absorbed segments and lists none per patch",
+            w.counters.absorbed
+        ));
     }
     let counts = match (&w.counts, wanted.discrete) {
         (Some(c), true) => {
-            let entries = c.entries()?;
-            let fits = entries.iter().all(|&(k, _)| {
+            let entries = entries_of(c, "pair counts")?;
+            if let Some(&(k, _)) = entries.iter().find(|&&(k, _)| {
                 let (i, j) = split_key(k);
-                (j as usize) < patches && i <= j
-            });
-            fits.then(|| PairCounts::from_entries(patches, entries))
+                (j as usize) >= patches || i > j
+            }) {
+                let (i, j) = split_key(k);
+                return Err(format!(
+                    "a pair count of patches {i} and {j}, not a pair of the scene's {patches} patches"
+                ));
+            }
+            check_sum(&entries, w.counters.pairs, "pair counts")?;
+            Some(PairCounts::from_entries(patches, entries))
         }
         (None, false) => None,
-        _ => return None,
+        (None, true) => return Err("a group without the pair counts its run keeps".into()),
+        (Some(_), false) => return Err("pair counts in a run that keeps none".into()),
     };
+    if !w.orientation.is_empty() && w.orientation.len() != scene.objects {
+        return Err(format!(
+            "side counts for {} objects, the scene has {}",
+            w.orientation.len(),
+            scene.objects
+        ));
+    }
     let orientation = w
         .orientation
         .iter()
@@ -380,11 +438,21 @@ fn tally_of(w: &TallyWire, patches: usize, wanted: Wanted) -> Option<Tally> {
         )
         .collect();
     // Sums for a run that gathers none, or none for one that does, would make the state's groups
-    // disagree on what they hold: inconsistent.
+    // disagree on what they hold.
     let kernel_by_patch = match (&w.kernel_by_patch, wanted.per_patch) {
         (Some(k), true) => {
             if k.log2_kernel.len() != patches || k.ends.len() != patches {
-                return None;
+                return Err(format!(
+                    "per-patch sums of eq. (27) for {} patches, the scene has {patches}",
+                    k.log2_kernel.len().max(k.ends.len())
+                ));
+            }
+            let ends = k.ends.iter().map(|&e| u128::from(e)).sum::<u128>();
+            if ends > 2 * u128::from(w.counters.pairs) {
+                return Err(format!(
+                    "per-patch sums of eq. (27) over {ends} pair ends, more than its {} pairs have",
+                    w.counters.pairs
+                ));
             }
             Some(PatchKernelSums {
                 log2_kernel: k.log2_kernel.clone(),
@@ -392,9 +460,14 @@ fn tally_of(w: &TallyWire, patches: usize, wanted: Wanted) -> Option<Tally> {
             })
         }
         (None, false) => None,
-        _ => return None,
+        (None, true) => {
+            return Err("a group without the per-patch sums of eq. (27) its run keeps".into())
+        }
+        (Some(_), false) => {
+            return Err("per-patch sums of eq. (27) in a run that keeps none".into())
+        }
     };
-    Some(Tally {
+    Ok(Tally {
         counters: w.counters,
         orientation,
         escapes_by_patch,
@@ -402,6 +475,23 @@ fn tally_of(w: &TallyWire, patches: usize, wanted: Wanted) -> Option<Tally> {
         counts,
         kernel_by_patch,
     })
+}
+
+/// What a state is checked against in its scene.
+struct SceneSize {
+    patches: usize,
+    triangles: u64,
+    objects: usize,
+}
+
+impl SceneSize {
+    fn of(scene: &Scene) -> Self {
+        SceneSize {
+            patches: scene.patch_count(),
+            triangles: scene.triangles.len() as u64,
+            objects: scene.objects.len(),
+        }
+    }
 }
 
 /// The bytes of the state file of a run that took `seconds` so far.
@@ -439,8 +529,76 @@ pub fn encode(identity: &RunIdentity, state: &RunState, seconds: f64) -> Vec<u8>
     out
 }
 
-/// A state from the bytes of a state file called `path` (for messages).
-pub fn decode(path: &str, bytes: &[u8]) -> Result<SavedRun, PersistError> {
+/// A state file read and checked for form (its header, length, checksum and encoding) but not yet for
+/// meaning: what it is of ([`StateFile::identity`]) can be looked at before the scene it names is loaded,
+/// and its tallies are built only against that scene ([`StateFile::into_run`]), so that a state cannot
+/// make scx allocate for more patches than the scene has.
+pub struct StateFile {
+    path: String,
+    wire: Wire,
+}
+
+impl std::fmt::Debug for StateFile {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("StateFile")
+            .field("path", &self.path)
+            .field("identity", &self.wire.identity)
+            .finish_non_exhaustive()
+    }
+}
+
+impl StateFile {
+    /// What the saved run is of.
+    pub fn identity(&self) -> &RunIdentity {
+        &self.wire.identity
+    }
+
+    /// The file, as named when it was read.
+    pub fn path(&self) -> &str {
+        &self.path
+    }
+
+    /// Seconds spent on the run so far.
+    pub fn seconds(&self) -> f64 {
+        self.wire.seconds
+    }
+
+    /// The saved run, once the state is found to be of `scene` (its fingerprint) and consistent with it
+    /// and with itself: keys sorted and unique, patch indices within the scene's, each group holding the
+    /// lines of its batches, counts adding up to their counters ([`PersistError::Bad`] naming the first
+    /// problem otherwise).
+    pub fn into_run(self, scene: &Scene) -> Result<SavedRun, PersistError> {
+        let saved = &self.wire.identity.scene.fingerprint;
+        let fingerprint = scene.fingerprint();
+        if saved != &fingerprint {
+            let problem = format!(
+                "the state is of another scene than {} (fingerprint {} against {})",
+                scene.name,
+                saved.get(..12).unwrap_or(saved),
+                &fingerprint[..12]
+            );
+            return Err(PersistError::Bad {
+                path: self.path,
+                problem,
+            });
+        }
+        self.into_run_of_any_scene(scene)
+    }
+
+    /// [`StateFile::into_run`] without the fingerprint check: the state checked against `scene`'s size
+    /// only (for fuzzing the checks with states whose scene is not at hand).
+    #[doc(hidden)]
+    pub fn into_run_of_any_scene(self, scene: &Scene) -> Result<SavedRun, PersistError> {
+        let StateFile { path, wire } = self;
+        state_of(wire, &SceneSize::of(scene)).map_err(|problem| PersistError::Bad {
+            path,
+            problem: format!("inconsistent contents: {problem}"),
+        })
+    }
+}
+
+/// A state file from its bytes, checked for form; `path` names it in messages.
+pub fn decode(path: &str, bytes: &[u8]) -> Result<StateFile, PersistError> {
     let bad = |problem: String| PersistError::Bad {
         path: path.to_string(),
         problem,
@@ -477,58 +635,81 @@ pub fn decode(path: &str, bytes: &[u8]) -> Result<SavedRun, PersistError> {
     }
     let wire: Wire = ciborium::from_reader(payload)
         .map_err(|e| bad(format!("cannot be read as a run state ({e})")))?;
-    state_of(wire).ok_or_else(|| bad("inconsistent contents".into()))
+    Ok(StateFile {
+        path: path.to_string(),
+        wire,
+    })
 }
 
-fn state_of(w: Wire) -> Option<SavedRun> {
+/// The run a decoded state holds, checked for meaning against the scene's size.
+fn state_of(w: Wire, scene: &SceneSize) -> Result<SavedRun, String> {
+    let spec = &w.identity.spec;
     let plan = BatchPlan {
         lines: w.plan_lines,
         batch_size: w.batch_size,
     };
-    if plan.batch_size == 0 || w.groups.is_empty() {
-        return None;
+    if plan != spec.plan() {
+        return Err(format!(
+            "its plan of {} lines in batches of {} is not that of its run of {} lines",
+            plan.lines, plan.batch_size, spec.lines
+        ));
+    }
+    if w.groups.len() != spec.group_count() {
+        return Err(format!(
+            "{} groups, where its run has {}",
+            w.groups.len(),
+            spec.group_count()
+        ));
     }
     // The per-patch sums need the pair keys (the discrete counts) to be gathered at all.
     if w.per_patch && !w.discrete {
-        return None;
+        return Err("per-patch sums without the pair counts they need".into());
+    }
+    if w.identity.scene.patches != scene.patches as u64 {
+        return Err(format!(
+            "it says its scene has {} patches, the scene has {}",
+            w.identity.scene.patches, scene.patches
+        ));
     }
     let wanted = Wanted {
         discrete: w.discrete,
         continuous: w.continuous,
         per_patch: w.per_patch,
     };
-    // Patch indices are u32 everywhere: a state claiming more patches is forged or damaged.
-    if w.identity.scene.patches > u64::from(u32::MAX) {
-        return None;
-    }
-    let patches = usize::try_from(w.identity.scene.patches).ok()?;
+    let done = consistency::done_batches(&w.done, plan)?;
+    let lines = consistency::group_lines(plan, &done, w.groups.len());
     let groups = w
         .groups
         .iter()
-        .map(|g| match g {
-            Some(t) => tally_of(t, patches, wanted).map(Some),
-            None => Some(None),
+        .zip(&lines)
+        .enumerate()
+        .map(|(g, (t, &lines))| match t {
+            Some(t) => tally_of(t, scene, wanted, lines)
+                .map(Some)
+                .map_err(|e| format!("group {g}: {e}")),
+            None if lines == 0 => Ok(None),
+            None => Err(format!(
+                "group {g} is empty, though its batches hold {lines} lines"
+            )),
         })
-        .collect::<Option<Vec<_>>>()?;
-    let done = BatchSet::from_ranges(
-        w.done
-            .iter()
-            .filter(|r| r[0] < r[1] && r[1] <= plan.batches())
-            .map(|r| r[0]..r[1]),
-    );
-    if done.len()
-        != w.done
-            .iter()
-            .map(|r| r[1].saturating_sub(r[0]))
-            .sum::<u64>()
-    {
-        return None;
-    }
-    let tail = match &w.tail {
-        Some((b, t)) => Some((*b, tally_of(t, patches, wanted)?)),
-        None => None,
+        .collect::<Result<Vec<_>, _>>()?;
+    let partial = consistency::partial_batch(plan).filter(|&b| done.contains(b));
+    let tail = match (&w.tail, partial) {
+        (Some((b, t)), Some(last)) if *b == last => {
+            let lines = plan.batch_len(last) as u64;
+            let tally =
+                tally_of(t, scene, wanted, lines).map_err(|e| format!("last batch: {e}"))?;
+            Some((*b, tally))
+        }
+        (None, None) => None,
+        (Some((b, _)), _) => {
+            return Err(format!(
+                "a partial last batch {b} that is not its run's, or not done"
+            ))
+        }
+        (None, Some(b)) => return Err(format!("its partial last batch {b} is done but not kept")),
     };
-    Some(SavedRun {
+    Ok(SavedRun {
         identity: w.identity,
         state: RunState::from_parts(plan, wanted, groups, done, tail),
         seconds: w.seconds,
@@ -617,15 +798,45 @@ fn is_whole_state(path: &Path) -> bool {
             == crc32fast::hash(&bytes[HEADER..])
 }
 
-/// Reads a state file.
-pub fn load(path: &Path) -> Result<SavedRun, PersistError> {
+/// Reads a state file and checks its form ([`decode`]). Only a regular file is read: a directory, a
+/// device or a FIFO named as a state is refused (opened without blocking, so that a FIFO put there after
+/// the check cannot hang the reader), and no more bytes are read than its size said.
+pub fn read(path: &Path) -> Result<StateFile, PersistError> {
     let shown = path.display().to_string();
-    let bytes = std::fs::read(path).map_err(|source| PersistError::Io {
+    let io = |source| PersistError::Io {
         doing: "read",
         path: shown.clone(),
         source,
-    })?;
+    };
+    let not_a_file = |meta: &std::fs::Metadata| PersistError::Bad {
+        path: shown.clone(),
+        problem: format!(
+            "not a regular file ({}): a run state is a file",
+            scene_read::kind_of(meta)
+        ),
+    };
+    let meta = std::fs::metadata(path).map_err(io)?;
+    if !meta.is_file() {
+        return Err(not_a_file(&meta));
+    }
+    let file = scene_read::open_nonblocking(path).map_err(io)?;
+    let opened = file.metadata().map_err(io)?;
+    if !opened.is_file() {
+        return Err(not_a_file(&opened));
+    }
+    let mut bytes = Vec::new();
+    bytes
+        .try_reserve_exact(opened.len() as usize)
+        .map_err(|_| io(std::io::Error::from(std::io::ErrorKind::OutOfMemory)))?;
+    // A file growing meanwhile is cut at the size read above, and then refused as truncated.
+    std::io::Read::read_to_end(&mut std::io::Read::take(file, opened.len()), &mut bytes)
+        .map_err(io)?;
     decode(&shown, &bytes)
+}
+
+/// Reads a state file of `scene` ([`read`], then [`StateFile::into_run`]).
+pub fn load(path: &Path, scene: &Scene) -> Result<SavedRun, PersistError> {
+    read(path)?.into_run(scene)
 }
 
 #[cfg(test)]
@@ -667,7 +878,7 @@ mod tests {
                 },
             );
             let bytes = encode(&identity, &state, 1.5);
-            let back = decode("s.scx", &bytes).unwrap();
+            let back = decode("s.scx", &bytes).unwrap().into_run(&scene).unwrap();
             assert_eq!(back.identity, identity);
             assert_eq!(back.seconds, 1.5);
             let (a, b) = (state.finish(&scene), back.state.finish(&scene));
@@ -763,6 +974,8 @@ mod tests {
             );
             let back = decode("s.scx", &encode(&identity, &state, 0.5))
                 .unwrap()
+                .into_run(&scene)
+                .unwrap()
                 .state;
             assert_eq!(back.wanted(), state.wanted());
             assert_eq!(back.wanted().per_patch, per_patch);
@@ -832,13 +1045,20 @@ mod tests {
         strip(&mut damaged, false);
         let mut payload = Vec::new();
         ciborium::into_writer(&damaged, &mut payload).unwrap();
-        let message = decode("d.scx", &framed(&payload)).unwrap_err().to_string();
+        let message = decode("d.scx", &framed(&payload))
+            .unwrap()
+            .into_run(&scene)
+            .unwrap_err()
+            .to_string();
         assert!(message.contains("inconsistent"), "{message}");
         // Both removed: a state of an older scx.
         strip(&mut doc, true);
         let mut payload = Vec::new();
         ciborium::into_writer(&doc, &mut payload).unwrap();
-        let old = decode("old.scx", &framed(&payload)).unwrap();
+        let old = decode("old.scx", &framed(&payload))
+            .unwrap()
+            .into_run(&scene)
+            .unwrap();
         assert!(!old.state.wanted().per_patch);
         let (a, b) = (state.finish(&scene), old.state.finish(&scene));
         assert_eq!(a.total.counters, b.total.counters);

@@ -124,7 +124,7 @@ pub(crate) enum ReadError {
 }
 
 /// What kind of file metadata describes, for a message (`a FIFO (named pipe)`).
-fn kind_of(meta: &std::fs::Metadata) -> &'static str {
+pub(crate) fn kind_of(meta: &std::fs::Metadata) -> &'static str {
     let ft = meta.file_type();
     if ft.is_dir() {
         return "a directory";
@@ -182,7 +182,7 @@ fn read_regular(
 }
 
 /// Opens a file for reading; on Unix without blocking, so that opening a FIFO returns at once.
-fn open_nonblocking(path: &Path) -> std::io::Result<File> {
+pub(crate) fn open_nonblocking(path: &Path) -> std::io::Result<File> {
     let mut options = std::fs::OpenOptions::new();
     options.read(true);
     #[cfg(unix)]

@@ -465,8 +465,10 @@ fn outputs_are_renamed_into_place() {
     assert!(left.is_empty(), "temporaries left: {left:?}");
 }
 
-/// A state edited with its checksum recomputed: a pair key stored twice, or 2^64 - 1 patches, is
-/// refused (exit 2, "inconsistent"), never counted twice nor a panic.
+/// A state edited with its checksum recomputed is refused (exit 2, "inconsistent contents" and what is
+/// wrong), never counted, wrapped around, looped over nor a panic: a pair key stored twice, 2^64 - 1 or
+/// 2^32 - 1 patches (before any allocation for them), a group holding more lines than its batches, a
+/// pair count or a counter no line could give, done batches beyond the plan.
 #[test]
 fn forged_states_are_refused() {
     let dir = tempfile::tempdir().unwrap();
@@ -490,24 +492,112 @@ fn forged_states_are_refused() {
         out.extend_from_slice(&payload);
         std::fs::write(d.join(name), out).unwrap();
     };
-    forge("repeated.scx", &|doc| {
-        let tally = &mut field(doc, "groups").as_array_mut().unwrap()[0];
-        let steps = field(field(tally, "counts"), "key_steps");
-        steps.as_array_mut().unwrap()[1] = ciborium::Value::Integer(0.into());
-    });
-    forge("huge.scx", &|doc| {
-        let scene = field(field(doc, "identity"), "scene");
-        *field(scene, "patches") = ciborium::Value::Integer(u64::MAX.into());
-    });
-    for name in ["repeated.scx", "huge.scx"] {
-        let out = scx_in(d, &["merge", name]);
-        let err = stderr(&out);
-        assert_eq!(code(&out), Some(2), "{name}: {err}");
-        assert!(
-            err.contains(name) && err.contains("inconsistent"),
-            "{name}: {err}"
-        );
+    let int = |n: u64| ciborium::Value::Integer(n.into());
+    let counter = |doc: &mut ciborium::Value, name: &str, n: u64| {
+        *field(field(first_group(doc), "counters"), name) = int(n);
+    };
+    let cases: [(&str, &Edit<'_>, &str); 7] = [
+        (
+            "repeated.scx",
+            &|doc| {
+                let tally = first_group(doc);
+                let steps = field(field(tally, "counts"), "key_steps");
+                steps.as_array_mut().unwrap()[1] = int(0);
+            },
+            "not a sorted list of distinct keys",
+        ),
+        (
+            "huge.scx",
+            &|doc| {
+                let scene = field(field(doc, "identity"), "scene");
+                *field(scene, "patches") = int(u64::MAX);
+            },
+            "patches",
+        ),
+        (
+            "many.scx",
+            &|doc| {
+                let scene = field(field(doc, "identity"), "scene");
+                *field(scene, "patches") = int(u64::from(u32::MAX));
+            },
+            "says its scene has 4294967295 patches, the scene has 24",
+        ),
+        (
+            "lines.scx",
+            &|doc| counter(doc, "lines", 1 << 63),
+            "group 0: it holds 9223372036854775808 lines",
+        ),
+        (
+            "count.scx",
+            &|doc| {
+                let tally = first_group(doc);
+                let values = field(field(tally, "counts"), "values");
+                values.as_array_mut().unwrap()[0] = int(u64::MAX);
+            },
+            "pair counts add up to",
+        ),
+        (
+            "pairs.scx",
+            &|doc| counter(doc, "pairs", u64::MAX),
+            "more pairs than crossings",
+        ),
+        (
+            "done.scx",
+            &|doc| {
+                *field(doc, "done") =
+                    ciborium::Value::Array(vec![ciborium::Value::Array(vec![int(0), int(1 << 40)])])
+            },
+            "not a range within",
+        ),
+    ];
+    for (name, change, problem) in cases {
+        forge(name, change);
+        let started = std::time::Instant::now();
+        for args in [vec!["merge", name], vec!["analyze", "--resume", name]] {
+            let out = scx_in(d, &args);
+            let err = stderr(&out);
+            assert_eq!(code(&out), Some(2), "{args:?}: {err}");
+            assert!(
+                err.contains(name) && err.contains("inconsistent") && err.contains(problem),
+                "{args:?}: {err}"
+            );
+        }
+        assert!(started.elapsed().as_secs() < 60, "{name} took too long");
     }
+}
+
+/// A FIFO or a directory named as a state to resume or merge is refused, not read without end.
+#[test]
+fn states_are_read_from_regular_files_only() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let made = std::process::Command::new("mkfifo")
+        .arg(d.join("pipe.scx"))
+        .status()
+        .unwrap();
+    assert!(made.success());
+    std::fs::create_dir(d.join("dir.scx")).unwrap();
+    for name in ["pipe.scx", "dir.scx"] {
+        for args in [vec!["merge", name], vec!["analyze", "--resume", name]] {
+            let out = scx_in(d, &args);
+            let err = stderr(&out);
+            // `--resume` also writes the state back: a directory is refused as that output first.
+            let (expected, words) = match (args[0], name) {
+                ("analyze", "dir.scx") => (3, "it is a directory"),
+                _ => (2, "not a regular file"),
+            };
+            assert_eq!(code(&out), Some(expected), "{args:?}: {err}");
+            assert!(err.contains(words), "{args:?}: {err}");
+        }
+    }
+}
+
+/// An edit of a state's CBOR document.
+type Edit<'a> = dyn Fn(&mut ciborium::Value) + 'a;
+
+/// The tally of the first group of a state's CBOR document.
+fn first_group(doc: &mut ciborium::Value) -> &mut ciborium::Value {
+    &mut field(doc, "groups").as_array_mut().unwrap()[0]
 }
 
 /// The value of `key` in the CBOR map `v`.
