@@ -391,4 +391,35 @@ mod tests {
         assert_eq!(temporary_owner(path, ".t.scx.77.tmp"), None);
         assert_eq!(temporary_owner(path, "s.scx"), None);
     }
+
+    /// When only the rename fails (here: the target is a folder that is not empty), the temporary holds
+    /// the whole output and is kept, named in the error; when the writing fails, nothing is left.
+    #[test]
+    fn a_failed_rename_keeps_the_whole_temporary() {
+        let dir = tempfile::tempdir().unwrap();
+        let target = dir.path().join("s.scx");
+        std::fs::create_dir(&target).unwrap();
+        std::fs::write(target.join("inside"), b"x").unwrap();
+        let err = write_file_via(&target, None, &|_| false, &mut |t| {
+            std::fs::write(t, b"whole")
+        })
+        .unwrap_err();
+        let kept = err.kept.expect("the temporary is kept");
+        assert_eq!(std::fs::read(&kept).unwrap(), b"whole");
+        assert_eq!(kept.parent(), Some(dir.path()));
+
+        let other = dir.path().join("t.scx");
+        let err = write_file_via(&other, None, &|_| false, &mut |t| {
+            std::fs::write(t, b"half")?;
+            Err(std::io::Error::other("disk full"))
+        })
+        .unwrap_err();
+        assert!(err.kept.is_none());
+        let left: Vec<_> = std::fs::read_dir(dir.path())
+            .unwrap()
+            .map(|e| e.unwrap().file_name())
+            .collect();
+        assert_eq!(left.len(), 2, "only s.scx and the kept temporary: {left:?}");
+        assert!(!other.exists());
+    }
 }

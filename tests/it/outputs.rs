@@ -609,3 +609,90 @@ fn field<'a>(v: &'a mut ciborium::Value, key: &str) -> &'a mut ciborium::Value {
         .unwrap()
         .1
 }
+
+/// A folder that takes no new file (immutable, `chattr +i`: even root cannot create a file there) is
+/// found before any line is traced, for a state, a checkpoint and a report, even when the state file
+/// itself exists and is writable (the temporary and the rename need the folder). Skipped where
+/// `chattr` does not work (not root, or a file system without the attribute).
+#[test]
+fn a_folder_that_takes_no_file_is_refused_before_work() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let locked = d.join("locked");
+    std::fs::create_dir(&locked).unwrap();
+    std::fs::write(locked.join("s.scx"), b"old").unwrap();
+    let chattr = |flag: &str| {
+        Command::new("chattr")
+            .arg(flag)
+            .arg(&locked)
+            .status()
+            .is_ok_and(|s| s.success())
+    };
+    if !chattr("+i") {
+        eprintln!("skipped: chattr +i does not work here");
+        return;
+    }
+    let cases = [
+        vec!["--save", "locked/s.scx"],
+        vec!["--save", "locked/new.scx"],
+        vec!["--checkpoint", "locked/c.scx"],
+        vec!["-o", "locked/report.txt"],
+    ];
+    let mut failures = Vec::new();
+    for extra in cases {
+        let mut args = vec!["analyze", "@cube:2", "--lines", "1e8"];
+        args.extend(&extra);
+        let started = Instant::now();
+        let out = scx_in(d, &args);
+        let err = stderr(&out);
+        if code(&out) != Some(3) || !err.contains("locked/") || started.elapsed().as_secs() > 20 {
+            failures.push(format!(
+                "{extra:?}: exit {:?} after {:?}: {err}",
+                code(&out),
+                started.elapsed()
+            ));
+        }
+    }
+    chattr("-i");
+    assert_eq!(std::fs::read(locked.join("s.scx")).unwrap(), b"old");
+    assert!(failures.is_empty(), "{failures:#?}");
+}
+
+/// A FIFO named as the report is written into as a stream (a reader gets the whole report), never
+/// replaced by a file.
+#[test]
+fn a_fifo_as_the_report_is_a_stream() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let fifo = d.join("report.fifo");
+    assert!(Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .unwrap()
+        .success());
+    let reader = {
+        let fifo = fifo.clone();
+        std::thread::spawn(move || std::fs::read_to_string(fifo).unwrap())
+    };
+    let out = scx_in(
+        d,
+        &[
+            "analyze",
+            "@cube:2",
+            "--lines",
+            "1e4",
+            "--format",
+            "json",
+            "-o",
+            "report.fifo",
+        ],
+    );
+    assert_eq!(code(&out), Some(0), "{}", stderr(&out));
+    let text = reader.join().unwrap();
+    assert!(
+        text.contains("\"schema_version\"") && text.trim_end().ends_with('}'),
+        "{text}"
+    );
+    let kind = std::fs::symlink_metadata(&fifo).unwrap().file_type();
+    assert!(std::os::unix::fs::FileTypeExt::is_fifo(&kind));
+}
