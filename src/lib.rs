@@ -78,7 +78,7 @@ pub use scene::{
     Material, Normalization, ObjectSet, Patch, Planarity, Scene, SceneBuilder, SceneError,
     SceneOptions, DEFAULT_PLANARITY,
 };
-pub use scene::{Reach, ReadPolicy};
+pub use scene::{Reach, ReadPolicy, SceneWarning, SceneWarningKind};
 pub use scenes::{load, load_with, load_with_policy, Builtin, CATALOGUE};
 
 // Tracing.
@@ -104,9 +104,9 @@ pub use sample::tally::{Tally, Wanted};
 
 // What is computed from a run.
 pub use analysis::{
-    analyze, cast, finish, Analysis, AnalysisError, PatchResult, RadiosityOutcome, RadiositySolve,
-    Reliability, RunWarning, RunWarningKind, SamplingReport, SolveFailure, TargetOutcome, Verdict,
-    COVERAGE_OK, COVERAGE_UNUSABLE,
+    analyze, cast, finish, Analysis, AnalysisError, ObjectResult, PatchResult, RadiosityOutcome,
+    RadiositySolve, Reliability, RunWarning, RunWarningKind, SamplingReport, SolveFailure,
+    TargetOutcome, Verdict, COVERAGE_OK, COVERAGE_UNUSABLE,
 };
 pub use measure::catalogue::{
     Bound, ByMeasure, Family, Measure, MeasureInfo, Needs, PatchMeasure, PatchMeasureInfo, Unit,

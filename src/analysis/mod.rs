@@ -6,6 +6,7 @@
 //! and [`finish`]es it, computing every measure on the whole run and on each group
 //! ([`crate::run::Spread`]).
 
+pub mod object_results;
 mod orientation;
 pub mod patch_results;
 pub mod radiosity;
@@ -15,6 +16,7 @@ pub mod warnings;
 
 use std::time::Instant;
 
+pub use object_results::ObjectResult;
 pub use patch_results::{PatchLight, PatchResult};
 pub use radiosity::{RadiosityOutcome, RadiositySolve, SolveFailure, NOTHING_EMITS};
 pub use reliability::{Reliability, SamplingReport, Verdict, COVERAGE_OK, COVERAGE_UNUSABLE};
@@ -115,6 +117,9 @@ pub struct Analysis {
     /// Each patch's results, with standard errors, when [`RunSpec::per_patch`] asked for them
     /// (`None` as well for an enclosed open scene).
     pub patches: Option<Vec<PatchResult>>,
+    /// Each object's results ([`ObjectResult`]): what it is and how its sides were met always, its
+    /// segments when the pairs were counted, and its share of the measures with per-patch results.
+    pub objects: Vec<ObjectResult>,
 }
 
 impl Analysis {
@@ -317,7 +322,9 @@ pub fn finish(
             per_patch::estimates(scene, &run, cfg.estimator, light)
         })
         .flatten();
+    let (patches, object_values) = patches.unzip();
     let FinishedRun { total, .. } = run;
+    let objects = object_results::of_run(scene, &total, object_values);
     let mut warnings = warnings::of_run(
         &scene.name,
         &total.counters,
@@ -375,6 +382,7 @@ pub fn finish(
         orientation: total.orientation.clone(),
         tally: total,
         patches,
+        objects,
     })
 }
 

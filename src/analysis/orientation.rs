@@ -52,9 +52,9 @@ pub(crate) fn warnings(scene: &Scene, total: &Tally, enclosed: bool) -> Vec<RunW
     }
     let mut out = Vec::new();
     if !inside_out.is_empty() {
-        out.push(RunWarning {
-            kind: RunWarningKind::InsideOut,
-            message: format!(
+        out.push(RunWarning::new(
+            RunWarningKind::InsideOut,
+            format!(
                 "{}: normals face inwards: {} look(s) inside out: segments from front sides outside them \
                  arrive at their back sides and are absorbed there, while their front sides are seen only \
                  from inside them; try --flip-normals{}",
@@ -62,12 +62,13 @@ pub(crate) fn warnings(scene: &Scene, total: &Tally, enclosed: bool) -> Vec<RunW
                 named(scene, sides, &inside_out),
                 names_argument(scene, &inside_out)
             ),
-        });
+        )
+        .about(names(scene, &inside_out)));
     }
     if !one_sided.is_empty() {
-        out.push(RunWarning {
-            kind: RunWarningKind::OneSided,
-            message: format!(
+        out.push(RunWarning::new(
+            RunWarningKind::OneSided,
+            format!(
                 "{}: one-sided surface(s) seen from behind: {}: segments from front sides arrive at \
                  their back sides and are absorbed there (they count in their rows, as escapes do: the form \
                  factors between the other surfaces stay right); if they are thin surfaces meant to be seen \
@@ -76,7 +77,8 @@ pub(crate) fn warnings(scene: &Scene, total: &Tally, enclosed: bool) -> Vec<RunW
                 named(scene, sides, &one_sided),
                 names_argument(scene, &one_sided)
             ),
-        });
+        )
+        .about(names(scene, &one_sided)));
     }
     out
 }
@@ -142,14 +144,20 @@ fn no_pairs(scene: &Scene, total: &Tally) -> RunWarning {
             names_argument(scene, &backs)
         )
     };
-    RunWarning {
-        kind: RunWarningKind::NoPairs,
-        message: format!(
+    let about = if backs.is_empty() { &fronts } else { &backs };
+    RunWarning::new(
+        RunWarningKind::NoPairs,
+        format!(
             "{}: no line segment joined two patches ({} escapes, {} unpaired), so the visibility \
              measures are undefined: {diagnosis}",
             scene.name, c.escapes, c.unpaired
         ),
-    }
+    )
+    .about(names(scene, about))
+    .with_numbers(&[
+        ("escapes", c.escapes as f64),
+        ("unpaired", c.unpaired as f64),
+    ])
 }
 
 /// The objects for a message, the most affected first: `name` (back sides met N times), ...
@@ -177,6 +185,11 @@ fn named(scene: &Scene, sides: &[ObjectSides], objects: &[usize]) -> String {
         parts.push(format!("and {} more", sorted.len() - NAMED));
     }
     parts.join(", ")
+}
+
+/// The names of some objects, in the scene's order.
+fn names(scene: &Scene, objects: &[usize]) -> Vec<String> {
+    objects.iter().map(|&k| scene.objects[k].clone()).collect()
 }
 
 fn backs_met(s: &ObjectSides) -> u64 {

@@ -7,6 +7,7 @@
 
 use rayon::prelude::*;
 
+use super::object_results::{object_weight, patches_by_object};
 use crate::measure::estimators::EntropyEstimator;
 use crate::measure::radiosity::{self, FormFactors, PatchMaterials, SolveOptions};
 use crate::measure::shares::{patch_values, ContinuousSums, PatchValues};
@@ -61,13 +62,17 @@ struct TallyPatches {
     light: Option<(Vec<f64>, Vec<f64>)>,
 }
 
-/// Every patch's results from a finished run; `None` without pair counts.
+/// Every patch's results from a finished run, and each object's values ([`object_values`]); `None`
+/// without pair counts.
 pub(crate) fn estimates(
     scene: &Scene,
     run: &FinishedRun,
     estimator: EntropyEstimator,
     light: Option<PatchLight<'_>>,
-) -> Option<Vec<PatchResult>> {
+) -> Option<(
+    Vec<PatchResult>,
+    Vec<[Option<Estimate>; PatchMeasure::COUNT]>,
+)> {
     let of = |t: &Tally| of_tally(scene, t, estimator, light);
     let (all, groups): (Option<TallyPatches>, Vec<Option<TallyPatches>>) = rayon::join(
         || of(&run.total),
@@ -75,11 +80,10 @@ pub(crate) fn estimates(
     );
     let all = all?;
     let groups: Vec<TallyPatches> = groups.into_iter().flatten().collect();
-    Some(
-        (0..scene.patch_count())
-            .map(|i| patch_estimate(i, &all, &groups))
-            .collect(),
-    )
+    let patches = (0..scene.patch_count())
+        .map(|i| patch_estimate(i, &all, &groups))
+        .collect();
+    Some((patches, object_values(scene, &all, &groups)))
 }
 
 fn of_tally(
@@ -110,49 +114,77 @@ fn of_tally(
     })
 }
 
+/// An estimate from the value of all the lines and the values of the groups (the batch-means standard
+/// error; none when a group has no value).
+fn estimate_of(
+    f: &dyn Fn(&TallyPatches) -> Option<f64>,
+    all: &TallyPatches,
+    groups: &[TallyPatches],
+) -> Option<Estimate> {
+    let value = f(all)?;
+    let per_group: Option<Vec<f64>> = groups.iter().map(f).collect();
+    Some(match per_group {
+        Some(g) => Estimate::from_groups(value, &g),
+        None => Estimate {
+            value,
+            stderr: None,
+        },
+    })
+}
+
+/// Patch `i`'s value of `q` in one tally (`None`: not computed).
+fn patch_value(q: PatchMeasure, i: usize, t: &TallyPatches) -> Option<f64> {
+    let v = &t.values;
+    let continuous = || Some(v.continuous_term.as_ref()?[i]);
+    match q {
+        PatchMeasure::RowEntropy => Some(v.row_entropy[i]),
+        PatchMeasure::RowEntropyCorrected => Some(v.row_entropy_corrected[i]),
+        PatchMeasure::MutualInformationTerm => Some(v.mutual_information_term[i]),
+        PatchMeasure::MutualInformationTermCorrected => {
+            Some(v.mutual_information_term_corrected[i])
+        }
+        PatchMeasure::ContinuousTerm => continuous(),
+        PatchMeasure::LostInformation => Some(continuous()? - v.mutual_information_term[i]),
+        PatchMeasure::LostInformationCorrected => {
+            Some(continuous()? - v.mutual_information_term_corrected[i])
+        }
+        PatchMeasure::Radiosity => Some(t.light.as_ref()?.0[i]),
+        PatchMeasure::IncomingRadiosity => Some(t.light.as_ref()?.1[i]),
+    }
+}
+
 /// Patch `i`'s values from all the lines, with the batch-means standard errors of the groups'.
 fn patch_estimate(i: usize, all: &TallyPatches, groups: &[TallyPatches]) -> PatchResult {
-    let est = |f: &dyn Fn(&TallyPatches) -> Option<f64>| -> Option<Estimate> {
-        let value = f(all)?;
-        let per_group: Option<Vec<f64>> = groups.iter().map(f).collect();
-        Some(match per_group {
-            Some(g) => Estimate::from_groups(value, &g),
-            None => Estimate {
-                value,
-                stderr: None,
-            },
-        })
-    };
-    let continuous = |t: &TallyPatches| Some(t.values.continuous_term.as_ref()?[i]);
-    let lost = |t: &TallyPatches, corrected: bool| {
-        let discrete = if corrected {
-            t.values.mutual_information_term_corrected[i]
-        } else {
-            t.values.mutual_information_term[i]
-        };
-        Some(continuous(t)? - discrete)
-    };
-    // The estimator behind each entry of the per-patch catalogue.
-    let value = |q: PatchMeasure, t: &TallyPatches| -> Option<f64> {
-        let v = &t.values;
-        match q {
-            PatchMeasure::RowEntropy => Some(v.row_entropy[i]),
-            PatchMeasure::RowEntropyCorrected => Some(v.row_entropy_corrected[i]),
-            PatchMeasure::MutualInformationTerm => Some(v.mutual_information_term[i]),
-            PatchMeasure::MutualInformationTermCorrected => {
-                Some(v.mutual_information_term_corrected[i])
-            }
-            PatchMeasure::ContinuousTerm => continuous(t),
-            PatchMeasure::LostInformation => lost(t, false),
-            PatchMeasure::LostInformationCorrected => lost(t, true),
-            PatchMeasure::Radiosity => Some(t.light.as_ref()?.0[i]),
-            PatchMeasure::IncomingRadiosity => Some(t.light.as_ref()?.1[i]),
-        }
-    };
     PatchResult {
         segments: all.values.segments[i],
         escapes: all.escapes[i],
         absorbed: all.absorbed.get(i).copied().unwrap_or(0),
-        values: PatchMeasure::ALL.map(|q| est(&|t| value(q, t))),
+        values: PatchMeasure::ALL.map(|q| estimate_of(&|t| patch_value(q, i, t), all, groups)),
     }
+}
+
+/// Each object's values: its patches' values weighted as [`object_weight`] says, summed in each tally,
+/// with the batch-means standard error of the groups' sums.
+fn object_values(
+    scene: &Scene,
+    all: &TallyPatches,
+    groups: &[TallyPatches],
+) -> Vec<[Option<Estimate>; PatchMeasure::COUNT]> {
+    let total_area = scene.total_area();
+    let fraction = |i: usize| scene.patches[i].area / total_area;
+    patches_by_object(scene)
+        .iter()
+        .map(|members| {
+            let object_fraction: f64 = members.iter().map(|&i| fraction(i)).sum();
+            PatchMeasure::ALL.map(|q| {
+                let sum = |t: &TallyPatches| -> Option<f64> {
+                    members.iter().try_fold(0.0, |acc, &i| {
+                        let w = object_weight(q, fraction(i), object_fraction);
+                        Some(acc + w * patch_value(q, i, t)?)
+                    })
+                };
+                estimate_of(&sum, all, groups)
+            })
+        })
+        .collect()
 }

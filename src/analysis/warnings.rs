@@ -25,6 +25,21 @@ pub enum RunWarningKind {
     OneSided,
 }
 
+impl RunWarningKind {
+    /// The stable code of the warning in the JSON report (`open-scene`).
+    pub fn code(self) -> &'static str {
+        match self {
+            RunWarningKind::OpenScene => "open-scene",
+            RunWarningKind::CoincidentCrossings => "coincident-crossings",
+            RunWarningKind::UnsampledPatches => "unsampled-patches",
+            RunWarningKind::DegeneratePairs => "degenerate-pairs",
+            RunWarningKind::NoPairs => "no-pairs",
+            RunWarningKind::InsideOut => "inside-out",
+            RunWarningKind::OneSided => "one-sided",
+        }
+    }
+}
+
 /// One warning about a run.
 #[derive(Clone, Debug, PartialEq)]
 pub struct RunWarning {
@@ -32,6 +47,34 @@ pub struct RunWarning {
     pub kind: RunWarningKind,
     /// The sentence for the report, naming the scene.
     pub message: String,
+    /// The objects it is about, by the names the scene file gives them (empty: the whole scene).
+    pub objects: Vec<String>,
+    /// The numbers it reports, by name (`escape_fraction`, `patches`), for programs.
+    pub numbers: Vec<(&'static str, f64)>,
+}
+
+impl RunWarning {
+    /// A warning of `kind` saying `message`, about no object in particular.
+    pub fn new(kind: RunWarningKind, message: String) -> Self {
+        RunWarning {
+            kind,
+            message,
+            objects: Vec::new(),
+            numbers: Vec::new(),
+        }
+    }
+
+    /// The same warning with numbers for programs.
+    pub fn with_numbers(mut self, numbers: &[(&'static str, f64)]) -> Self {
+        self.numbers = numbers.to_vec();
+        self
+    }
+
+    /// The same warning about these objects.
+    pub fn about(mut self, objects: Vec<String>) -> Self {
+        self.objects = objects;
+        self
+    }
 }
 
 impl std::fmt::Display for RunWarning {
@@ -55,7 +98,9 @@ pub(crate) fn of_run(
     environment_area: Option<Estimate>,
 ) -> Vec<RunWarning> {
     let mut w = Vec::new();
-    let mut push = |kind, message| w.push(RunWarning { kind, message });
+    let mut push = |kind, message, numbers: &[(&'static str, f64)]| {
+        w.push(RunWarning::new(kind, message).with_numbers(numbers))
+    };
     if let Some(fraction) = escape_fraction(counters).filter(|&f| f > 0.0) {
         let effect = match environment_area {
             Some(env) => format!(
@@ -72,6 +117,7 @@ pub(crate) fn of_run(
                  scene; {effect}",
                 100.0 * fraction
             ),
+            &[("escape_fraction", fraction)],
         );
     }
     if counters.coincident_crossings > 0 {
@@ -82,6 +128,7 @@ pub(crate) fn of_run(
                  face first in the scene is seen there (remove duplicated faces and decals)",
                 counters.coincident_crossings
             ),
+            &[("crossings", counters.coincident_crossings as f64)],
         );
     }
     if let Some((n, frac)) = unsampled.filter(|u| u.0 > 0) {
@@ -92,6 +139,7 @@ pub(crate) fn of_run(
                  empty; cast more lines",
                 100.0 * frac
             ),
+            &[("patches", n as f64), ("area_fraction", frac)],
         );
     }
     if counters.degenerate_pairs > 0 {
@@ -101,6 +149,7 @@ pub(crate) fn of_run(
                 "{scene}: {} pair(s) joined coincident points (touching surfaces) and were left out of I_s^c",
                 counters.degenerate_pairs
             ),
+            &[("pairs", counters.degenerate_pairs as f64)],
         );
     }
     w

@@ -176,7 +176,7 @@ fn spec_of(args: &AnalyzeArgs) -> Result<RunSpec, Failure> {
         budget,
         source: LineSource::bundles(args.bundle).map_err(Failure::bad_input)?,
         enclose: args.enclose,
-        per_patch: !args.files.patches.is_empty(),
+        per_patch: args.files.wants_per_patch(),
         ..args.run.spec(lines, args.run.seed.value)
     })
 }
@@ -360,7 +360,7 @@ pub fn run(args: &AnalyzeArgs) -> Result<Exit, Failure> {
     // The per-patch files asked for now decide what is shared out at the end; what is gathered is what
     // the state gathers.
     let cfg = RunSpec {
-        per_patch: !args.files.patches.is_empty(),
+        per_patch: args.files.wants_per_patch(),
         ..identity.spec.clone()
     };
     let scope = Scope::of(identity.shard);

@@ -172,7 +172,7 @@ pub fn run(args: &ConvergenceArgs) -> Result<Exit, Failure> {
     })
 }
 
-/// Every run's `analyze --format csv` rows, with the repeat and the seconds in front.
+/// Every run's `analyze --format csv` rows (which hold its seconds), with the repeat in front.
 fn csv(info: &report::RunInfo, levels: &[Level]) -> String {
     let mut out = String::new();
     for (k, l) in levels.iter().enumerate() {
@@ -181,11 +181,11 @@ fn csv(info: &report::RunInfo, levels: &[Level]) -> String {
             for (n, line) in rows.lines().enumerate() {
                 if n == 0 {
                     if k == 0 && r == 0 {
-                        let _ = writeln!(out, "repeat,seconds,{line}");
+                        let _ = writeln!(out, "repeat,{line}");
                     }
                     continue;
                 }
-                let _ = writeln!(out, "{r},{},{line}", a.seconds);
+                let _ = writeln!(out, "{r},{line}");
             }
         }
     }

@@ -27,7 +27,7 @@ pub fn load_scene(
     })
     .map_err(|e| Failure::bad_input(e.to_string()))?;
     for w in &scene.warnings {
-        warn(w);
+        warn(&w.message);
     }
     Ok(scene)
 }

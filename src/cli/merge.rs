@@ -178,7 +178,7 @@ pub fn run(args: &MergeArgs) -> Result<Exit, Failure> {
     args.files
         .check_saved(&first, &identity, state.wanted(), &without_sums)?;
     let cfg = RunSpec {
-        per_patch: !args.files.patches.is_empty(),
+        per_patch: args.files.wants_per_patch(),
         ..identity.spec.clone()
     };
     // Saved after the report, so that a save that fails never costs it.

@@ -38,6 +38,13 @@ pub struct PatchFiles {
     /// `.mtx` (Matrix Market, for scipy.io.mmread). Repeat to write both.
     #[arg(long, value_name = "FILE")]
     pub form_factors: Vec<PathBuf>,
+    /// Also write one row per object (the groups, meshes or nodes the scene file names) to FILE (.csv):
+    /// name, patches, triangles, area, segments, escapes and how lines met its sides, and its share of
+    /// each per-patch quantity with its standard error (the sums of its patches' terms of I_s and I_s^c;
+    /// sum a_i H_i for the row entropies; area-weighted means for the radiosities). Gathers what
+    /// --patches gathers.
+    #[arg(long, value_name = "FILE")]
+    pub objects: Vec<PathBuf>,
 }
 
 impl PatchFiles {
@@ -48,25 +55,30 @@ impl PatchFiles {
             .form_factors
             .iter()
             .map(|p| ("--form-factors", p.as_path()));
-        patches.chain(matrices).collect()
+        let objects = self.objects.iter().map(|p| ("--objects", p.as_path()));
+        patches.chain(matrices).chain(objects).collect()
     }
 
-    /// Whether no per-patch file was asked for.
+    /// Whether no per-patch file was asked for (`--objects` aside: it has rows for any run).
     pub fn is_empty(&self) -> bool {
         self.patches.is_empty() && self.form_factors.is_empty()
     }
 
+    /// Whether the run must gather the per-patch sums of eq. (27) ([`scene_complexity::RunSpec::per_patch`]).
+    pub fn wants_per_patch(&self) -> bool {
+        !self.patches.is_empty() || !self.objects.is_empty()
+    }
+
     /// Checks, before any work, the files' kinds and that they can be written.
     pub fn check(&self) -> Result<(), Failure> {
-        if self.is_empty() {
-            return Ok(());
-        }
-        check_patch_files(&self.patches)?;
+        check_csv_files(&self.patches, "--patches")?;
+        check_csv_files(&self.objects, "--objects")?;
         check_matrix_files(&self.form_factors)?;
         output::check_all(
             self.patches
                 .iter()
                 .chain(&self.form_factors)
+                .chain(&self.objects)
                 .map(PathBuf::as_path),
         )
     }
@@ -115,7 +127,11 @@ impl PatchFiles {
     /// Writes every file asked for from a finished analysis.
     pub fn write(&self, scene: &Scene, a: &Analysis) -> Result<(), Failure> {
         write_patches(&self.patches, scene, a)?;
-        write_form_factors(&self.form_factors, scene, a)
+        write_form_factors(&self.form_factors, scene, a)?;
+        for path in &self.objects {
+            write_with(path, |w| objects_csv(w, a))?;
+        }
+        Ok(())
     }
 }
 
@@ -133,12 +149,12 @@ fn extension(path: &Path) -> String {
         .to_ascii_lowercase()
 }
 
-/// Checks, before any work, that every per-patch file is a `.csv`.
-fn check_patch_files(paths: &[PathBuf]) -> Result<(), Failure> {
+/// Checks, before any work, that every file of `option` is a `.csv`.
+fn check_csv_files(paths: &[PathBuf], option: &str) -> Result<(), Failure> {
     for p in paths {
         if extension(p) != "csv" {
             return Err(Failure::bad_input(format!(
-                "{}: --patches writes a .csv file",
+                "{}: {option} writes a .csv file",
                 p.display()
             )));
         }
@@ -382,7 +398,7 @@ fn patches_csv(w: &mut dyn Write, scene: &Scene, patches: &[PatchResult]) -> std
         let material = &scene.materials[patch.material as usize].name;
         let mut row = vec![
             i.to_string(),
-            String::new(),
+            scene.objects[patch.object as usize].clone(),
             material.clone(),
             num(Some(patch.area * norm.scale * norm.scale)),
             num(Some(c.x)),
@@ -398,6 +414,59 @@ fn patches_csv(w: &mut dyn Write, scene: &Scene, patches: &[PatchResult]) -> std
             p.sampled().to_string(),
         ];
         for e in PatchMeasure::ALL.map(|q| p.get(q)) {
+            row.push(num(e.map(|e| e.value)));
+            row.push(num(e.and_then(|e| e.stderr)));
+        }
+        out.write_record(&row)?;
+    }
+    out.flush()
+}
+
+/// One row per object: what it is, how lines met it, and its value of each per-patch quantity.
+fn objects_csv(w: &mut dyn Write, a: &Analysis) -> std::io::Result<()> {
+    let mut out = csv::Writer::from_writer(w);
+    let mut header: Vec<String> = [
+        "object",
+        "patches",
+        "triangles",
+        "area",
+        "area_fraction",
+        "segments",
+        "escapes",
+        "escape_fraction",
+        "absorbed",
+        "front_sides_to_open_space",
+        "back_sides_seen_from_fronts",
+        "back_sides_from_open_space",
+        "back_sides_to_open_space",
+    ]
+    .map(String::from)
+    .to_vec();
+    for q in PatchMeasure::ALL {
+        let name = q.info().column;
+        header.push(name.to_string());
+        header.push(format!("{name}_stderr"));
+    }
+    out.write_record(&header)?;
+    let num = |x: Option<f64>| x.map(|v| format!("{}", v + 0.0)).unwrap_or_default();
+    let int = |x: Option<u64>| x.map(|v| v.to_string()).unwrap_or_default();
+    for o in &a.objects {
+        let mut row = vec![
+            o.name.clone(),
+            o.patches.to_string(),
+            o.triangles.to_string(),
+            num(Some(o.area)),
+            num(Some(o.area_fraction)),
+            int(o.segments),
+            int(o.escapes),
+            num(o.escape_fraction()),
+            int(o.absorbed),
+            o.sides.front_open.to_string(),
+            o.sides.back_seen.to_string(),
+            o.sides.back_from_open.to_string(),
+            o.sides.back_to_open.to_string(),
+        ];
+        for e in PatchMeasure::ALL.map(|q| o.get(q)) {
             row.push(num(e.map(|e| e.value)));
             row.push(num(e.and_then(|e| e.stderr)));
         }

@@ -10,7 +10,8 @@ use scene_complexity::LineSource;
 use scene_complexity::Scene;
 use scene_complexity::VerdictRule;
 use scene_complexity::{
-    Analysis, RadiosityOutcome, Reliability, TargetOutcome, Verdict, COVERAGE_OK,
+    Analysis, ObjectResult, PatchMeasure, RadiosityOutcome, Reliability, TargetOutcome, Verdict,
+    COVERAGE_OK,
 };
 use scene_complexity::{ErrorMethod, Shard, StopReason, Tracing};
 use scene_complexity::{Estimate, Family, Measure, Unit};
@@ -41,7 +42,7 @@ pub fn render(format: Format, run: &RunInfo, a: &Analysis) -> String {
 /// JSON schema version of `analyze --format json` (2: units, reliability, sampling, target, command
 /// line, CPU; 3: segments to back sides counted in their rows (`absorbed`), and I_s^c of an open scene
 /// on the footing of the discrete measures, the lost segments counted).
-pub const SCHEMA_VERSION: u32 = 3;
+pub const SCHEMA_VERSION: u32 = 4;
 
 /// Facts about the run that the analysis itself does not hold: the scene, how it ran.
 pub struct RunInfo<'a> {
@@ -245,11 +246,72 @@ pub fn json(run: &RunInfo, a: &Analysis) -> String {
         "visibility": Value::Object(visibility),
         "radiosity": radiosity_json(a),
         "radiosity_skipped": skipped_reason(&a.radiosity).map_or(Value::Null, Value::from),
-        "warnings": a.warnings.iter().map(|w| w.message.as_str()).collect::<Vec<_>>(),
+        "objects": objects_json(a),
+        "warnings": warnings_json(run.scene, a),
     });
     let mut s = serde_json::to_string_pretty(&doc).expect("a JSON value always serialises");
     s.push('\n');
     s
+}
+
+/// Each object's results: what it is, how its sides were met, its segments (when the pairs were
+/// counted) and, with per-patch results, its value of each per-patch quantity with its standard error.
+fn objects_json(a: &Analysis) -> Value {
+    let object = |o: &ObjectResult| {
+        let mut doc = json!({
+            "name": o.name,
+            "patches": o.patches,
+            "triangles": o.triangles,
+            "area": finite(o.area),
+            "area_fraction": finite(o.area_fraction),
+            "segments": o.segments,
+            "escapes": o.escapes,
+            "escape_fraction": o.escape_fraction(),
+            "absorbed": o.absorbed,
+            "front_sides_to_open_space": o.sides.front_open,
+            "back_sides_seen_from_fronts": o.sides.back_seen,
+            "back_sides_from_open_space": o.sides.back_from_open,
+            "back_sides_to_open_space": o.sides.back_to_open,
+        });
+        let map = doc.as_object_mut().expect("an object");
+        for q in PatchMeasure::ALL {
+            let value = o.get(q).map_or(
+                Value::Null,
+                |e| json!({"value": finite(e.value), "stderr": e.stderr.and_then(finite)}),
+            );
+            map.insert(q.info().column.to_string(), value);
+        }
+        doc
+    };
+    Value::Array(a.objects.iter().map(object).collect())
+}
+
+/// The warnings as data: how the scene was read, then the run's; each with its stable code, the
+/// objects it is about, the numbers it reports and its sentence.
+fn warnings_json(scene: &Scene, a: &Analysis) -> Value {
+    let entry =
+        |from: &str, code: &str, message: &str, objects: &[String], numbers: &[(&str, f64)]| {
+            let numbers: serde_json::Map<String, Value> = numbers
+                .iter()
+                .map(|&(k, v)| (k.to_string(), finite(v).map_or(Value::Null, Value::from)))
+                .collect();
+            json!({
+                "code": code,
+                "from": from,
+                "objects": objects,
+                "numbers": numbers,
+                "message": message,
+            })
+        };
+    let read = scene
+        .warnings
+        .iter()
+        .map(|w| entry("scene", w.kind.code(), &w.message, &w.objects, &w.numbers));
+    let run = a
+        .warnings
+        .iter()
+        .map(|w| entry("run", w.kind.code(), &w.message, &w.objects, &w.numbers));
+    Value::Array(read.chain(run).collect())
 }
 
 /// Why the radiosity measures were left out (`None` when computed).
@@ -289,6 +351,9 @@ pub fn csv(run: &RunInfo, a: &Analysis) -> String {
         "lines",
         "seed",
         "tracer",
+        "patches",
+        "escape_fraction",
+        "seconds",
         "family",
         "measure",
         "unit",
@@ -316,6 +381,9 @@ pub fn csv(run: &RunInfo, a: &Analysis) -> String {
             a.lines.to_string(),
             a.spec.seed.to_string(),
             run.tracing.backend.name().to_string(),
+            run.scene.patch_count().to_string(),
+            num(a.escape_fraction()),
+            a.seconds.to_string(),
             family.to_string(),
             r.key.to_string(),
             r.unit.name().to_string(),

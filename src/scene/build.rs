@@ -8,7 +8,7 @@
 
 use std::collections::HashMap;
 
-use super::{Material, Normalization, Patch, Scene, SceneError};
+use super::{Material, Normalization, Patch, Scene, SceneError, SceneWarning, SceneWarningKind};
 use crate::geom::polygon::{planar_pieces, planarity_deviation, triangulate};
 use crate::geom::{centroid, newell, triangle_area, Point};
 
@@ -85,7 +85,7 @@ pub struct SceneBuilder {
     materials: Vec<Material>,
     objects: Vec<String>,
     current_object: Option<u32>,
-    warnings: Vec<String>,
+    warnings: Vec<SceneWarning>,
 }
 
 #[derive(Clone, Debug)]
@@ -96,6 +96,8 @@ struct Polygon {
     sides: Sides,
     /// Where it came from, for messages (`face 12`, `line 40`).
     origin: String,
+    /// Whether it is the back side of a two-sided polygon (the reverse of the one before it).
+    back: bool,
 }
 
 /// The polygons split because they were not planar, for the one warning about them.
@@ -103,8 +105,12 @@ struct Polygon {
 struct Splits {
     count: usize,
     pieces: usize,
+    /// The pieces of the back sides of split two-sided polygons: patches too, but not more polygons.
+    back_pieces: usize,
     worst: f64,
     examples: Vec<String>,
+    /// The objects of the split polygons.
+    objects: std::collections::BTreeSet<u32>,
 }
 
 impl SceneBuilder {
@@ -188,12 +194,18 @@ impl SceneBuilder {
             object,
             sides,
             origin: origin.into(),
+            back: false,
         });
     }
 
     /// Records a non-fatal problem to report with the scene.
-    pub fn warn(&mut self, message: impl Into<String>) {
-        self.warnings.push(message.into());
+    pub fn warn(&mut self, kind: SceneWarningKind, message: impl Into<String>) {
+        self.warnings.push(SceneWarning::new(kind, message));
+    }
+
+    /// Records a non-fatal problem, with its objects and counts.
+    pub fn warn_with(&mut self, warning: SceneWarning) {
+        self.warnings.push(warning);
     }
 
     /// Validates the geometry, triangulates the polygons and scales the scene to its unit bounding sphere,
@@ -275,7 +287,7 @@ impl SceneBuilder {
                 }
                 let pieces = planar_pieces(&pts)
                     .map_err(|e| self.geometry_error(format!("{}: {e}", poly.origin)))?;
-                splits.add(&poly.origin, deviation, pieces.len());
+                splits.add(poly, deviation, pieces.len());
                 let mut any = false;
                 for piece in pieces {
                     let corners = piece.map(|k| poly.vertices[k]);
@@ -305,22 +317,34 @@ impl SceneBuilder {
                 dropped_polygons.push(poly.origin.clone());
             }
         }
-        if let Some(w) = splits.warning(&self.name, options.planarity.tolerance) {
+        if let Some(w) = splits.warning(&self.name, options.planarity.tolerance, &scene.objects) {
             scene.warnings.push(w);
         }
         if dropped_triangles > 0 {
-            scene.warnings.push(format!(
-                "{}: dropped {dropped_triangles} zero-area triangle(s)",
-                self.name
-            ));
+            let w = SceneWarning::new(
+                SceneWarningKind::ZeroAreaTriangles,
+                format!(
+                    "{}: dropped {dropped_triangles} zero-area triangle(s)",
+                    self.name
+                ),
+            );
+            scene
+                .warnings
+                .push(w.with_numbers(&[("triangles", dropped_triangles as f64)]));
         }
         if !dropped_polygons.is_empty() {
-            scene.warnings.push(format!(
-                "{}: dropped {} zero-area face(s), first: {}",
-                self.name,
-                dropped_polygons.len(),
-                dropped_polygons[0]
-            ));
+            let w = SceneWarning::new(
+                SceneWarningKind::ZeroAreaFaces,
+                format!(
+                    "{}: dropped {} zero-area face(s), first: {}",
+                    self.name,
+                    dropped_polygons.len(),
+                    dropped_polygons[0]
+                ),
+            );
+            scene
+                .warnings
+                .push(w.with_numbers(&[("faces", dropped_polygons.len() as f64)]));
         }
         if scene.patches.is_empty() {
             return Err(self.geometry_error("the scene has no faces of non-zero area".into()));
@@ -463,7 +487,7 @@ fn weld_f32(traced: &[Point], polygons: &mut [Polygon]) -> Vec<u32> {
 /// coincide with it and face the same way, so they could never be seen (of overlapping faces the first
 /// in the scene is the one seen, see `sample::order`). The same corners in the opposite order are the
 /// two sides of a thin panel, which stay.
-fn drop_duplicates(name: &str, polygons: &mut Vec<Polygon>, warnings: &mut Vec<String>) {
+fn drop_duplicates(name: &str, polygons: &mut Vec<Polygon>, warnings: &mut Vec<SceneWarning>) {
     let mut seen: HashMap<Vec<u32>, usize> = HashMap::new();
     let mut duplicates = Vec::new();
     for (k, poly) in polygons.iter().enumerate() {
@@ -481,13 +505,17 @@ fn drop_duplicates(name: &str, polygons: &mut Vec<Polygon>, warnings: &mut Vec<S
     let Some(&(first, again)) = duplicates.first() else {
         return;
     };
-    warnings.push(format!(
+    let message = format!(
         "{name}: dropped {} face(s) repeating an earlier face (same corners, facing the same way: never \
          seen), first: {} repeats {}",
         duplicates.len(),
         polygons[again].origin,
         polygons[first].origin
-    ));
+    );
+    warnings.push(
+        SceneWarning::new(SceneWarningKind::DuplicateFaces, message)
+            .with_numbers(&[("faces", duplicates.len() as f64)]),
+    );
     let drop: std::collections::HashSet<usize> = duplicates.iter().map(|&(_, k)| k).collect();
     let mut k = 0;
     polygons.retain(|_| {
@@ -513,6 +541,7 @@ fn sided_polygons(polygons: Vec<Polygon>, flip: &[bool], two_sided: &[bool]) -> 
             let mut back = poly.clone();
             reverse_corners(&mut back.vertices);
             back.origin = format!("{} (back side)", poly.origin);
+            back.back = true;
             back
         });
         out.push(poly);
@@ -581,7 +610,13 @@ fn add_patch(
 }
 
 impl Splits {
-    fn add(&mut self, origin: &str, deviation: f64, pieces: usize) {
+    fn add(&mut self, poly: &Polygon, deviation: f64, pieces: usize) {
+        if poly.back {
+            self.back_pieces += pieces;
+            return;
+        }
+        let origin = &poly.origin;
+        self.objects.insert(poly.object);
         self.count += 1;
         self.pieces += pieces;
         self.worst = self.worst.max(deviation);
@@ -591,7 +626,7 @@ impl Splits {
     }
 
     /// The one warning about the split polygons (`None` when none was split).
-    fn warning(&self, scene: &str, tolerance: f64) -> Option<String> {
+    fn warning(&self, scene: &str, tolerance: f64, objects: &[String]) -> Option<SceneWarning> {
         if self.count == 0 {
             return None;
         }
@@ -601,14 +636,32 @@ impl Splits {
         } else {
             String::new()
         };
-        Some(format!(
-            "{scene}: split {} non-planar polygon(s) into {} planar triangles, each a patch (worst: a \
-             vertex {:.3e} of the face's size off its plane; tolerance {tolerance:e}): {}{rest}",
+        let backs = if self.back_pieces > 0 {
+            format!(
+                " (and their back sides, two-sided: {} more)",
+                self.back_pieces
+            )
+        } else {
+            String::new()
+        };
+        let message = format!(
+            "{scene}: split {} non-planar polygon(s) into {} planar triangles{backs}, each a patch \
+             (worst: a vertex {:.3e} of the face's size off its plane; tolerance {tolerance:e}): {}{rest}",
             self.count,
             self.pieces,
             self.worst,
             self.examples.join("; ")
-        ))
+        );
+        let names = self.objects.iter().map(|&o| objects[o as usize].clone());
+        Some(
+            SceneWarning::new(SceneWarningKind::NonPlanarSplit, message)
+                .about(names.collect())
+                .with_numbers(&[
+                    ("polygons", self.count as f64),
+                    ("triangles", self.pieces as f64),
+                    ("worst_deviation", self.worst),
+                ]),
+        )
     }
 }
 

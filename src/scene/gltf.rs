@@ -20,7 +20,7 @@ use serde_json::json;
 
 use super::gltf_data::{self, Budget, Data};
 use super::read::Folder;
-use super::{Material, Scene, SceneBuilder, SceneError, SceneOptions, Sides};
+use super::{Material, Scene, SceneBuilder, SceneError, SceneOptions, SceneWarningKind, Sides};
 
 type Matrix = [[f64; 4]; 4];
 
@@ -181,16 +181,22 @@ fn load_document(
         ));
     }
     if skipped_modes > 0 {
-        b.warn(format!(
+        b.warn(
+            SceneWarningKind::NoArea,
+            format!(
             "{shown}: ignored {skipped_modes} primitive(s) of points or lines: they have no area"
-        ));
+        ),
+        );
     }
     if !textured.is_empty() {
-        b.warn(format!(
-            "{shown}: textures are not read; the reflectance of material(s) {} is their \
+        b.warn(
+            SceneWarningKind::TexturesIgnored,
+            format!(
+                "{shown}: textures are not read; the reflectance of material(s) {} is their \
              baseColorFactor alone",
-            super::build::list_names(&textured)
-        ));
+                super::build::list_names(&textured)
+            ),
+        );
     }
     b.build_with(options)
 }

@@ -14,9 +14,11 @@ mod obj_check;
 mod ply;
 pub mod read;
 mod stl;
+mod warning;
 
 pub use build::{ObjectSet, Planarity, SceneBuilder, SceneOptions, Sides, DEFAULT_PLANARITY};
 pub use read::{Reach, ReadPolicy, DEFAULT_MAX_BYTES};
+pub use warning::{SceneWarning, SceneWarningKind};
 
 use std::fmt;
 
@@ -172,7 +174,7 @@ pub struct Scene {
     /// Total area in the scene's own units, from the original f64 coordinates.
     pub area_scene_units: f64,
     /// Non-fatal problems found while loading (missing MTL, dropped degenerate triangles, ...).
-    pub warnings: Vec<String>,
+    pub warnings: Vec<SceneWarning>,
 }
 
 impl Scene {

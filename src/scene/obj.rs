@@ -7,7 +7,7 @@
 use std::path::Path;
 
 use super::read::{self, Escape, Fetched, Folder, ReadError, ReadPolicy, RefError};
-use super::{Material, Scene, SceneBuilder, SceneError, SceneOptions};
+use super::{Material, Scene, SceneBuilder, SceneError, SceneOptions, SceneWarningKind};
 
 /// Loads an OBJ file (and its MTL library, if any, beside it) as a scene.
 pub fn load(path: &Path) -> Result<Scene, SceneError> {
@@ -302,11 +302,14 @@ pub fn load_text_with(
                 tobj::LoadError::OpenFileFailed => unread.borrow().first().map(MtlError::to_string),
                 _ => None,
             };
-            b.warn(format!(
+            b.warn(
+                SceneWarningKind::MaterialLibrary,
+                format!(
                 "{shown}: material library not loaded ({}); every face gets the default material \
                  (reflectance 0.5, no emission)",
                 why.unwrap_or_else(|| describe_tobj_error(&e))
-            ));
+            ),
+            );
             None
         }
     };
@@ -409,10 +412,13 @@ fn warn_refused_libraries(b: &mut SceneBuilder, shown: &str, unread: &[MtlError]
         return;
     }
     for why in unread.iter().filter(|w| !w.is_missing()) {
-        b.warn(format!(
+        b.warn(
+            SceneWarningKind::MaterialLibrary,
+            format!(
             "{shown}: a material library was not read ({why}); faces using its materials get the \
              default material (reflectance 0.5, no emission)"
-        ));
+        ),
+        );
     }
 }
 
@@ -468,11 +474,14 @@ fn warn_undefined_materials(
         .iter()
         .map(|(line, name)| format!("`{name}` (line {line})"))
         .collect();
-    b.warn(format!(
+    b.warn(
+        SceneWarningKind::UndefinedMaterials,
+        format!(
         "{shown}: `usemtl` names material(s) no library defines: {}; their faces get the default \
          material (reflectance 0.5, no emission)",
         named.join(", ")
-    ));
+    ),
+    );
 }
 
 /// Warnings about what the loader left out: `w` weights and line or point statements.
@@ -483,14 +492,14 @@ fn warn_ignored_statements(
 ) {
     let (weights, line) = prepared.weights;
     if weights > 0 {
-        b.warn(format!(
+        b.warn(SceneWarningKind::VertexWeights, format!(
             "{shown}: ignored the weight `w` of {weights} vertex statement(s) `v x y z w` (first at line \
              {line}): it applies to rational curves and surfaces only"
         ));
     }
     let (count, line) = prepared.lines_and_points;
     if count > 0 {
-        b.warn(format!(
+        b.warn(SceneWarningKind::NoArea, format!(
             "{shown}: ignored {count} line and point statement(s) (`l`, `p`; first at line {line}): they \
              have no area"
         ));

@@ -26,7 +26,7 @@ fn json_report_parses_and_carries_the_documented_fields() {
         String::from_utf8_lossy(&out.stderr)
     );
     let doc: serde_json::Value = serde_json::from_slice(&out.stdout).expect("valid JSON");
-    assert_eq!(doc["schema_version"], 3);
+    assert_eq!(doc["schema_version"], 4);
     assert_eq!(
         doc["absorbed"], 0,
         "a closed, consistently oriented cube shows no back side"

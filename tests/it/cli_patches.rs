@@ -346,3 +346,102 @@ fn a_resumed_run_without_the_sums_leaves_the_continuous_columns_empty_and_says_s
         assert!(!r[col("mutual_information_term")].is_empty());
     }
 }
+
+/// `--objects`: one row per object of the file, by its name; their areas are the objects' own, their
+/// shares of I_s, I_s^c and H_s add up to the scene's readings (to rounding), and the standard error of
+/// each object's sum is at most the sum of its patches' errors (the norm of a sum); `--patches` names
+/// each patch's object; the JSON report's `objects` holds the same numbers.
+#[test]
+fn object_results_add_up_to_the_scene() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut obj = String::new();
+    let mut faces = 0;
+    for line in crate::support::room_with_box_obj(1.0).lines() {
+        if line.starts_with("f ") {
+            match faces {
+                0 => obj.push_str("o room\n"),
+                6 => obj.push_str("o box\n"),
+                _ => {}
+            }
+            faces += 1;
+        }
+        obj.push_str(line);
+        obj.push('\n');
+    }
+    let scene = dir.path().join("room.obj");
+    std::fs::write(&scene, obj).unwrap();
+    let (objects, patches) = (dir.path().join("o.csv"), dir.path().join("p.csv"));
+    let out = scx(&[
+        "analyze",
+        scene.to_str().unwrap(),
+        "--lines",
+        "2e5",
+        "--format",
+        "json",
+        "--objects",
+        objects.to_str().unwrap(),
+        "--patches",
+        patches.to_str().unwrap(),
+    ]);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+
+    let (header, rows) = read_csv(&objects);
+    let col = |name: &str| header.iter().position(|h| h == name).unwrap();
+    let num = |row: &[String], name: &str| row[col(name)].parse::<f64>().unwrap();
+    let names: Vec<&str> = rows.iter().map(|r| r[col("object")].as_str()).collect();
+    assert_eq!(names, ["room", "box"]);
+    let box_area = 2.0 * (0.3 * 0.3 + 0.3 * 0.45 + 0.3 * 0.45);
+    for (row, area) in rows.iter().zip([6.0, box_area]) {
+        assert_eq!(num(row, "patches"), 6.0);
+        assert!((num(row, "area") - area).abs() < 1e-9, "{row:?}");
+        assert_eq!(num(row, "escapes"), 0.0, "a closed scene");
+    }
+    let fractions: f64 = rows.iter().map(|r| num(r, "area_fraction")).sum();
+    assert!((fractions - 1.0).abs() < 1e-12);
+    let scene_value = |key: &str| doc["visibility"][key]["value"].as_f64().unwrap();
+    for (column, key) in [
+        (
+            "continuous_mutual_information_term",
+            "continuous_mutual_information",
+        ),
+        ("mutual_information_term", "mutual_information"),
+        ("row_entropy", "entropy"),
+    ] {
+        let sum: f64 = rows.iter().map(|r| num(r, column)).sum();
+        let whole = scene_value(key);
+        assert!(
+            (sum - whole).abs() < 1e-9 * whole.abs(),
+            "{column}: {sum} against {whole}"
+        );
+    }
+
+    let (p_header, p_rows) = read_csv(&patches);
+    let p_col = |name: &str| p_header.iter().position(|h| h == name).unwrap();
+    let owners: Vec<&str> = p_rows.iter().map(|r| r[p_col("object")].as_str()).collect();
+    assert_eq!(owners, [vec!["room"; 6], vec!["box"; 6]].concat());
+    for (k, row) in rows.iter().enumerate() {
+        let column = "continuous_mutual_information_term_stderr";
+        let patch_errors: f64 = p_rows[6 * k..6 * k + 6]
+            .iter()
+            .map(|r| r[p_col(column)].parse::<f64>().unwrap())
+            .sum();
+        let error = num(row, column);
+        assert!(
+            error > 0.0 && error <= patch_errors * (1.0 + 1e-12),
+            "{error} {patch_errors}"
+        );
+        let json = &doc["objects"][k];
+        assert_eq!(json["name"], names[k]);
+        assert_eq!(
+            json["continuous_mutual_information_term"]["value"].as_f64(),
+            Some(num(row, "continuous_mutual_information_term"))
+        );
+        assert_eq!(json["segments"].as_f64(), Some(num(row, "segments")));
+    }
+}

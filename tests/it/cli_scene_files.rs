@@ -150,6 +150,19 @@ fn a_scene_without_pairs_reports_undefined_measures() {
         warnings.contains("no line segment joined two patches"),
         "{warnings}"
     );
+    // As data: the stable code, the object by its name in the file, the counts behind the sentence.
+    let all = doc["warnings"].as_array().unwrap();
+    let no_pairs = all.iter().find(|w| w["code"] == "no-pairs").unwrap();
+    assert_eq!(no_pairs["code"], "no-pairs", "{warnings}");
+    assert_eq!(
+        no_pairs["objects"],
+        serde_json::json!(["box"]),
+        "{warnings}"
+    );
+    assert_eq!(
+        no_pairs["numbers"]["escapes"],
+        doc["escapes"].as_f64().unwrap()
+    );
     assert!(
         warnings.contains("`box`") && warnings.contains("--flip-normals"),
         "{warnings}"

@@ -33,6 +33,15 @@ fn run(scene: &Scene, lines: u64, seed: u64, measures: Measures) -> Analysis {
     analyze(scene, tracer.as_ref(), &cfg, &RunControl::default()).unwrap()
 }
 
+/// The sentences of a scene's warnings, one a line.
+fn messages(warnings: &[scene_complexity::SceneWarning]) -> String {
+    warnings
+        .iter()
+        .map(|w| w.message.as_str())
+        .collect::<Vec<_>>()
+        .join("\n")
+}
+
 fn kinds(a: &Analysis) -> Vec<RunWarningKind> {
     a.warnings.iter().map(|w| w.kind).collect()
 }
@@ -54,7 +63,7 @@ fn a_slightly_non_planar_quad_becomes_two_planar_triangles() {
         assert_eq!(p.polygon.len(), 3);
         assert_eq!(scene.objects[p.object as usize], "bent");
     }
-    let warning = scene.warnings.join("\n");
+    let warning = messages(&scene.warnings);
     assert!(
         warning.contains("split 1 non-planar polygon") && warning.contains("line 6: face 1"),
         "{warning}"
@@ -68,6 +77,21 @@ fn a_slightly_non_planar_quad_becomes_two_planar_triangles() {
         ..SceneOptions::default()
     };
     assert_eq!(load_file(&path, &loose).patch_count(), 1);
+    // Two-sided: its back side is split too (4 patches), but it is still one polygon split in two.
+    let both = SceneOptions {
+        two_sided: ObjectSet::All,
+        ..SceneOptions::default()
+    };
+    let two_sided = load_file(&path, &both);
+    assert_eq!(two_sided.patch_count(), 4);
+    let warning = messages(&two_sided.warnings);
+    assert!(
+        warning.contains(
+            "split 1 non-planar polygon(s) into 2 planar triangles (and their back \
+                          sides, two-sided: 2 more)"
+        ),
+        "{warning}"
+    );
     let strict = SceneOptions {
         planarity: Planarity {
             tolerance: 1e-4,
@@ -130,7 +154,10 @@ fn the_vertex_weight_is_ignored() {
     );
     assert_eq!(scene.patch_count(), 6);
     assert!((scene.total_area_scene_units() - 6.0).abs() < 1e-12);
-    assert!(scene.warnings.iter().any(|w| w.contains("weight `w`")));
+    assert!(scene
+        .warnings
+        .iter()
+        .any(|w| w.message.contains("weight `w`")));
 }
 
 /// Boxes as OBJ objects: `(lo, hi, inward, name)`.

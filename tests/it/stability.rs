@@ -641,8 +641,8 @@ fn coplanar_overlapping_faces_are_seen_once_and_reported() {
         scene
             .warnings
             .iter()
-            .any(|w| w.contains("dropped 1 face(s)")
-                && w.contains("ceiling again repeats room face 5")),
+            .any(|w| w.message.contains("dropped 1 face(s)")
+                && w.message.contains("ceiling again repeats room face 5")),
         "the repeated face is named: {:?}",
         scene.warnings
     );
@@ -1013,11 +1013,22 @@ fn a_very_fine_mesh_with_few_lines_reports_its_unsampled_patches() {
     let fraction = doc["unsampled_area_fraction"].as_f64().unwrap();
     assert!((fraction - got / n_p as f64).abs() < 1e-9, "{fraction}");
     let warnings = doc["warnings"].as_array().unwrap();
+    let unsampled = warnings
+        .iter()
+        .find(|w| w["code"] == "unsampled-patches")
+        .unwrap_or_else(|| panic!("{warnings:?}"));
     assert!(
-        warnings
-            .iter()
-            .any(|w| w.as_str().unwrap().contains(&format!("{got} patch(es)"))),
-        "{warnings:?}"
+        unsampled["message"]
+            .as_str()
+            .unwrap()
+            .contains(&format!("{got} patch(es)")),
+        "{unsampled}"
+    );
+    assert_eq!(unsampled["from"], "run");
+    assert_eq!(unsampled["numbers"]["patches"].as_f64(), Some(got));
+    assert_eq!(
+        unsampled["numbers"]["area_fraction"].as_f64(),
+        Some(fraction)
     );
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(stderr.contains("were never left by a line"), "{stderr}");
@@ -1054,7 +1065,15 @@ fn zero_area_triangles_are_dropped_with_a_warning() {
     let a = scenes::load(plain.to_str().unwrap()).unwrap();
     let b = scenes::load(broken.to_str().unwrap()).unwrap();
     assert!(a.warnings.is_empty(), "{:?}", a.warnings);
-    let joined = b.warnings.join("\n");
+    let joined = b
+        .warnings
+        .iter()
+        .map(|w| w.message.as_str())
+        .collect::<Vec<_>>()
+        .join("\n");
+    let codes: Vec<&str> = b.warnings.iter().map(|w| w.kind.code()).collect();
+    assert_eq!(codes, ["zero-area-triangles", "zero-area-faces"]);
+    assert_eq!(b.warnings[0].numbers, [("triangles", 2.0)]);
     assert!(
         joined.contains("dropped 2 zero-area triangle(s)"),
         "{joined}"
