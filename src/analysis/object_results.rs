@@ -7,6 +7,9 @@ use crate::measure::{Estimate, PatchMeasure};
 use crate::sample::tally::{ObjectSides, Tally};
 use crate::scene::Scene;
 
+/// An object's value of each quantity of the per-patch catalogue, by [`PatchMeasure`].
+pub type ObjectValues = [Option<Estimate>; PatchMeasure::COUNT];
+
 /// One object's results.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ObjectResult {
@@ -31,7 +34,7 @@ pub struct ObjectResult {
     pub absorbed: Option<u64>,
     /// Per quantity of the per-patch catalogue, the object's value ([`object_weight`]), when the run
     /// has per-patch results.
-    pub(crate) values: [Option<Estimate>; PatchMeasure::COUNT],
+    pub(crate) values: ObjectValues,
 }
 
 impl ObjectResult {
@@ -85,7 +88,7 @@ pub fn patches_by_object(scene: &Scene) -> Vec<Vec<usize>> {
 pub(crate) fn of_run(
     scene: &Scene,
     total: &Tally,
-    values: Option<Vec<[Option<Estimate>; PatchMeasure::COUNT]>>,
+    values: Option<Vec<ObjectValues>>,
 ) -> Vec<ObjectResult> {
     let members = patches_by_object(scene);
     let total_area = scene.total_area();

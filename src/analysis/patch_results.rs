@@ -7,7 +7,7 @@
 
 use rayon::prelude::*;
 
-use super::object_results::{object_weight, patches_by_object};
+use super::object_results::{object_weight, patches_by_object, ObjectValues};
 use crate::measure::estimators::EntropyEstimator;
 use crate::measure::radiosity::{self, FormFactors, PatchMaterials, SolveOptions};
 use crate::measure::shares::{patch_values, ContinuousSums, PatchValues};
@@ -69,10 +69,7 @@ pub(crate) fn estimates(
     run: &FinishedRun,
     estimator: EntropyEstimator,
     light: Option<PatchLight<'_>>,
-) -> Option<(
-    Vec<PatchResult>,
-    Vec<[Option<Estimate>; PatchMeasure::COUNT]>,
-)> {
+) -> Option<(Vec<PatchResult>, Vec<ObjectValues>)> {
     let of = |t: &Tally| of_tally(scene, t, estimator, light);
     let (all, groups): (Option<TallyPatches>, Vec<Option<TallyPatches>>) = rayon::join(
         || of(&run.total),
@@ -165,11 +162,7 @@ fn patch_estimate(i: usize, all: &TallyPatches, groups: &[TallyPatches]) -> Patc
 
 /// Each object's values: its patches' values weighted as [`object_weight`] says, summed in each tally,
 /// with the batch-means standard error of the groups' sums.
-fn object_values(
-    scene: &Scene,
-    all: &TallyPatches,
-    groups: &[TallyPatches],
-) -> Vec<[Option<Estimate>; PatchMeasure::COUNT]> {
+fn object_values(scene: &Scene, all: &TallyPatches, groups: &[TallyPatches]) -> Vec<ObjectValues> {
     let total_area = scene.total_area();
     let fraction = |i: usize| scene.patches[i].area / total_area;
     patches_by_object(scene)
