@@ -519,3 +519,128 @@ fn field<'a>(v: &'a mut ciborium::Value, key: &str) -> &'a mut ciborium::Value {
         .unwrap()
         .1
 }
+
+/// Checks a refusal of the command line or the input: exit 2, every `expected` part in the message,
+/// and none of the text of a parser that does not say what is wanted.
+fn assert_usage(out: &Output, expected: &[&str]) {
+    let err = stderr(out);
+    assert_eq!(code(out), Some(2), "{err}");
+    for e in expected {
+        assert!(err.contains(e), "`{e}` not in: {err}");
+    }
+    assert!(
+        !err.contains("invalid digit") && !err.contains("Some("),
+        "{err}"
+    );
+}
+
+/// Numeric flags say what they accept (issue 28: `--groups 1e9` said "invalid digit found in
+/// string"): the flag, and its range.
+#[test]
+fn numeric_flags_name_their_range() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let cases: [(&[&str], &[&str]); 7] = [
+        (
+            &["analyze", "@cube:3", "--groups", "1e9"],
+            &["--groups", "number of groups", "from 2 to 1024"],
+        ),
+        (
+            &["analyze", "@cube:3", "--threads", "1e5"],
+            &["--threads", "from 0 to 4096"],
+        ),
+        (
+            &["analyze", "@cube:3", "--bundle", "x"],
+            &["--bundle", "from 0 to 64"],
+        ),
+        (
+            &["convergence", "@cube:2", "--repeats", "0"],
+            &["--repeats", "from 1 to 1000"],
+        ),
+        (&["reproduce", "--table", "10"], &["--table", "from 1 to 9"]),
+        (
+            &["crosscheck", "@cube:2", "--show", "-1"],
+            &["--show", "cannot be negative", "from 0"],
+        ),
+        (
+            &["calibrate", "--scene", "@cube", "--seeds", "0"],
+            &["--seeds", "runs per cell", "from 1"],
+        ),
+    ];
+    for (args, expected) in cases {
+        assert_usage(&scx_in(d, args), expected);
+    }
+}
+
+/// `refine --patches 0` speaks of patches, not of "a line count".
+#[test]
+fn refine_patches_says_what_it_needs() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = scx_in(
+        dir.path(),
+        &[
+            "refine",
+            "@cube:2",
+            "--strategy",
+            "uniform",
+            "--patches",
+            "0",
+            "-o",
+            "r.obj",
+        ],
+    );
+    assert_usage(&out, &["--patches", "number of patches", "from 1"]);
+    assert!(!stderr(&out).contains("line count"), "{}", stderr(&out));
+    assert!(!dir.path().join("r.obj").exists());
+}
+
+/// Durations take units (`30s`, `5m`, `1h30m`) as well as plain seconds; garbage says what a duration
+/// is; a duration with units beyond the clock is no limit, as plain seconds are.
+#[test]
+fn durations_take_units() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    for extra in [
+        &["--seconds", "5m"][..],
+        &["--seconds", "1h30m"],
+        &["--seconds", "99999999999999999999h"],
+        &["--checkpoint-every", "30s", "--checkpoint", "c.scx"],
+    ] {
+        let mut args = vec!["analyze", "@cube:2", "--lines", "2e4", "--format", "json"];
+        args.extend_from_slice(extra);
+        let out = scx_in(d, &args);
+        assert_eq!(code(&out), Some(0), "{extra:?}: {}", stderr(&out));
+        let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        assert_eq!(report["lines"], 20_000, "{extra:?}");
+    }
+    for bad in ["abc", "0s", "-5", "5 parsecs"] {
+        let out = scx_in(d, &["analyze", "@cube:2", "--seconds", bad]);
+        assert_usage(&out, &["--seconds", "30s", "1h30m"]);
+    }
+}
+
+/// A flag whose list is optional, put before the scene, takes the scene as its list: the error says
+/// so and how to write it.
+#[test]
+fn a_list_flag_that_took_the_scene_says_so() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::write(d.join("scene.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
+    for flag in ["--two-sided", "--flip-normals"] {
+        let out = scx_in(d, &["analyze", flag, "scene.obj"]);
+        assert_usage(
+            &out,
+            &[
+                &format!("{flag} took `scene.obj` as its list"),
+                "put the scene first",
+                "--",
+            ],
+        );
+    }
+    let out = scx_in(d, &["crosscheck", "--aimed", "@cube:2"]);
+    assert_usage(&out, &["--aimed took `@cube:2` as its list"]);
+    // The hint is for that case only: a missing scene with no list flag is clap's message alone.
+    let out = scx_in(d, &["analyze", "--lines", "1e3"]);
+    assert_eq!(code(&out), Some(2));
+    assert!(!stderr(&out).contains("hint"), "{}", stderr(&out));
+}
