@@ -644,3 +644,98 @@ fn a_list_flag_that_took_the_scene_says_so() {
     assert_eq!(code(&out), Some(2));
     assert!(!stderr(&out).contains("hint"), "{}", stderr(&out));
 }
+
+/// Makes the states of shard `k` of 2 of a run of `@cube:2` (with `more` settings) in `dir`.
+fn shard_state(dir: &Path, k: u32, file: &str, more: &[&str]) {
+    let shard = format!("{k}/2");
+    let mut args = vec![
+        "analyze", "@cube:2", "--lines", "1e4", "--shard", &shard, "--save", file, "-q",
+    ];
+    args.extend_from_slice(more);
+    let out = scx_in(dir, &args);
+    assert_eq!(code(&out), Some(0), "{}", stderr(&out));
+}
+
+/// `scx merge` refuses a state given twice, under one name or two (`./s2.scx`), naming it, before
+/// reading any (issue 28: it said "s2.scx cannot join s1.scx").
+#[test]
+fn a_state_given_twice_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    shard_state(d, 1, "s1.scx", &[]);
+    shard_state(d, 2, "s2.scx", &[]);
+    let out = scx_in(d, &["merge", "s1.scx", "s2.scx", "s2.scx"]);
+    assert_usage(&out, &["s2.scx is given twice", "name each state once"]);
+    assert!(!stderr(&out).contains("cannot join"));
+    let out = scx_in(d, &["merge", "s1.scx", "s2.scx", "./s2.scx"]);
+    assert_usage(&out, &["given twice", "s2.scx and ./s2.scx"]);
+    assert_eq!(code(&scx_in(d, &["merge", "s1.scx", "s2.scx"])), Some(0));
+}
+
+/// States of different runs are refused with both values in words: no Rust debug text, switches as
+/// on/off, shards counted, scenes named.
+#[test]
+fn merge_differences_read_as_words() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    shard_state(d, 1, "s1.scx", &[]);
+    shard_state(d, 2, "enclosed.scx", &["--enclose"]);
+    let out = scx_in(
+        d,
+        &[
+            "analyze",
+            "@cube:2",
+            "--lines",
+            "1e4",
+            "--save",
+            "whole.scx",
+            "-q",
+        ],
+    );
+    assert_eq!(code(&out), Some(0), "{}", stderr(&out));
+    let out = scx_in(d, &["merge", "s1.scx", "whole.scx"]);
+    assert_usage(
+        &out,
+        &["shard count differs (not sharded against 2 shards)"],
+    );
+    let out = scx_in(d, &["merge", "s1.scx", "enclosed.scx"]);
+    assert_usage(&out, &["enclose differs (on against off)"]);
+    assert!(!stderr(&out).contains("true"), "{}", stderr(&out));
+}
+
+/// Merging a state that a live run still holds (its `FILE.lock` names a running process) warns that
+/// the merge may miss that run's latest batches, and merges.
+#[cfg(target_os = "linux")]
+#[test]
+fn merging_a_live_state_warns() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    shard_state(d, 1, "s1.scx", &[]);
+    shard_state(d, 2, "s2.scx", &[]);
+    let live = std::process::id();
+    std::fs::write(d.join("s2.scx.lock"), format!("{} {live}\n", host())).unwrap();
+    let out = scx_in(d, &["merge", "s1.scx", "s2.scx"]);
+    let err = stderr(&out);
+    assert_eq!(code(&out), Some(0), "{err}");
+    assert!(
+        err.contains("warning: s2.scx is still being written by process")
+            && err.contains(&live.to_string())
+            && err.contains(&host())
+            && err.contains("may miss its latest batches"),
+        "{err}"
+    );
+    assert!(!err.contains("s1.scx is still"), "{err}");
+    // A lock whose process is gone is no warning.
+    std::fs::write(
+        d.join("s2.scx.lock"),
+        format!("{} {}\n", host(), dead_pid()),
+    )
+    .unwrap();
+    let out = scx_in(d, &["merge", "s1.scx", "s2.scx"]);
+    assert_eq!(code(&out), Some(0));
+    assert!(
+        !stderr(&out).contains("still being written"),
+        "{}",
+        stderr(&out)
+    );
+}
