@@ -99,7 +99,7 @@ pub use run::{
     SpecDifference, StopReason, Target, Tracing, DEFAULT_ESTIMATOR, DEFAULT_GROUPS,
 };
 pub use sample::counts::PairCounts;
-pub use sample::lines::{BundleError, LineSource};
+pub use sample::lines::{BundleError, LineSource, MAX_BUNDLE_GRID};
 pub use sample::tally::{Tally, Wanted};
 
 // What is computed from a run.

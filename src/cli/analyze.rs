@@ -4,7 +4,6 @@ use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use clap::ValueEnum;
-use scene_complexity::LineSource;
 use scene_complexity::Measure;
 use scene_complexity::Query;
 use scene_complexity::{cast, finish};
@@ -12,8 +11,12 @@ use scene_complexity::{
     remaining_lines, start, Budget, CastOptions, Measures, RunControl, RunIdentity, RunSpec,
     RunState, SceneRef, Scope, Shard, StopReason, Target,
 };
+use scene_complexity::{LineSource, MAX_BUNDLE_GRID};
 
-use super::args::{parse_count, parse_positive, target_measure_parser, ReportOutput, RunOptions};
+use super::args::{
+    parse_count, parse_positive, parse_seconds, parse_whole_in, target_measure_parser,
+    ReportOutput, RunOptions,
+};
 use super::exit::{Exit, Failure};
 use super::output::{self, warn};
 use super::patch_files::PatchFiles;
@@ -36,8 +39,9 @@ pub struct AnalyzeArgs {
     /// apply (radiosity needs an emitting material, and brings the discrete counts along).
     #[arg(long, value_delimiter = ',', value_enum)]
     measures: Option<Vec<MeasureArg>>,
-    /// Stop after this many seconds (then --lines is only a cap).
-    #[arg(long, value_parser = parse_positive, allow_negative_numbers = true)]
+    /// Stop after this long (then --lines is only a cap): seconds (`90`, `1e3`), or with units (`30s`,
+    /// `5m`, `2h`, `1h30m`).
+    #[arg(long, value_name = "DURATION", value_parser = parse_seconds, allow_negative_numbers = true)]
     seconds: Option<f64>,
     /// Stop when the standard error of --target-measure is at most this AND its reading is reliable
     /// (verdict `ok`); then --lines (and --seconds) only cap the run.
@@ -77,8 +81,9 @@ pub struct AnalyzeArgs {
     /// run killed loses only the work since the last checkpoint).
     #[arg(long, value_name = "FILE")]
     checkpoint: Option<PathBuf>,
-    /// Seconds between checkpoints.
-    #[arg(long, default_value = "300", value_parser = parse_positive, allow_negative_numbers = true)]
+    /// Time between checkpoints: seconds (`300`), or with units (`30s`, `5m`, `1h30m`).
+    #[arg(long, value_name = "DURATION", default_value = "300", value_parser = parse_seconds,
+          allow_negative_numbers = true)]
     checkpoint_every: f64,
     /// Continue the run saved in FILE (by --save or --checkpoint) with its own settings, up to --lines
     /// (more lines than first asked are fine), and save it back to FILE as it goes. --tracer, --query
@@ -142,10 +147,13 @@ fn check_patch_files(args: &AnalyzeArgs) -> Result<(), Failure> {
 }
 
 fn parse_bundle(s: &str) -> Result<u32, String> {
-    let g: u32 = s
-        .trim()
-        .parse()
-        .map_err(|_| format!("`{s}` is not a whole number"))?;
+    let g = parse_whole_in(
+        s,
+        "the bundle grid (0: independent lines)",
+        0,
+        u64::from(MAX_BUNDLE_GRID),
+    )?;
+    let g = g as u32;
     LineSource::bundles(g).map(|_| g).map_err(|e| e.to_string())
 }
 

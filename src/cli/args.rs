@@ -133,8 +133,8 @@ pub struct RunOptions {
     #[arg(long, default_value = "single", value_parser = parse_query)]
     pub query: Query,
     /// Independent groups of lines behind each standard error (2 to 1024).
-    #[arg(long, default_value_t = DEFAULT_GROUPS as u16,
-          value_parser = clap::value_parser!(u16).range(2..=1024))]
+    #[arg(long, default_value_t = DEFAULT_GROUPS as u16, value_parser = parse_groups,
+          allow_negative_numbers = true)]
     pub groups: u16,
     /// Estimator of the bias-corrected H_s and I_s: plug-in, miller-madow, grassberger, chao-shen,
     /// chao-wang-jost.
@@ -204,22 +204,46 @@ impl TracerArg {
     }
 }
 
-/// A whole number written as `1000000`, `1e6` or `2.5e6`, within `[min, 1e15]`; `what` names it in
-/// messages.
-fn parse_whole(s: &str, what: &str, min: u64) -> Result<u64, String> {
+/// The largest count any flag takes (lines, seeds): far beyond any run, small enough that every
+/// such number is exact in an f64.
+pub const MAX_WHOLE: u64 = 1_000_000_000_000_000;
+
+/// A bound as the user would write it: `1e15` rather than its sixteen digits.
+fn shown(n: u64) -> String {
+    if n == MAX_WHOLE {
+        "1e15".into()
+    } else {
+        n.to_string()
+    }
+}
+
+/// A whole number written as `1000000`, `1e6` or `2.5e6`, within `[min, max]` (`max` at most 1e15);
+/// `what` names it in messages, which always give the range.
+pub fn parse_whole_in(s: &str, what: &str, min: u64, max: u64) -> Result<u64, String> {
+    let range = format!(
+        "{what} must be a whole number from {} to {}",
+        shown(min),
+        shown(max)
+    );
     let v: f64 = s
         .trim()
         .parse()
-        .map_err(|_| format!("`{s}` is not a number"))?;
+        .map_err(|_| format!("`{s}` is not a number: {range}"))?;
     if v.is_finite() && v < 0.0 {
-        return Err(format!("{what} cannot be negative (`{s}`)"));
-    }
-    if !(v.is_finite() && v.fract() == 0.0 && v >= min as f64 && v <= 1e15) {
         return Err(format!(
-            "`{s}`: {what} must be a whole number from {min} to 1e15"
+            "`{s}`: {what} cannot be negative: it is a whole number from {} to {}",
+            shown(min),
+            shown(max)
         ));
     }
+    if !(v.is_finite() && v.fract() == 0.0 && v >= min as f64 && v <= max as f64) {
+        return Err(format!("`{s}`: {range}"));
+    }
     Ok(v as u64)
+}
+
+fn parse_whole(s: &str, what: &str, min: u64) -> Result<u64, String> {
+    parse_whole_in(s, what, min, MAX_WHOLE)
 }
 
 /// A line count: a whole number >= 1.
@@ -232,13 +256,18 @@ pub fn parse_seed(s: &str) -> Result<u64, String> {
     parse_whole(s, "a seed", 0)
 }
 
+/// The most worker threads a run may ask for.
+const MAX_THREADS: u64 = 4096;
+
 /// A thread count: 0 means all cores.
 pub fn parse_threads(s: &str) -> Result<usize, String> {
-    let n = parse_whole(s, "a thread count", 0)?;
-    if n > 4096 {
-        return Err(format!("`{s}`: at most 4096 threads"));
-    }
-    Ok(n as usize)
+    parse_whole_in(s, "a thread count (0: all cores)", 0, MAX_THREADS).map(|n| n as usize)
+}
+
+/// `--groups`: the independent groups behind each standard error, 2 to 1024 (fewer gives no error
+/// bar; more makes each group too small to be normal).
+pub fn parse_groups(s: &str) -> Result<u16, String> {
+    parse_whole_in(s, "the number of groups", 2, 1024).map(|n| n as u16)
 }
 
 /// A planarity tolerance: a fraction of a polygon's size, >= 0.
@@ -297,6 +326,35 @@ pub fn parse_positive(s: &str) -> Result<f64, String> {
     }
 }
 
+/// The forms a duration may take, for messages.
+const DURATION_FORMS: &str =
+    "seconds (`90`, `1e3`, `0.5`) or a duration with units (`30s`, `5m`, `2h`, `1h30m`, `1d`)";
+
+/// A duration in seconds (`--seconds`, `--checkpoint-every`): a plain number of seconds, or a duration
+/// with units as humantime reads it. One longer than any clock is returned as it is (a plain number)
+/// or as 2^64 seconds (with units): the run treats both as no limit.
+pub fn parse_seconds(s: &str) -> Result<f64, String> {
+    let t = s.trim();
+    if let Ok(v) = t.parse::<f64>() {
+        return match v {
+            v if v.is_finite() && v > 0.0 => Ok(v),
+            v if v <= 0.0 => Err(format!("`{s}`: need a duration above 0: {DURATION_FORMS}")),
+            _ => Err(format!("`{s}` is not a duration: need {DURATION_FORMS}")),
+        };
+    }
+    match humantime::parse_duration(t) {
+        Ok(d) if d.is_zero() => Err(format!("`{s}`: need a duration above 0: {DURATION_FORMS}")),
+        Ok(d) => Ok(d.as_secs_f64()),
+        // Whole units beyond humantime's range (thousands of years) are no limit, as plain seconds
+        // are; a fraction may instead be below a nanosecond, which no clock counts.
+        Err(humantime::DurationError::NumberOverflow) if !t.contains('.') => Ok(u64::MAX as f64),
+        Err(humantime::DurationError::NumberOverflow) => Err(format!(
+            "`{s}`: too long, or more precise than a nanosecond; for no limit leave the flag out"
+        )),
+        Err(_) => Err(format!("`{s}` is not a duration: need {DURATION_FORMS}")),
+    }
+}
+
 fn parse_estimator(s: &str) -> Result<EntropyEstimator, String> {
     EntropyEstimator::from_name(s).ok_or_else(|| {
         let names: Vec<&str> = EntropyEstimator::ALL.iter().map(|e| e.name()).collect();
@@ -351,5 +409,27 @@ mod tests {
             .contains("unknown unit"));
         assert!(parse_size("-1GB").is_err());
         assert!(parse_size("0").is_err());
+    }
+
+    #[test]
+    fn ranges_are_named_and_durations_take_units() {
+        assert_eq!(parse_groups("1e2"), Ok(100));
+        assert!(parse_groups("1e9").unwrap_err().contains("from 2 to 1024"));
+        assert!(parse_threads("5000")
+            .unwrap_err()
+            .contains("from 0 to 4096"));
+        assert!(parse_count("x").unwrap_err().contains("from 1 to 1e15"));
+        assert_eq!(parse_seconds("90"), Ok(90.0));
+        assert_eq!(parse_seconds("1e3"), Ok(1000.0));
+        assert_eq!(parse_seconds("30s"), Ok(30.0));
+        assert_eq!(parse_seconds("5m"), Ok(300.0));
+        assert_eq!(parse_seconds("2h"), Ok(7200.0));
+        assert_eq!(parse_seconds("1h30m"), Ok(5400.0));
+        assert_eq!(parse_seconds("1e30"), Ok(1e30));
+        assert_eq!(parse_seconds("99999999999999999999h"), Ok(u64::MAX as f64));
+        for bad in ["abc", "0", "0s", "-1", "inf", "NaN", "5 parsecs", ""] {
+            assert!(parse_seconds(bad).is_err(), "{bad}");
+        }
+        assert!(parse_seconds("abc").unwrap_err().contains("1h30m"));
     }
 }

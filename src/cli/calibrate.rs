@@ -10,8 +10,8 @@ use scene_complexity::calibrate::{
 use scene_complexity::Measure;
 
 use super::args::{
-    parse_count, parse_positive, parse_seed, target_measure_parser, ReportOutput, Threads, Tracer,
-    TracerArg,
+    parse_count, parse_positive, parse_seed, parse_whole_in, target_measure_parser, ReportOutput,
+    Threads, Tracer, TracerArg, MAX_WHOLE,
 };
 use super::exit::{Exit, Failure};
 use super::output::{self, check_all};
@@ -35,7 +35,7 @@ pub struct CalibrateArgs {
     #[arg(long, value_delimiter = ',', value_parser = parse_count, default_value = "1e5")]
     lines: Vec<u64>,
     /// Runs per cell (with `--scene`), seeds `first-seed..first-seed + seeds`.
-    #[arg(long, value_parser = parse_count, default_value = "200")]
+    #[arg(long, value_parser = parse_seed_count, default_value = "200")]
     seeds: u64,
     /// The first seed (with `--scene`).
     #[arg(long, value_parser = parse_seed, default_value = "1")]
@@ -66,6 +66,11 @@ pub struct CalibrateArgs {
     readings: Option<PathBuf>,
     #[command(flatten)]
     out: ReportOutput,
+}
+
+/// `--seeds`: runs per cell, a whole number >= 1.
+fn parse_seed_count(s: &str) -> Result<u64, String> {
+    parse_whole_in(s, "the number of runs per cell", 1, MAX_WHOLE)
 }
 
 fn parse_suite(s: &str) -> Result<SuiteLevel, String> {

@@ -10,7 +10,7 @@ use scene_complexity::StopReason;
 use scene_complexity::{Estimate, Measure};
 use serde_json::json;
 
-use super::args::{parse_count, ReportOutput, RunOptions};
+use super::args::{parse_count, parse_whole_in, ReportOutput, RunOptions};
 use super::exit::{Exit, Failure};
 use super::output::{self, check_all, note};
 use super::plot::{self, Curve, Series};
@@ -28,7 +28,7 @@ pub struct ConvergenceArgs {
           allow_negative_numbers = true)]
     lines: Vec<u64>,
     /// Runs per line count (seeds seed, seed+1, ...).
-    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=1000))]
+    #[arg(long, default_value_t = 1, value_parser = parse_repeats, allow_negative_numbers = true)]
     repeats: u32,
     #[command(flatten)]
     run: RunOptions,
@@ -53,6 +53,11 @@ enum ConvergenceFormat {
 }
 
 /// The measures followed (the catalogue's, in their column order).
+/// `--repeats`: runs per line count, 1 to 1000.
+fn parse_repeats(s: &str) -> Result<u32, String> {
+    parse_whole_in(s, "the number of runs per line count", 1, 1000).map(|n| n as u32)
+}
+
 fn followed() -> Vec<Measure> {
     let mut all: Vec<Measure> = Measure::ALL
         .into_iter()

@@ -5,7 +5,7 @@ use scene_complexity::crosscheck::{self, AimedConfig, CrossCheckConfig, Toleranc
 use scene_complexity::{make_tracer, AnalysisError, Backend, Query, Scene, Tracer, DEFAULT_GROUPS};
 
 use super::args::SceneArgs;
-use super::args::{parse_count, ReportOutput, Seed, Threads};
+use super::args::{parse_count, parse_whole_in, ReportOutput, Seed, Threads};
 use super::exit::{Exit, Failure};
 use super::input::load_scene;
 use super::output::{self, check_all};
@@ -40,10 +40,11 @@ pub struct CrosscheckArgs {
     #[command(flatten)]
     threads: Threads,
     /// Distances agree within this many f32 ulps at max(t, 1).
-    #[arg(long, default_value_t = Tolerance::default().ulps, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = Tolerance::default().ulps, value_parser = parse_ulps,
+          allow_negative_numbers = true)]
     ulps: f32,
     /// How many differing lines to print.
-    #[arg(long, default_value_t = 5)]
+    #[arg(long, default_value_t = 5, value_parser = parse_show, allow_negative_numbers = true)]
     show: usize,
     #[command(flatten)]
     out: ReportOutput,
@@ -97,6 +98,21 @@ impl AimArg {
 }
 
 /// The kinds asked for, each once, in the order of [`AimKind::ALL`].
+/// `--ulps`: a tolerance in f32 ulps, a number >= 0.
+fn parse_ulps(s: &str) -> Result<f32, String> {
+    match s.trim().parse::<f32>() {
+        Ok(v) if v.is_finite() && v >= 0.0 => Ok(v),
+        _ => Err(format!(
+            "`{s}`: the tolerance must be a number of f32 ulps >= 0 (such as 4 or 0.5)"
+        )),
+    }
+}
+
+/// `--show`: how many differing lines to print, a whole number >= 0.
+fn parse_show(s: &str) -> Result<usize, String> {
+    parse_whole_in(s, "the number of lines to show", 0, 1_000_000).map(|n| n as usize)
+}
+
 fn aimed_kinds(args: &[AimArg]) -> Vec<AimKind> {
     let asked: Vec<AimKind> = args.iter().flat_map(|a| a.kinds()).collect();
     AimKind::ALL

@@ -3,7 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
-use scene_complexity::finish;
+use scene_complexity::{files, finish};
 use scene_complexity::{RunSpec, RunState, SavedRun, Scene, StateFile, StopReason};
 
 use super::analyze::persist_failure;
@@ -107,8 +107,54 @@ fn merged(files: Vec<StateFile>, scene: &Scene) -> Result<Merged, Failure> {
     })
 }
 
+/// Refuses a state given twice (by the same name, or by two names of one file: `./s.scx`, a link),
+/// naming it: its batches would otherwise show up as an overlap of the file with itself.
+fn check_states_distinct(states: &[PathBuf]) -> Result<(), Failure> {
+    let real = |p: &PathBuf| std::fs::canonicalize(p).unwrap_or_else(|_| p.clone());
+    for (k, path) in states.iter().enumerate() {
+        if let Some(first) = states[..k].iter().find(|q| real(q) == real(path)) {
+            let also = if first == path {
+                String::new()
+            } else {
+                format!(" (as {} and {})", first.display(), path.display())
+            };
+            return Err(Failure::bad_input(format!(
+                "{} is given twice{also}: name each state once",
+                path.display()
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// Warns about each state that a live run still holds (its `FILE.lock` names a process that is
+/// running, or one on another host): the merge reads what was saved last and may miss the batches that
+/// run casts after. A warning, not a refusal: merging a checkpoint of a run still going is legitimate.
+fn warn_live_states(states: &[PathBuf]) {
+    let host = files::this_host();
+    for path in states {
+        let real = std::fs::canonicalize(path).unwrap_or_else(|_| path.clone());
+        let Ok(held) = std::fs::read_to_string(files::lock_path(&real)) else {
+            continue;
+        };
+        let mut words = held.split_whitespace();
+        let (holder, pid) = (words.next().unwrap_or(""), words.next().unwrap_or(""));
+        let live = holder != host || pid.parse().map_or(true, files::process_alive);
+        let pid = if pid.is_empty() { "(unknown)" } else { pid };
+        if live && !holder.is_empty() {
+            warn(&format!(
+                "{} is still being written by process {pid} on {holder}: the merge may miss its \
+                 latest batches (merge again when that run has ended)",
+                path.display()
+            ));
+        }
+    }
+}
+
 /// Runs `scx merge`.
 pub fn run(args: &MergeArgs) -> Result<Exit, Failure> {
+    check_states_distinct(&args.states)?;
+    warn_live_states(&args.states);
     let mut outputs: Vec<(&str, &Path)> = Vec::new();
     outputs.extend(args.out.output.as_deref().map(|p| ("-o", p)));
     outputs.extend(args.save.as_deref().map(|p| ("--save", p)));

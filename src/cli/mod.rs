@@ -31,7 +31,7 @@ use exit::Exit;
 
 /// Runs the command line.
 pub fn main() -> ExitCode {
-    let cli = Cli::parse();
+    let cli = Cli::try_parse().unwrap_or_else(|e| usage_error(e));
     output::set_quiet(cli.quiet);
     // A panic is a bug in scx, never the user's to read as a backtrace: the hook keeps its message
     // quiet (a reader that catches a dependency's panic has already said what went wrong), and one that
@@ -76,6 +76,63 @@ pub fn main() -> ExitCode {
             ExitCode::from(f.code as u8)
         }
     }
+}
+
+/// Ends the program on a command line clap refused (exit 2; help and version exit 0), with a hint
+/// when a flag whose list is optional took the scene as its list.
+fn usage_error(e: clap::Error) -> ! {
+    use clap::error::ErrorKind;
+    let swallowed = matches!(
+        e.kind(),
+        ErrorKind::MissingRequiredArgument | ErrorKind::InvalidValue
+    );
+    let hint = swallowed
+        .then(|| {
+            let words: Vec<String> = std::env::args_os()
+                .skip(1)
+                .map(|w| w.to_string_lossy().into_owned())
+                .collect();
+            swallowed_scene(&Cli::command(), &words)
+        })
+        .flatten();
+    let Some(hint) = hint else { e.exit() };
+    let _ = e.print();
+    eprintln!("hint: {hint}");
+    std::process::exit(e.exit_code());
+}
+
+/// When a flag that takes an optional list (`--two-sided`, `--flip-normals`, `--aimed`) is followed by
+/// a word that looks like a scene (an existing file, a built-in `@...`, a scene file's name), the
+/// sentence that says so: clap gave that word to the flag, and then found no scene.
+fn swallowed_scene(command: &clap::Command, words: &[String]) -> Option<String> {
+    let optional_lists: Vec<String> = command
+        .get_subcommands()
+        .flat_map(|c| c.get_arguments())
+        .filter(|a| {
+            a.get_num_args()
+                .is_some_and(|n| n.min_values() == 0 && n.takes_values())
+        })
+        .filter_map(|a| a.get_long().map(|l| format!("--{l}")))
+        .collect();
+    words.windows(2).find_map(|pair| {
+        let (flag, value) = (&pair[0], &pair[1]);
+        (optional_lists.contains(flag) && looks_like_scene(value)).then(|| {
+            format!(
+                "{flag} took `{value}` as its list; put the scene first, or write {flag}=NAMES, \
+                 or put `--` before the scene"
+            )
+        })
+    })
+}
+
+/// Whether a word names a scene rather than objects: a built-in, standard input, a scene file's
+/// extension, or an existing file.
+fn looks_like_scene(word: &str) -> bool {
+    let path = std::path::Path::new(word);
+    let scene_extension = path.extension().is_some_and(|e| {
+        ["obj", "gltf", "glb", "ply", "stl"].contains(&e.to_string_lossy().to_lowercase().as_str())
+    });
+    word.starts_with('@') || word == "-" || scene_extension || path.is_file()
 }
 
 /// The message and place of the last panic (for the sentence that ends the program).

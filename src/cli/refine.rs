@@ -10,7 +10,9 @@ use scene_complexity::{make_tracer, Query};
 use std::sync::Arc;
 
 use super::args::SceneArgs;
-use super::args::{parse_count, parse_positive, Seed, Threads, Tracer, TracerArg};
+use super::args::{
+    parse_count, parse_positive, parse_whole_in, Seed, Threads, Tracer, TracerArg, MAX_WHOLE,
+};
 use super::exit::{Exit, Failure};
 use super::input::load_scene;
 use super::output::{self, note};
@@ -28,7 +30,7 @@ pub struct RefineArgs {
     #[arg(long, value_enum)]
     strategy: StrategyArg,
     /// Stop at about this many patches (at most 2 over).
-    #[arg(long, value_parser = parse_count, allow_negative_numbers = true)]
+    #[arg(long, value_parser = parse_patches, allow_negative_numbers = true)]
     patches: u64,
     /// The OBJ file to write; the MTL library goes beside it (both checked writable first).
     #[arg(short, long)]
@@ -53,6 +55,11 @@ enum StrategyArg {
     Power,
     Smoothness,
     Information,
+}
+
+/// `--patches`: the patch count to refine towards, a whole number >= 1.
+fn parse_patches(s: &str) -> Result<u64, String> {
+    parse_whole_in(s, "the number of patches to refine towards", 1, MAX_WHOLE)
 }
 
 /// Runs `scx refine`.

@@ -6,7 +6,7 @@ use std::time::Instant;
 use scene_complexity::reproduce::{reproduce, LinePlan, ReproduceConfig, TableReport, TABLES};
 use scene_complexity::Backend;
 
-use super::args::{ReportOutput, Seed, Threads, Tracer, TracerArg};
+use super::args::{parse_whole_in, ReportOutput, Seed, Threads, Tracer, TracerArg};
 use super::exit::{Exit, Failure};
 use super::output::{self, check_all};
 use super::runner::thread_pool;
@@ -15,7 +15,7 @@ use super::runner::thread_pool;
 #[derive(clap::Args, Debug)]
 pub struct ReproduceArgs {
     /// The tables to regenerate, comma separated (default: all, 1 to 9).
-    #[arg(long, value_delimiter = ',', value_parser = clap::value_parser!(u8).range(1..=9))]
+    #[arg(long, value_delimiter = ',', value_parser = parse_table, allow_negative_numbers = true)]
     table: Vec<u8>,
     /// Lines per run: `default` (the paper's counts, at most 1e8 per run), `paper` (the paper's counts,
     /// 1e9 included), a factor on the defaults (`x0.1`), or one count for every run (`1e6`).
@@ -29,6 +29,11 @@ pub struct ReproduceArgs {
     tracer: Tracer,
     #[command(flatten)]
     out: ReportOutput,
+}
+
+/// `--table`: a table of the paper, 1 to 9.
+fn parse_table(s: &str) -> Result<u8, String> {
+    parse_whole_in(s, "a table number", 1, 9).map(|n| n as u8)
 }
 
 /// Runs `scx reproduce`: the Markdown goes to standard output as each table finishes, or to `-o FILE`

@@ -123,18 +123,27 @@ impl RunIdentity {
                 theirs,
             })
         };
-        let shards = |s: &RunIdentity| s.shard.map_or("none".into(), |s| s.count.to_string());
+        // Only the count must agree: each part is another shard of it.
+        let shards = |s: &RunIdentity| {
+            s.shard
+                .map_or("not sharded".into(), |s| format!("{} shards", s.count))
+        };
+        // Enough of the fingerprint to tell scenes apart, by chars: a forged state's may be any text.
+        let scene = |s: &RunIdentity| {
+            let print: String = s.scene.fingerprint.chars().take(12).collect();
+            format!("{} (fingerprint {print})", s.scene.name)
+        };
         differ(
             "scx version",
             self.scx_version.clone(),
             other.scx_version.clone(),
         )
         .or_else(|| {
-            differ(
-                "scene fingerprint",
-                self.scene.fingerprint.clone(),
-                other.scene.fingerprint.clone(),
-            )
+            (self.scene.fingerprint != other.scene.fingerprint).then(|| SpecDifference {
+                setting: "scene fingerprint".into(),
+                ours: scene(self),
+                theirs: scene(other),
+            })
         })
         .or_else(|| {
             differ(

@@ -215,18 +215,25 @@ fn first_difference(
     })
 }
 
-/// A JSON value as a reader would write it: strings bare, `null` as `none`, objects as `key value`.
+/// A JSON value as a reader would write it: strings bare, `null` as `none`, switches as `on`/`off`,
+/// whole numbers without a decimal point, lists and objects (`key value`) joined by commas.
 fn in_words(v: &serde_json::Value) -> String {
     use serde_json::Value;
     match v {
         Value::Null => "none".into(),
+        Value::Bool(b) => if *b { "on" } else { "off" }.into(),
         Value::String(s) => s.clone(),
+        Value::Number(n) => match n.as_f64() {
+            // Exact in an f64 up to 2^53: beyond, serde's own text keeps every digit.
+            Some(x) if n.is_f64() && x.fract() == 0.0 && x.abs() < 9e15 => format!("{x:.0}"),
+            _ => n.to_string(),
+        },
+        Value::Array(items) => items.iter().map(in_words).collect::<Vec<_>>().join(", "),
         Value::Object(m) => m
             .iter()
             .map(|(k, v)| format!("{k} {}", in_words(v)))
             .collect::<Vec<_>>()
             .join(", "),
-        other => other.to_string(),
     }
 }
 

@@ -696,3 +696,223 @@ fn a_fifo_as_the_report_is_a_stream() {
     let kind = std::fs::symlink_metadata(&fifo).unwrap().file_type();
     assert!(std::os::unix::fs::FileTypeExt::is_fifo(&kind));
 }
+
+/// Checks a refusal of the command line or the input: exit 2, every `expected` part in the message,
+/// and none of the text of a parser that does not say what is wanted.
+fn assert_usage(out: &Output, expected: &[&str]) {
+    let err = stderr(out);
+    assert_eq!(code(out), Some(2), "{err}");
+    for e in expected {
+        assert!(err.contains(e), "`{e}` not in: {err}");
+    }
+    assert!(
+        !err.contains("invalid digit") && !err.contains("Some("),
+        "{err}"
+    );
+}
+
+/// Numeric flags say what they accept (issue 28: `--groups 1e9` said "invalid digit found in
+/// string"): the flag, and its range.
+#[test]
+fn numeric_flags_name_their_range() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let cases: [(&[&str], &[&str]); 7] = [
+        (
+            &["analyze", "@cube:3", "--groups", "1e9"],
+            &["--groups", "number of groups", "from 2 to 1024"],
+        ),
+        (
+            &["analyze", "@cube:3", "--threads", "1e5"],
+            &["--threads", "from 0 to 4096"],
+        ),
+        (
+            &["analyze", "@cube:3", "--bundle", "x"],
+            &["--bundle", "from 0 to 64"],
+        ),
+        (
+            &["convergence", "@cube:2", "--repeats", "0"],
+            &["--repeats", "from 1 to 1000"],
+        ),
+        (&["reproduce", "--table", "10"], &["--table", "from 1 to 9"]),
+        (
+            &["crosscheck", "@cube:2", "--show", "-1"],
+            &["--show", "cannot be negative", "from 0"],
+        ),
+        (
+            &["calibrate", "--scene", "@cube", "--seeds", "0"],
+            &["--seeds", "runs per cell", "from 1"],
+        ),
+    ];
+    for (args, expected) in cases {
+        assert_usage(&scx_in(d, args), expected);
+    }
+}
+
+/// `refine --patches 0` speaks of patches, not of "a line count".
+#[test]
+fn refine_patches_says_what_it_needs() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = scx_in(
+        dir.path(),
+        &[
+            "refine",
+            "@cube:2",
+            "--strategy",
+            "uniform",
+            "--patches",
+            "0",
+            "-o",
+            "r.obj",
+        ],
+    );
+    assert_usage(&out, &["--patches", "number of patches", "from 1"]);
+    assert!(!stderr(&out).contains("line count"), "{}", stderr(&out));
+    assert!(!dir.path().join("r.obj").exists());
+}
+
+/// Durations take units (`30s`, `5m`, `1h30m`) as well as plain seconds; garbage says what a duration
+/// is; a duration with units beyond the clock is no limit, as plain seconds are.
+#[test]
+fn durations_take_units() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    for extra in [
+        &["--seconds", "5m"][..],
+        &["--seconds", "1h30m"],
+        &["--seconds", "99999999999999999999h"],
+        &["--checkpoint-every", "30s", "--checkpoint", "c.scx"],
+    ] {
+        let mut args = vec!["analyze", "@cube:2", "--lines", "2e4", "--format", "json"];
+        args.extend_from_slice(extra);
+        let out = scx_in(d, &args);
+        assert_eq!(code(&out), Some(0), "{extra:?}: {}", stderr(&out));
+        let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        assert_eq!(report["lines"], 20_000, "{extra:?}");
+    }
+    for bad in ["abc", "0s", "-5", "5 parsecs"] {
+        let out = scx_in(d, &["analyze", "@cube:2", "--seconds", bad]);
+        assert_usage(&out, &["--seconds", "30s", "1h30m"]);
+    }
+}
+
+/// A flag whose list is optional, put before the scene, takes the scene as its list: the error says
+/// so and how to write it.
+#[test]
+fn a_list_flag_that_took_the_scene_says_so() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::write(d.join("scene.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
+    for flag in ["--two-sided", "--flip-normals"] {
+        let out = scx_in(d, &["analyze", flag, "scene.obj"]);
+        assert_usage(
+            &out,
+            &[
+                &format!("{flag} took `scene.obj` as its list"),
+                "put the scene first",
+                "--",
+            ],
+        );
+    }
+    let out = scx_in(d, &["crosscheck", "--aimed", "@cube:2"]);
+    assert_usage(&out, &["--aimed took `@cube:2` as its list"]);
+    // The hint is for that case only: a missing scene with no list flag is clap's message alone.
+    let out = scx_in(d, &["analyze", "--lines", "1e3"]);
+    assert_eq!(code(&out), Some(2));
+    assert!(!stderr(&out).contains("hint"), "{}", stderr(&out));
+}
+
+/// Makes the states of shard `k` of 2 of a run of `@cube:2` (with `more` settings) in `dir`.
+fn shard_state(dir: &Path, k: u32, file: &str, more: &[&str]) {
+    let shard = format!("{k}/2");
+    let mut args = vec![
+        "analyze", "@cube:2", "--lines", "1e4", "--shard", &shard, "--save", file, "-q",
+    ];
+    args.extend_from_slice(more);
+    let out = scx_in(dir, &args);
+    assert_eq!(code(&out), Some(0), "{}", stderr(&out));
+}
+
+/// `scx merge` refuses a state given twice, under one name or two (`./s2.scx`), naming it, before
+/// reading any (issue 28: it said "s2.scx cannot join s1.scx").
+#[test]
+fn a_state_given_twice_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    shard_state(d, 1, "s1.scx", &[]);
+    shard_state(d, 2, "s2.scx", &[]);
+    let out = scx_in(d, &["merge", "s1.scx", "s2.scx", "s2.scx"]);
+    assert_usage(&out, &["s2.scx is given twice", "name each state once"]);
+    assert!(!stderr(&out).contains("cannot join"));
+    let out = scx_in(d, &["merge", "s1.scx", "s2.scx", "./s2.scx"]);
+    assert_usage(&out, &["given twice", "s2.scx and ./s2.scx"]);
+    assert_eq!(code(&scx_in(d, &["merge", "s1.scx", "s2.scx"])), Some(0));
+}
+
+/// States of different runs are refused with both values in words: no Rust debug text, switches as
+/// on/off, shards counted, scenes named.
+#[test]
+fn merge_differences_read_as_words() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    shard_state(d, 1, "s1.scx", &[]);
+    shard_state(d, 2, "enclosed.scx", &["--enclose"]);
+    let out = scx_in(
+        d,
+        &[
+            "analyze",
+            "@cube:2",
+            "--lines",
+            "1e4",
+            "--save",
+            "whole.scx",
+            "-q",
+        ],
+    );
+    assert_eq!(code(&out), Some(0), "{}", stderr(&out));
+    let out = scx_in(d, &["merge", "s1.scx", "whole.scx"]);
+    assert_usage(
+        &out,
+        &["shard count differs (not sharded against 2 shards)"],
+    );
+    let out = scx_in(d, &["merge", "s1.scx", "enclosed.scx"]);
+    assert_usage(&out, &["enclose differs (on against off)"]);
+    assert!(!stderr(&out).contains("true"), "{}", stderr(&out));
+}
+
+/// Merging a state that a live run still holds (its `FILE.lock` names a running process) warns that
+/// the merge may miss that run's latest batches, and merges.
+#[cfg(target_os = "linux")]
+#[test]
+fn merging_a_live_state_warns() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    shard_state(d, 1, "s1.scx", &[]);
+    shard_state(d, 2, "s2.scx", &[]);
+    let live = std::process::id();
+    std::fs::write(d.join("s2.scx.lock"), format!("{} {live}\n", host())).unwrap();
+    let out = scx_in(d, &["merge", "s1.scx", "s2.scx"]);
+    let err = stderr(&out);
+    assert_eq!(code(&out), Some(0), "{err}");
+    assert!(
+        err.contains("warning: s2.scx is still being written by process")
+            && err.contains(&live.to_string())
+            && err.contains(&host())
+            && err.contains("may miss its latest batches"),
+        "{err}"
+    );
+    assert!(!err.contains("s1.scx is still"), "{err}");
+    // A lock whose process is gone is no warning.
+    std::fs::write(
+        d.join("s2.scx.lock"),
+        format!("{} {}\n", host(), dead_pid()),
+    )
+    .unwrap();
+    let out = scx_in(d, &["merge", "s1.scx", "s2.scx"]);
+    assert_eq!(code(&out), Some(0));
+    assert!(
+        !stderr(&out).contains("still being written"),
+        "{}",
+        stderr(&out)
+    );
+}

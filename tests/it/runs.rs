@@ -256,7 +256,9 @@ fn bad_states_are_refused_by_name() {
     std::fs::write(&flipped, &f).unwrap();
     let other_scene = part("@cube:5", "1", "2/2", "other_scene.scx");
     let other_seed = part("@cube:4", "2", "2/2", "other_seed.scx");
-    let cases: [(&[&str], &[&str]); 6] = [
+    let copy = path("copy.scx");
+    std::fs::copy(&a, &copy).unwrap();
+    let cases: [(&[&str], &[&str]); 7] = [
         (&[&truncated, &b], &["truncated.scx", "truncated"]),
         (&[&a, &flipped], &["flipped.scx", "checksum"]),
         (
@@ -264,7 +266,8 @@ fn bad_states_are_refused_by_name() {
             &["other_scene.scx", "a.scx", "fingerprint"],
         ),
         (&[&a, &other_seed], &["other_seed.scx", "a.scx", "seed"]),
-        (&[&a, &a], &["a.scx", "overlap"]),
+        (&[&a, &a], &["a.scx", "given twice"]),
+        (&[&a, &copy], &["copy.scx", "a.scx", "overlap"]),
         (&[&a], &["missing", "..100000"]),
     ];
     for (files, expected) in cases {
