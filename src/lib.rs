@@ -26,7 +26,8 @@
 //! The API at a glance:
 //!
 //! * scenes: [`load`] a file or a built-in ([`CATALOGUE`]), or build one with [`SceneBuilder`]; write it
-//!   with [`write_obj`] or [`write_gltf`];
+//!   with [`write_scene`] (OBJ, PLY, STL, glTF by the extension, [`WriteFormat`]), [`write_obj`] or
+//!   [`write_gltf`];
 //! * a run: [`RunSpec`] says what it is (every setting that determines its numbers), [`analyze`] casts
 //!   it with a [`Tracer`] from [`make_tracer`] and returns an [`Analysis`], whose readings are indexed by
 //!   [`Measure`] (the catalogue of measures, [`MEASURES`]), each an [`Estimate`] with its standard error
@@ -71,6 +72,9 @@ pub mod reproduce;
 
 // Scenes: loading (files and built-ins), building from arrays, writing.
 pub use geom::{Direction, Normal, Point, Vector};
+pub use scene::export::{
+    files as scene_files, write as write_scene, UnknownExtension, WriteFormat, WRITE_EXTENSIONS,
+};
 pub use scene::format::load_stream;
 pub use scene::{
     gltf::to_bytes as gltf_bytes, gltf::write as write_gltf, obj::load_text_with as load_obj_text,

@@ -26,8 +26,8 @@ use super::runner::Runner;
 /// Arguments of `scx analyze`.
 #[derive(clap::Args, Debug)]
 pub struct AnalyzeArgs {
-    /// A scene file (OBJ, glTF, PLY, STL), a built-in scene such as `@cube:10` (see `scx scenes`), or `-` to read an OBJ
-    /// from standard input. With --resume, the saved run's scene (given again, it must be the same).
+    /// The scene: a file in OBJ, glTF/GLB, PLY or STL (told by its content), a built-in such as
+    /// `@cube:10` (`scx scenes` lists them), or `-` for a scene in any of those formats on standard input. With --resume, the saved run's scene (given again, it must be the same).
     #[arg(required_unless_present = "resume")]
     scene: Option<String>,
     /// Number of global lines (accepts `1e7`; default 1e6, or no limit with a budget).

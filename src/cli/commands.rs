@@ -48,8 +48,12 @@ pub enum Command {
     /// List the built-in scenes and their parameters.
     #[command(after_help = "Example:\n  scx scenes")]
     Scenes(ScenesArgs),
-    /// Write a scene (built-in or file) as OBJ + MTL.
-    #[command(after_help = "Example:\n  scx export @cornell -o cornell.obj")]
+    /// Write a scene (built-in or file) as OBJ + MTL, PLY, STL or glTF/GLB, chosen by the extension of -o.
+    #[command(after_help = concat!(
+        "Examples:\n",
+        "  scx export @cornell -o cornell.obj    (OBJ, and cornell.mtl beside it)\n",
+        "  scx export scan.ply -o scan.glb"
+    ))]
     Export(export::ExportArgs),
     /// Run a scene at growing line counts: every measure with its error against run time.
     #[command(after_help = concat!(
@@ -57,7 +61,8 @@ pub enum Command {
         "  scx convergence @cube:30 --lines 1e5,1e6,1e7 --repeats 3 --plot conv.png --csv conv.csv"
     ))]
     Convergence(convergence::ConvergenceArgs),
-    /// Refine a scene's patches with a meshing strategy (paper Table 9) and write the mesh as OBJ + MTL.
+    /// Refine a scene's patches with a meshing strategy (paper Table 9) and write the mesh (OBJ + MTL,
+    /// PLY, STL or glTF/GLB, by the extension of -o).
     #[command(after_help = concat!(
         "Example:\n",
         "  scx refine @cornell --strategy information --patches 460 -o cornell_460.obj"

@@ -21,7 +21,8 @@ use super::table::{fixed, Align, Table};
 /// Arguments of `scx convergence`.
 #[derive(clap::Args, Debug)]
 pub struct ConvergenceArgs {
-    /// A scene file (OBJ, glTF, PLY, STL), a built-in scene such as `@cube:30`, or `-` for an OBJ on standard input.
+    /// The scene: a file in OBJ, glTF/GLB, PLY or STL (told by its content), a built-in such as
+    /// `@cube:30` (`scx scenes` lists them), or `-` for a scene on standard input.
     scene: String,
     /// The line counts to run, comma separated (accepts `1e6`).
     #[arg(long, value_delimiter = ',', value_parser = parse_count, default_value = "1e4,1e5,1e6,1e7",

@@ -20,8 +20,8 @@ const DEFAULT_AIMED_LINES: u64 = 100_000;
 /// Arguments of `scx crosscheck`.
 #[derive(clap::Args, Debug)]
 pub struct CrosscheckArgs {
-    /// A scene file (OBJ, glTF, PLY, STL), a built-in scene such as `@cube:10` (see `scx scenes`), or `-` for an OBJ on
-    /// standard input.
+    /// The scene: a file in OBJ, glTF/GLB, PLY or STL (told by its content), a built-in such as
+    /// `@cube:10` (`scx scenes` lists them), or `-` for a scene on standard input.
     scene: String,
     #[command(flatten)]
     input: SceneArgs,

@@ -1,8 +1,9 @@
-//! `scx export`: a scene (built-in or file) written as OBJ + MTL, or as glTF 2.0.
+//! `scx export`: a scene (built-in or file) written as OBJ + MTL, PLY, STL or glTF, by the extension of
+//! `-o` (the library's [`WriteFormat`] picks; this module checks the paths and writes the files).
 
 use std::path::{Path, PathBuf};
 
-use scene_complexity::{gltf_bytes, obj_text, Scene};
+use scene_complexity::{scene_files, Scene, WriteFormat};
 
 use super::args::SceneArgs;
 use super::exit::{Exit, Failure};
@@ -12,52 +13,62 @@ use super::output::{self, check_all};
 /// Arguments of `scx export`.
 #[derive(clap::Args, Debug)]
 pub struct ExportArgs {
-    /// A scene file (OBJ, glTF, PLY, STL), a built-in scene such as `@cube:10`, or `-` for an OBJ on standard input.
+    /// The scene: a file in OBJ, glTF/GLB, PLY or STL (told by its content), a built-in such as
+    /// `@cube:10` (`scx scenes` lists them), or `-` for a scene on standard input.
     scene: String,
     #[command(flatten)]
     input: SceneArgs,
-    /// The file to write: `.gltf` or `.glb` writes glTF 2.0, anything else OBJ with its MTL library
-    /// beside it (checked writable first).
+    /// The file to write, its format chosen by the extension: `.obj` (OBJ, its MTL library written
+    /// beside it), `.ply` (binary PLY), `.stl` (binary STL), `.gltf` or `.glb` (glTF 2.0); any other
+    /// extension is refused. Checked writable first.
     #[arg(short, long)]
     output: PathBuf,
 }
 
 /// Runs `scx export`.
 pub fn run(args: &ExportArgs) -> Result<Exit, Failure> {
-    let gltf = is_gltf(&args.output);
-    let mtl = args.output.with_extension("mtl");
-    if gltf {
-        check_outputs(&args.output, None, &args.scene)?;
-    } else {
-        check_outputs(&args.output, Some(&mtl), &args.scene)?;
-    }
+    let format = planned_output(&args.output, &args.scene)?;
     let scene = load_scene(&args.scene, &args.input.options(), &args.input.policy())?;
-    if gltf {
-        let binary = args
-            .output
-            .extension()
-            .is_some_and(|e| e.eq_ignore_ascii_case("glb"));
-        output::write_silently(&args.output, &gltf_bytes(&scene, binary))?;
-    } else {
-        write_obj_files(&scene, &args.output, &mtl)?;
-    }
-    let beside = if gltf {
-        String::new()
-    } else {
-        format!(" and {}", mtl.display())
-    };
+    let beside = write_scene(&scene, format, &args.output)?;
     output::note(&format!(
-        "wrote {} ({} patches){beside}",
+        "wrote {} as {}, {} patches{beside}",
         args.output.display(),
+        format.name(),
         scene.patch_count(),
     ));
     Ok(Exit::Ok)
 }
 
-/// Whether `path` asks for glTF (`.gltf` text or `.glb` binary) rather than OBJ.
-fn is_gltf(path: &std::path::Path) -> bool {
-    path.extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("gltf") || e.eq_ignore_ascii_case("glb"))
+/// The format `-o` asks for by its extension, refused (exit 2, naming the extensions scx writes)
+/// when it names none; the files it will write are checked as [`check_outputs`] does. Before any work.
+pub fn planned_output(output: &Path, scene: &str) -> Result<WriteFormat, Failure> {
+    let format = match WriteFormat::of_path(output) {
+        Ok(format) => format,
+        Err(e) => {
+            // A folder is the first thing to say of a path without an extension.
+            if output.is_dir() {
+                check_all([output])?;
+            }
+            return Err(Failure::bad_input(format!("-o {}: {e}", output.display())));
+        }
+    };
+    check_outputs(output, format.companion(output).as_deref(), scene)?;
+    Ok(format)
+}
+
+/// Writes a scene in `format` at `output` (each file whole or not at all), warning first of what the
+/// format cannot keep; returns ` and FILE` naming a file written beside it, or nothing.
+pub fn write_scene(scene: &Scene, format: WriteFormat, output: &Path) -> Result<String, Failure> {
+    for loss in format.losses(scene) {
+        output::warn(&format!("{}: {loss}", output.display()));
+    }
+    for (path, bytes) in scene_files(scene, format, output) {
+        output::write_silently(&path, &bytes)?;
+    }
+    Ok(format
+        .companion(output)
+        .map(|c| format!(" and {}", c.display()))
+        .unwrap_or_default())
 }
 
 /// Checks, before any work, the files a scene is written to: the OBJ (or glTF) `output` and the MTL
@@ -77,15 +88,4 @@ pub fn check_outputs(output: &Path, mtl: Option<&Path>, scene: &str) -> Result<(
     outputs.extend(mtl.map(|m| ("its MTL library", m)));
     output::check_distinct(&outputs, &[("scene", Path::new(scene))], &[])?;
     check_all(outputs.iter().map(|(_, p)| *p))
-}
-
-/// Writes a scene as OBJ to `path` and its MTL library to `mtl`, each whole or not at all.
-pub fn write_obj_files(scene: &Scene, path: &Path, mtl: &Path) -> Result<(), Failure> {
-    let mtl_name = mtl
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_else(|| "scene.mtl".into());
-    let (obj, library) = obj_text(scene, &mtl_name);
-    output::write_silently(mtl, library.as_bytes())?;
-    output::write_silently(path, obj.as_bytes())
 }

@@ -25,8 +25,8 @@ pub struct MergeArgs {
     /// missing batch is an error naming the missing lines.
     #[arg(long)]
     partial: bool,
-    /// The scene, when it is not where the states say (it must be the same scene: its fingerprint is
-    /// checked).
+    /// The scene, when it is not where the states say: a file in OBJ, glTF/GLB, PLY or STL, or a
+    /// built-in such as `@cube:10` (it must be the same scene: its fingerprint is checked).
     #[arg(long)]
     scene: Option<String>,
     /// Also save the merged state to FILE (to continue it with `scx analyze --resume`).

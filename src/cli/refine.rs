@@ -21,7 +21,8 @@ use super::runner::{thread_pool, watch_ctrl_c};
 /// Arguments of `scx refine`.
 #[derive(clap::Args, Debug)]
 pub struct RefineArgs {
-    /// A scene file (OBJ, glTF, PLY, STL), a built-in scene such as `@cornell`, or `-` for an OBJ on standard input.
+    /// The scene: a file in OBJ, glTF/GLB, PLY or STL (told by its content), a built-in such as
+    /// `@cornell` (`scx scenes` lists them), or `-` for a scene on standard input.
     scene: String,
     #[command(flatten)]
     input: SceneArgs,
@@ -32,7 +33,9 @@ pub struct RefineArgs {
     /// Stop at about this many patches (at most 2 over).
     #[arg(long, value_parser = parse_patches, allow_negative_numbers = true)]
     patches: u64,
-    /// The OBJ file to write; the MTL library goes beside it (both checked writable first).
+    /// The file to write the refined mesh to, its format chosen by the extension: `.obj` (OBJ, its MTL
+    /// library written beside it), `.ply` (binary PLY), `.stl` (binary STL), `.gltf` or `.glb` (glTF
+    /// 2.0); any other extension is refused. Checked writable first. OBJ and PLY keep the patches.
     #[arg(short, long)]
     output: PathBuf,
     /// Global lines per refinement round (accepts `1e6`).
@@ -64,8 +67,7 @@ fn parse_patches(s: &str) -> Result<u64, String> {
 
 /// Runs `scx refine`.
 pub fn run(args: &RefineArgs) -> Result<Exit, Failure> {
-    let mtl = args.output.with_extension("mtl");
-    super::export::check_outputs(&args.output, Some(&mtl), &args.scene)?;
+    let format = super::export::planned_output(&args.output, &args.scene)?;
     let scene = load_scene(&args.scene, &args.input.options(), &args.input.policy())?;
     let backend = TracerArg::backend(args.tracer.value);
     // Check the backend once up front, so that an unavailable one is a clear input error.
@@ -109,13 +111,13 @@ pub fn run(args: &RefineArgs) -> Result<Exit, Failure> {
             )
         })
         .map_err(Failure::of)?;
-    super::export::write_obj_files(&refined.scene, &args.output, &mtl)?;
+    let beside = super::export::write_scene(&refined.scene, format, &args.output)?;
     let lines: u64 = refined.rounds.iter().map(|r| r.lines).sum();
     output::note(&format!(
-        "wrote {} ({} patches) and {}: {} rounds, {lines} lines, {:.2} s",
+        "wrote {} as {}, {} patches{beside}: {} rounds, {lines} lines, {:.2} s",
         args.output.display(),
+        format.name(),
         refined.scene.patch_count(),
-        mtl.display(),
         refined.rounds.len(),
         started.elapsed().as_secs_f64()
     ));

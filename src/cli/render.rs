@@ -22,7 +22,8 @@ use super::runner::Runner;
 /// Arguments of `scx render`.
 #[derive(clap::Args, Debug)]
 pub struct RenderArgs {
-    /// A scene file (OBJ), a built-in scene such as `@cornell`, or `-` for an OBJ on standard input.
+    /// The scene: a file in OBJ, glTF/GLB, PLY or STL (told by its content), a built-in such as
+    /// `@cornell` (`scx scenes` lists them), or `-` for a scene on standard input.
     scene: String,
     /// What colours the patches: a per-patch result of the run.
     #[arg(long, value_parser = quantity_parser())]

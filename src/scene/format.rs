@@ -271,8 +271,8 @@ pub(crate) enum FormatProblem {
     /// A file named `.stl` whose size is not the one its binary STL header gives.
     #[error(
         "a binary STL of the wrong size: its header says {count} triangles ({expected} bytes), the \
-         file has {size} bytes ({})",
-        stl_size_why(*.size, *.expected)
+         file has {size} bytes: {}",
+        stl_size_why(*.size, *.expected, *.count)
     )]
     StlSize {
         /// The triangle count in the header.
@@ -323,12 +323,20 @@ pub(crate) enum FormatProblem {
     },
 }
 
-/// Why a binary STL's size may be wrong, from the size it has and the one its header gives.
-fn stl_size_why(size: u64, expected: u64) -> &'static str {
+/// Why a binary STL's size may be wrong, from the size it has, the one its header gives and the
+/// header's triangle count.
+fn stl_size_why(size: u64, expected: u64, count: u64) -> String {
     if size < expected {
-        "cut short?"
+        format!(
+            "it holds {} bytes fewer than its header's {count} triangles need (cut short?)",
+            expected - size
+        )
     } else {
-        "more bytes than its triangles need: a wrong count, or data after the triangles"
+        format!(
+            "it holds {} bytes more than its header's {count} triangles need (a wrong count, or data \
+             after the triangles)",
+            size - expected
+        )
     }
 }
 

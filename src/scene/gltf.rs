@@ -61,11 +61,13 @@ fn load_document(
     check_glb_header(bytes).map_err(|p| file_error(p.to_string()))?;
     let unreadable = |e: ::gltf::Error| file_error(format!("not a readable glTF 2.0 file: {e}"));
     let raw = ::gltf::Gltf::from_slice_without_validation(bytes).map_err(unreadable)?;
+    let mut json = raw.document.into_json();
+    drop_unknown_attributes(&mut json);
     // gltf-json's validation indexes the accessors with each POSITION attribute unchecked: check
     // those indices first, then validate as `Gltf::from_slice` does.
-    check_position_accessors(raw.document.as_json()).map_err(|p| file_error(p.to_string()))?;
+    check_position_accessors(&json).map_err(|p| file_error(p.to_string()))?;
     let gltf = ::gltf::Gltf {
-        document: ::gltf::Document::from_json(raw.document.into_json()).map_err(unreadable)?,
+        document: ::gltf::Document::from_json(json).map_err(unreadable)?,
         blob: raw.blob,
     };
     let root = gltf.document.as_json();
@@ -231,6 +233,20 @@ enum DocumentProblem {
     /// A `minVersion` other than 2.0: that version.
     #[error("the file needs a reader of glTF {0} (its minVersion): scx reads glTF 2.0")]
     MinVersion(String),
+}
+
+/// Removes the vertex attributes whose names gltf-json does not know: application-specific ones (`_s`,
+/// `_TEMPERATURE`: the specification allows any name that starts with `_`) and any other. scx reads
+/// POSITION alone, and gltf-json's validation refuses such names as `<invalid semantic name>`, which
+/// would turn a valid file away.
+fn drop_unknown_attributes(root: &mut ::gltf::json::Root) {
+    for mesh in &mut root.meshes {
+        for primitive in &mut mesh.primitives {
+            primitive.attributes.retain(|semantic, _| {
+                matches!(semantic, ::gltf::json::validation::Checked::Valid(_))
+            });
+        }
+    }
 }
 
 /// Every POSITION attribute names an accessor that exists.

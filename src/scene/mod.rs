@@ -6,14 +6,15 @@
 //! original f64 coordinates.
 
 mod build;
+pub mod export;
 pub mod format;
 pub mod gltf;
 mod gltf_data;
 pub mod obj;
 mod obj_check;
-mod ply;
+pub mod ply;
 pub mod read;
-mod stl;
+pub mod stl;
 mod warning;
 
 pub use build::{ObjectSet, Planarity, SceneBuilder, SceneOptions, Sides, DEFAULT_PLANARITY};

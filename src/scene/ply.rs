@@ -1,17 +1,35 @@
-//! PLY scenes (ASCII, binary little- and big-endian), read with `ply-rs-bw`.
+//! PLY scenes (ASCII, binary little- and big-endian), read with `ply-rs-bw`, and written.
 //!
-//! The `vertex` element gives `x`, `y`, `z`; the `face` element a list `vertex_indices` (or
-//! `vertex_index`), each face one polygon (planar: one patch; see [`super::SceneBuilder`]). A face colour
+//! Reading: the `vertex` element gives `x`, `y`, `z`. Faces come from every other element with a list
+//! `vertex_indices` (or `vertex_index`): each item of `face` (or of another such element) is one polygon
+//! (planar: one patch; see [`super::SceneBuilder`]); each item of `tristrips` (Stanford's form, as in
+//! igea.ply) is a triangle strip, `-1` starting a new strip, each triangle a patch. A face colour
 //! (`red`, `green`, `blue`: 0-255 as integers, 0-1 as floats) is its reflectance, one material per
 //! distinct colour; faces without one get scx's default material. The file is one object, named after
 //! the file.
+//!
+//! Writing ([`to_bytes`]): binary little-endian, f64 vertices in the scene's units, one face per patch
+//! with its material's reflectance as f64 `red`, `green`, `blue`, so that reading it back gives the same
+//! patches and reflectances.
 
 use std::path::Path;
 
 use ply_rs_bw::parser::Parser;
-use ply_rs_bw::ply::{DefaultElement, Property};
+use ply_rs_bw::ply::{DefaultElement, ElementDef, Property, PropertyType};
 
 use super::{Material, Scene, SceneBuilder, SceneError, SceneOptions};
+
+/// The names of the list property that holds a face's vertices.
+const INDEX_LISTS: [&str; 2] = ["vertex_indices", "vertex_index"];
+
+/// How an element's index lists make triangles.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Kind {
+    /// Each list is one polygon.
+    Faces,
+    /// Each list is triangle strips, `-1` restarting.
+    Strips,
+}
 
 /// Loads PLY bytes read from `path`.
 pub(crate) fn load_bytes(
@@ -26,12 +44,18 @@ pub(crate) fn load_bytes(
         .read_ply(&mut cursor)
         .map_err(|e| file_error(format!("not a readable PLY file: {e}")))?;
     let vertices = ply.payload.get("vertex").map(Vec::as_slice).unwrap_or(&[]);
-    let faces = ply.payload.get("face").map(Vec::as_slice).unwrap_or(&[]);
-    if faces.is_empty() {
-        return Err(file_error(format!(
-            "the scene is empty: no faces (a `face` element with `vertex_indices`); {} vertices",
-            vertices.len()
-        )));
+    let sources: Vec<(&str, Kind, &[DefaultElement])> = ply
+        .header
+        .elements
+        .values()
+        .filter_map(|def| {
+            let kind = element_kind(def)?;
+            let items = ply.payload.get(&def.name)?;
+            Some((def.name.as_str(), kind, items.as_slice()))
+        })
+        .collect();
+    if sources.iter().all(|(_, _, items)| items.is_empty()) {
+        return Err(file_error(empty_message(&ply.header, vertices.len())));
     }
 
     let mut b = SceneBuilder::new(shown);
@@ -47,52 +71,139 @@ pub(crate) fn load_bytes(
         };
         ids.push(b.vertex([coordinate("x")?, coordinate("y")?, coordinate("z")?]));
     }
-    let mut colours: Vec<([u64; 3], u32)> = Vec::new();
-    let mut default_material = None;
-    for (k, f) in faces.iter().enumerate() {
-        let indices = f
-            .get("vertex_indices")
-            .or_else(|| f.get("vertex_index"))
-            .and_then(index_list)
-            .ok_or_else(|| file_error(format!("face {k}: no list `vertex_indices`")))?;
-        let corners = indices
-            .iter()
-            .map(|&i| {
-                usize::try_from(i)
-                    .ok()
-                    .and_then(|i| ids.get(i).copied())
-                    .ok_or_else(|| {
-                        file_error(format!(
-                            "face {k} refers to vertex {i}, but the file has {} vertices (0-based)",
-                            ids.len()
-                        ))
-                    })
-            })
-            .collect::<Result<Vec<u32>, _>>()?;
-        if corners.len() < 3 {
-            return Err(file_error(format!(
-                "face {k}: a face needs at least 3 vertices, it has {}",
-                corners.len()
-            )));
-        }
-        let material = match face_colour(f) {
-            Some(rgb) => {
-                let key = rgb.map(f64::to_bits);
-                match colours.iter().find(|(c, _)| *c == key) {
-                    Some(&(_, m)) => m,
-                    None => {
-                        let name = format!("colour_{}_{}_{}", rgb[0], rgb[1], rgb[2]);
-                        let m = b.material(Material::rgb(name, rgb, [0.0; 3]));
-                        colours.push((key, m));
-                        m
+    let mut materials = Materials::default();
+    for (element, kind, items) in sources {
+        for (k, item) in items.iter().enumerate() {
+            let at = |message: String| file_error(format!("{element} {k}: {message}"));
+            let indices = INDEX_LISTS
+                .iter()
+                .find_map(|name| item.get(*name))
+                .and_then(index_list)
+                .ok_or_else(|| at("no list `vertex_indices`".into()))?;
+            let material = materials.of(&mut b, item);
+            match kind {
+                Kind::Faces => {
+                    let corners = corners(&indices, &ids).map_err(at)?;
+                    if corners.len() < 3 {
+                        return Err(at(format!(
+                            "a face needs at least 3 vertices, it has {}",
+                            corners.len()
+                        )));
+                    }
+                    b.polygon(&corners, material, format!("{element} {k}"));
+                }
+                Kind::Strips => {
+                    for (t, triangle) in strip_triangles(&indices).into_iter().enumerate() {
+                        let corners = corners(&triangle, &ids).map_err(at)?;
+                        b.polygon(&corners, material, format!("{element} {k} triangle {t}"));
                     }
                 }
             }
-            None => *default_material.get_or_insert_with(|| b.material(Material::default())),
-        };
-        b.polygon(&corners, material, format!("face {k}"));
+        }
     }
     b.build_with(options)
+}
+
+/// Whether an element holds faces, strips, or neither: `vertex` never does; `tristrips` (or
+/// `tristrip`) with an index list is strips; any other element with one is faces.
+fn element_kind(def: &ElementDef) -> Option<Kind> {
+    if def.name == "vertex" {
+        return None;
+    }
+    let has_list = INDEX_LISTS.iter().any(|name| {
+        def.properties
+            .get(*name)
+            .is_some_and(|p| matches!(p.data_type, PropertyType::List(..)))
+    });
+    if !has_list {
+        return None;
+    }
+    Some(if def.name.starts_with("tristrip") {
+        Kind::Strips
+    } else {
+        Kind::Faces
+    })
+}
+
+/// Why a PLY without faces is empty, naming the elements it does have.
+fn empty_message(header: &ply_rs_bw::ply::Header, vertices: usize) -> String {
+    let elements: Vec<String> = header
+        .elements
+        .values()
+        .map(|e| format!("`{}` ({})", e.name, e.count))
+        .collect();
+    format!(
+        "the scene is empty: no faces (an element such as `face` with a list `vertex_indices`, or \
+         `tristrips`); {vertices} vertices; its elements: {}",
+        if elements.is_empty() {
+            "none".to_string()
+        } else {
+            elements.join(", ")
+        }
+    )
+}
+
+/// The triangles of a Stanford `tristrips` list: `-1` ends a strip; each triangle keeps the strip's
+/// orientation (every second one is reversed, as strips alternate their winding); triangles with a
+/// repeated corner are dropped, as strips use them to join.
+fn strip_triangles(list: &[i64]) -> Vec<[i64; 3]> {
+    let mut triangles = Vec::new();
+    for strip in list.split(|&i| i == -1) {
+        for (k, w) in strip.windows(3).enumerate() {
+            let t = if k % 2 == 0 {
+                [w[0], w[1], w[2]]
+            } else {
+                [w[1], w[0], w[2]]
+            };
+            if t[0] != t[1] && t[1] != t[2] && t[0] != t[2] {
+                triangles.push(t);
+            }
+        }
+    }
+    triangles
+}
+
+/// A polygon's corners as the builder's vertex ids, each index checked against the vertex count.
+fn corners(indices: &[i64], ids: &[u32]) -> Result<Vec<u32>, String> {
+    indices
+        .iter()
+        .map(|&i| {
+            usize::try_from(i)
+                .ok()
+                .and_then(|i| ids.get(i).copied())
+                .ok_or_else(|| {
+                    format!(
+                        "refers to vertex {i}, but the file has {} vertices (0-based)",
+                        ids.len()
+                    )
+                })
+        })
+        .collect()
+}
+
+/// The materials of faces: one per distinct colour, and scx's default for faces without one.
+#[derive(Default)]
+struct Materials {
+    colours: std::collections::HashMap<[u64; 3], u32>,
+    default: Option<u32>,
+}
+
+impl Materials {
+    /// The material of a face (or strip), added to the builder the first time it is met.
+    fn of(&mut self, b: &mut SceneBuilder, item: &DefaultElement) -> u32 {
+        let Some(rgb) = face_colour(item) else {
+            return *self
+                .default
+                .get_or_insert_with(|| b.material(Material::default()));
+        };
+        *self
+            .colours
+            .entry(rgb.map(f64::to_bits))
+            .or_insert_with(|| {
+                let name = format!("colour_{}_{}_{}", rgb[0], rgb[1], rgb[2]);
+                b.material(Material::rgb(name, rgb, [0.0; 3]))
+            })
+    }
 }
 
 /// A scalar property as f64.
@@ -134,4 +245,48 @@ fn face_colour(f: &DefaultElement) -> Option<[f64; 3]> {
         })
     };
     Some([channel("red")?, channel("green")?, channel("blue")?])
+}
+
+/// A scene as binary little-endian PLY (see the module's documentation): every vertex as f64 `x`, `y`,
+/// `z` in the scene's units, every patch as a face (its polygon) with its reflectance as f64 `red`,
+/// `green`, `blue`. Written here rather than with ply-rs-bw's writer, which wants a map of properties
+/// per vertex and face: a large scene would need several times its own size.
+pub fn to_bytes(scene: &Scene) -> Vec<u8> {
+    let wide = scene
+        .patches
+        .iter()
+        .any(|p| p.polygon.len() > usize::from(u8::MAX));
+    let count_type = if wide { "uint" } else { "uchar" };
+    let mut out = format!(
+        "ply\nformat binary_little_endian 1.0\ncomment written by scx {}: {} patches\n\
+         element vertex {}\nproperty double x\nproperty double y\nproperty double z\n\
+         element face {}\nproperty list {count_type} uint vertex_indices\nproperty double red\n\
+         property double green\nproperty double blue\nend_header\n",
+        env!("CARGO_PKG_VERSION"),
+        scene.patch_count(),
+        scene.vertices.len(),
+        scene.patch_count()
+    )
+    .into_bytes();
+    for v in &scene.vertices {
+        for c in v.to_array() {
+            out.extend_from_slice(&c.to_le_bytes());
+        }
+    }
+    for p in &scene.patches {
+        // A polygon has at most u32::MAX corners: its corners are u32 vertex indices of one scene.
+        let n = p.polygon.len() as u32;
+        if wide {
+            out.extend_from_slice(&n.to_le_bytes());
+        } else {
+            out.push(n as u8);
+        }
+        for v in &p.polygon {
+            out.extend_from_slice(&v.to_le_bytes());
+        }
+        for c in scene.materials[p.material as usize].reflectance_rgb {
+            out.extend_from_slice(&c.to_le_bytes());
+        }
+    }
+    out
 }

@@ -3,6 +3,9 @@
 //! An STL file is one object (named after the file) of triangles with one material, scx's default
 //! (reflectance 0.5, no emission): STL has no materials. Each triangle is a patch, facing the side its
 //! corners run counter-clockwise about (the STL rule; the stored facet normals are often zero or stale).
+//!
+//! Writing ([`to_bytes`]): binary STL with `stl_io`, every triangle with its patch's normal, f32
+//! coordinates in the scene's units.
 
 use std::path::Path;
 
@@ -49,4 +52,28 @@ pub(crate) fn is_binary_stl(bytes: &[u8]) -> bool {
     }
     let count = u32::from_le_bytes([bytes[80], bytes[81], bytes[82], bytes[83]]) as u64;
     bytes.len() as u64 == 84 + 50 * count
+}
+
+/// A scene as binary STL: each of its triangles (front side counter-clockwise) with its patch's normal,
+/// coordinates in the scene's units rounded to f32 (what STL holds). STL keeps neither patches,
+/// materials nor objects: reading it back gives a patch per triangle.
+pub fn to_bytes(scene: &Scene) -> Vec<u8> {
+    let corner = |v: u32| {
+        let p = scene.vertices[v as usize];
+        stl_io::Vertex::new([p.x as f32, p.y as f32, p.z as f32])
+    };
+    let triangles = scene
+        .triangles
+        .iter()
+        .zip(&scene.triangle_patch)
+        .map(|(t, &patch)| {
+            let n = scene.patches[patch as usize].normal;
+            stl_io::Triangle {
+                normal: stl_io::Normal::new([n.x as f32, n.y as f32, n.z as f32]),
+                vertices: t.map(corner),
+            }
+        });
+    let mut out = Vec::with_capacity(84 + 50 * scene.triangles.len());
+    stl_io::write_stl(&mut out, triangles).expect("writing to memory cannot fail");
+    out
 }

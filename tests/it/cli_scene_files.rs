@@ -233,3 +233,177 @@ fn formats_come_from_the_content() {
     );
     assert!((doc["area"].as_f64().unwrap() - original["area"].as_f64().unwrap()).abs() < 1.0);
 }
+
+/// I_s^c and its standard error from a JSON report.
+fn continuous_isc(report: &serde_json::Value) -> (f64, f64) {
+    let e = &report["visibility"]["continuous_mutual_information"];
+    (e["value"].as_f64().unwrap(), e["stderr"].as_f64().unwrap())
+}
+
+/// `scx analyze SCENE --lines 1e5 --seed 3 --format json` (Rust tracer).
+fn analyze_json(scene: &str) -> serde_json::Value {
+    json_of(&scx(&[
+        "analyze", scene, "--lines", "1e5", "--seed", "3", "--tracer", "rust", "--format", "json",
+    ]))
+}
+
+/// A .glb's JSON chunk rewritten by `edit` (the binary chunk kept).
+fn edit_glb(glb: &[u8], edit: impl Fn(&mut serde_json::Value)) -> Vec<u8> {
+    let json_length = u32::from_le_bytes(glb[12..16].try_into().unwrap()) as usize;
+    let mut doc: serde_json::Value = serde_json::from_slice(&glb[20..20 + json_length]).unwrap();
+    edit(&mut doc);
+    let mut json = serde_json::to_vec(&doc).unwrap();
+    while json.len() % 4 != 0 {
+        json.push(b' ');
+    }
+    let bin = &glb[20 + json_length..];
+    let mut out = b"glTF".to_vec();
+    out.extend(2u32.to_le_bytes());
+    out.extend(((12 + 8 + json.len() + bin.len()) as u32).to_le_bytes());
+    out.extend((json.len() as u32).to_le_bytes());
+    out.extend(b"JSON");
+    out.extend(json);
+    out.extend(bin);
+    out
+}
+
+/// glTF vertex attributes scx does not read are ignored, application-specific ones (`_s`, `_t` as
+/// trimesh writes them, the specification's `_TEMPERATURE`) and names gltf-rs does not know alike
+/// (before: exit 2, `attributes["<invalid semantic name>"]`): the file measures as the one without them,
+/// bit for bit. A missing POSITION is still refused.
+#[test]
+fn gltf_application_specific_attributes_are_ignored() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = scene_complexity::load("@cornell").unwrap();
+    let plain = dir.path().join("plain.glb");
+    std::fs::write(&plain, scene_complexity::gltf_bytes(&scene, true)).unwrap();
+    let add_attributes = |doc: &mut serde_json::Value| {
+        for mesh in doc["meshes"].as_array_mut().unwrap() {
+            for primitive in mesh["primitives"].as_array_mut().unwrap() {
+                let a = &mut primitive["attributes"];
+                let position = a["POSITION"].clone();
+                a["_s"] = position.clone();
+                a["_t"] = position.clone();
+                a["_TEMPERATURE"] = position.clone();
+                a["VENDOR_THING"] = serde_json::json!(999);
+            }
+        }
+    };
+    let glb = dir.path().join("trimesh.glb");
+    std::fs::write(
+        &glb,
+        edit_glb(&std::fs::read(&plain).unwrap(), add_attributes),
+    )
+    .unwrap();
+    let mut doc: serde_json::Value =
+        serde_json::from_slice(&scene_complexity::gltf_bytes(&scene, false)).unwrap();
+    add_attributes(&mut doc);
+    let gltf = dir.path().join("temperature.gltf");
+    std::fs::write(&gltf, serde_json::to_vec(&doc).unwrap()).unwrap();
+
+    let expected = analyze_json(&plain.display().to_string());
+    for path in [&glb, &gltf] {
+        let report = analyze_json(&path.display().to_string());
+        assert_eq!(report["patches"], expected["patches"], "{path:?}");
+        assert_eq!(
+            continuous_isc(&report),
+            continuous_isc(&expected),
+            "{path:?}"
+        );
+    }
+    doc["meshes"][0]["primitives"][0]["attributes"]
+        .as_object_mut()
+        .unwrap()
+        .remove("POSITION");
+    let missing = dir.path().join("missing.gltf");
+    std::fs::write(&missing, serde_json::to_vec(&doc).unwrap()).unwrap();
+    let out = scx(&["analyze", missing.to_str().unwrap()]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("missing.gltf") && err.contains("POSITION"),
+        "{err}"
+    );
+}
+
+/// `scx export -o` writes the format its extension names (before: OBJ text whatever the extension, and
+/// an .mtl beside it): binary PLY (which reads back with the same patches and the same I_s^c bit for bit)
+/// and binary STL (84 + 50 bytes per triangle), with no .mtl; a warning says what each cannot keep. Any
+/// other extension is refused before work, exit 2, naming the ones scx writes.
+#[test]
+fn scene_export_writes_the_format_its_extension_names() {
+    let dir = tempfile::tempdir().unwrap();
+    let original = analyze_json("@cornell");
+    let ply = dir.path().join("cornell.ply");
+    let out = scx(&["export", "@cornell", "-o", ply.to_str().unwrap()]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(0), "{err}");
+    assert!(
+        err.contains("binary PLY holds no emission") && err.contains("`light`"),
+        "{err}"
+    );
+    let bytes = std::fs::read(&ply).unwrap();
+    assert!(bytes.starts_with(b"ply\nformat binary_little_endian 1.0\n"));
+    let report = analyze_json(ply.to_str().unwrap());
+    assert_eq!(report["patches"], original["patches"]);
+    assert_eq!(continuous_isc(&report), continuous_isc(&original));
+
+    let stl = dir.path().join("cornell.stl");
+    let out = scx(&["export", "@cornell", "-o", stl.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(0));
+    let triangles = scene_complexity::load("@cornell").unwrap().triangles.len();
+    assert_eq!(
+        std::fs::metadata(&stl).unwrap().len(),
+        84 + 50 * triangles as u64
+    );
+    let report = analyze_json(stl.to_str().unwrap());
+    assert_eq!(report["patches"].as_u64(), Some(triangles as u64));
+    let (a, b) = (continuous_isc(&report), continuous_isc(&original));
+    assert!((a.0 - b.0).abs() <= 4.0 * a.1.hypot(b.1), "{a:?} {b:?}");
+    assert!(
+        !dir.path().join("cornell.mtl").exists(),
+        "no MTL beside PLY or STL"
+    );
+
+    for name in ["cornell.txt", "cornell", "cornell.mtl"] {
+        let path = dir.path().join(name);
+        let out = scx(&["export", "@cornell", "-o", path.to_str().unwrap()]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{name}: {err}");
+        assert!(
+            err.contains(name) && err.contains(".obj (with its .mtl), .ply, .stl, .gltf, .glb"),
+            "{name}: {err}"
+        );
+        assert!(!path.exists(), "{name}: refused before work");
+    }
+}
+
+/// Every help text of a scene argument lists the formats scx reads and the built-ins; those of an
+/// output scene list the formats it writes (before: `render` said "A scene file (OBJ)", `export` "OBJ +
+/// MTL").
+#[test]
+fn scene_help_texts_list_the_formats() {
+    for command in [
+        "analyze",
+        "export",
+        "convergence",
+        "refine",
+        "crosscheck",
+        "render",
+    ] {
+        let help = String::from_utf8_lossy(&scx(&[command, "--help"]).stdout).into_owned();
+        assert!(
+            help.contains("OBJ, glTF/GLB, PLY or STL") && help.contains("a built-in such as `@"),
+            "{command}: {help}"
+        );
+    }
+    for command in ["export", "refine"] {
+        let help = String::from_utf8_lossy(&scx(&[command, "--help"]).stdout).into_owned();
+        assert!(
+            help.contains("`.ply` (binary PLY), `.stl` (binary STL), `.gltf` or `.glb`"),
+            "{command}: {help}"
+        );
+    }
+    let help = String::from_utf8_lossy(&scx(&["--help"]).stdout).into_owned();
+    assert!(help.contains("OBJ + MTL, PLY, STL or glTF/GLB"), "{help}");
+}

@@ -716,3 +716,242 @@ fn two_sided_walls_one_after_another_pair_as_thin_panels() {
     let e = b.estimate(Measure::ContinuousMutualInformation).unwrap();
     assert!(e.value.is_finite());
 }
+
+/// The corners of a unit cube (corner bits x=1, y=2, z=4) and its faces as quads, counter-clockwise
+/// seen from inside (a room, as `@cube:1`).
+fn inward_cube() -> (Vec<[f32; 3]>, Vec<[usize; 4]>) {
+    let corners = (0..8)
+        .map(|i| [(i & 1) as f32, (i >> 1 & 1) as f32, (i >> 2 & 1) as f32])
+        .collect();
+    let outward = [
+        [0, 4, 6, 2],
+        [1, 3, 7, 5],
+        [0, 1, 5, 4],
+        [2, 6, 7, 3],
+        [0, 2, 3, 1],
+        [4, 5, 7, 6],
+    ];
+    (corners, outward.map(|[a, b, c, d]| [d, c, b, a]).to_vec())
+}
+
+/// The cube's faces as Stanford triangle strips: a quad `a b c d` is the strip `b c a d` (triangles
+/// `b c a` and, turned, `a c d`); two faces per strip, joined by repeating the last and next corners (four
+/// degenerate triangles), the strips separated by `-1`.
+fn cube_strips(quads: &[[usize; 4]]) -> Vec<i32> {
+    let mut list: Vec<i32> = Vec::new();
+    for (k, q) in quads.iter().enumerate() {
+        let strip = [q[1], q[2], q[0], q[3]].map(|v| v as i32);
+        if k % 2 == 0 {
+            if !list.is_empty() {
+                list.push(-1);
+            }
+        } else {
+            let last = *list.last().unwrap();
+            list.extend([last, strip[0]]);
+        }
+        list.extend(strip);
+    }
+    list
+}
+
+/// Stanford `tristrips` (igea.ply's form: `-1` restarts a strip, repeated corners join strips) read as
+/// triangles keeping the strip's orientation (before: "the scene is empty: no faces"): the cube's 6 faces
+/// as strips give its 12 triangles, area 6, every normal into the room, and the very triangles of an OBJ
+/// with the same faces, so the same I_s^c bit for bit; `@cube:1` gives the same I_s^c too (its triangles
+/// are the same). A face element of another name with a `vertex_index` list reads as faces.
+#[test]
+fn ply_triangle_strips_read_as_the_same_triangles() {
+    let (corners, quads) = inward_cube();
+    let strips = cube_strips(&quads);
+    let dir = tempfile::tempdir().unwrap();
+    let header = |format: &str| {
+        format!(
+            "ply\nformat {format} 1.0\ncomment Stanford style\nelement vertex 8\nproperty float x\n\
+             property float y\nproperty float z\nelement tristrips 1\n\
+             property list int int vertex_indices\nend_header\n"
+        )
+    };
+    let mut ascii = header("ascii");
+    let mut binary = header("binary_big_endian").into_bytes();
+    for c in &corners {
+        ascii.push_str(&format!("{} {} {}\n", c[0], c[1], c[2]));
+        binary.extend(c.iter().flat_map(|x| x.to_be_bytes()));
+    }
+    let listed: Vec<String> = strips.iter().map(i32::to_string).collect();
+    ascii.push_str(&format!("{} {}\n", strips.len(), listed.join(" ")));
+    binary.extend((strips.len() as i32).to_be_bytes());
+    binary.extend(strips.iter().flat_map(|x| x.to_be_bytes()));
+
+    let mut obj = String::new();
+    for c in &corners {
+        obj.push_str(&format!("v {} {} {}\n", c[0], c[1], c[2]));
+    }
+    for q in &quads {
+        obj.push_str(&format!("f {} {} {}\n", q[1] + 1, q[2] + 1, q[0] + 1));
+        obj.push_str(&format!("f {} {} {}\n", q[0] + 1, q[2] + 1, q[3] + 1));
+    }
+    let obj = load_file(
+        &write(dir.path(), "cube.obj", obj.as_bytes()),
+        &SceneOptions::default(),
+    );
+    let continuous = Measures {
+        discrete: false,
+        continuous: true,
+        radiosity: false,
+    };
+    let isc = |scene: &Scene| {
+        let a = run(scene, 100_000, 7, continuous);
+        let e = a.estimate(Measure::ContinuousMutualInformation).unwrap();
+        (e.value, e.stderr.unwrap())
+    };
+    let expected = isc(&obj);
+    for (name, bytes) in [("ascii.ply", ascii.into_bytes()), ("binary.ply", binary)] {
+        let scene = load_file(&write(dir.path(), name, &bytes), &SceneOptions::default());
+        assert_eq!(
+            (scene.patch_count(), scene.triangles.len()),
+            (12, 12),
+            "{name}"
+        );
+        assert!(
+            (scene.total_area_scene_units() - 6.0).abs() < 1e-12,
+            "{name}"
+        );
+        for p in &scene.patches {
+            let corner = scene.vertices[p.polygon[0] as usize];
+            let inward = (scene.normalization.center - corner).dot(p.normal);
+            assert!(inward > 0.0, "{name}: a triangle faces out of the room");
+        }
+        assert_eq!(scene.triangles, obj.triangles, "{name}");
+        assert_eq!(scene.positions, obj.positions, "{name}");
+        assert_eq!(isc(&scene), expected, "{name}");
+        assert!(scene.warnings.is_empty(), "{name}: {:?}", scene.warnings);
+    }
+    let cube = isc(&load("@cube:1").unwrap());
+    assert!(
+        (cube.0 - expected.0).abs() <= 4.0 * cube.1.hypot(expected.1),
+        "{cube:?} {expected:?}"
+    );
+
+    let mut polygons = String::from(
+        "ply\nformat ascii 1.0\nelement vertex 8\nproperty float x\nproperty float y\n\
+         property float z\nelement polygon 6\nproperty list uchar uint vertex_index\nend_header\n",
+    );
+    for c in &corners {
+        polygons.push_str(&format!("{} {} {}\n", c[0], c[1], c[2]));
+    }
+    for q in &quads {
+        polygons.push_str(&format!("4 {} {} {} {}\n", q[0], q[1], q[2], q[3]));
+    }
+    let scene = load_file(
+        &write(dir.path(), "polygons.ply", polygons.as_bytes()),
+        &SceneOptions::default(),
+    );
+    assert_eq!((scene.patch_count(), scene.triangles.len()), (6, 12));
+    assert_eq!(isc(&scene), isc(&load("@cube:1").unwrap()));
+}
+
+/// A PLY with no element of faces says which elements it has, strips among the forms it looks for.
+#[test]
+fn a_ply_without_faces_names_its_elements() {
+    let dir = tempfile::tempdir().unwrap();
+    let ply = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n\
+               property float z\nelement edge 1\nproperty int vertex1\nproperty int vertex2\n\
+               end_header\n0 0 0\n1 0 0\n0 1 0\n0 1\n";
+    let path = write(dir.path(), "edges.ply", ply.as_bytes());
+    let e = load_with(path.to_str().unwrap(), &SceneOptions::default())
+        .unwrap_err()
+        .to_string();
+    for words in [
+        "edges.ply",
+        "the scene is empty",
+        "`tristrips`",
+        "3 vertices",
+        "`vertex` (3), `edge` (1)",
+    ] {
+        assert!(e.contains(words), "{words}: {e}");
+    }
+}
+
+/// `write_scene` picks the format by the extension; each file reads back as the scene it was: OBJ and
+/// PLY with the same triangles, positions and patches, so I_s^c bit for bit; STL and glTF (triangles
+/// only, f32) with a patch per triangle and every corner the f32 of the original's, I_s^c within its
+/// error; an STL read back and written again gives the same scene. Any other extension is refused.
+#[test]
+fn scenes_written_in_every_format_read_back_the_same() {
+    use scene_complexity::{write_scene, WriteFormat};
+    let dir = tempfile::tempdir().unwrap();
+    let continuous = Measures {
+        discrete: false,
+        continuous: true,
+        radiosity: false,
+    };
+    let isc = |scene: &Scene| {
+        let a = run(scene, 50_000, 11, continuous);
+        let e = a.estimate(Measure::ContinuousMutualInformation).unwrap();
+        (e.value, e.stderr.unwrap())
+    };
+    let room = load_file(
+        &write(dir.path(), "room.obj", room_with_box_obj(3.0).as_bytes()),
+        &SceneOptions::default(),
+    );
+    for (label, scene) in [("cornell", load("@cornell").unwrap()), ("room", room)] {
+        let original = isc(&scene);
+        for ext in ["obj", "ply", "stl", "gltf", "glb"] {
+            let path = dir.path().join(format!("{label}_out.{ext}"));
+            write_scene(&scene, &path).unwrap();
+            let format = WriteFormat::of_path(&path).unwrap();
+            let back = load_file(&path, &SceneOptions::default());
+            let what = format!("{label} as {ext}");
+            assert!(
+                (back.total_area_scene_units() - scene.total_area_scene_units()).abs()
+                    < 1e-6 * scene.total_area_scene_units(),
+                "{what}"
+            );
+            if matches!(format, WriteFormat::Obj | WriteFormat::Ply) {
+                assert_eq!(back.patch_count(), scene.patch_count(), "{what}");
+                assert_eq!(back.triangles, scene.triangles, "{what}");
+                assert_eq!(back.positions, scene.positions, "{what}");
+                assert_eq!(back.vertices, scene.vertices, "{what}");
+                assert_eq!(back.triangle_patch, scene.triangle_patch, "{what}");
+                assert_eq!(isc(&back), original, "{what}");
+                continue;
+            }
+            assert_eq!(back.triangles.len(), scene.triangles.len(), "{what}");
+            assert_eq!(back.patch_count(), scene.triangles.len(), "{what}");
+            let corners = |s: &Scene| {
+                let mut v: Vec<[u32; 3]> = s
+                    .triangles
+                    .iter()
+                    .flatten()
+                    .map(|&k| {
+                        let p = s.vertices[k as usize];
+                        [p.x as f32, p.y as f32, p.z as f32].map(f32::to_bits)
+                    })
+                    .collect();
+                v.sort_unstable();
+                v
+            };
+            assert_eq!(corners(&back), corners(&scene), "{what}");
+            let again = isc(&back);
+            assert!(
+                (again.0 - original.0).abs() <= 4.0 * again.1.hypot(original.1),
+                "{what}: {again:?} {original:?}"
+            );
+            if format == WriteFormat::Stl {
+                let twice = dir.path().join(format!("{label}_twice.stl"));
+                write_scene(&back, &twice).unwrap();
+                let twice = load_file(&twice, &SceneOptions::default());
+                assert_eq!(twice.triangles, back.triangles, "{what}");
+                assert_eq!(twice.positions, back.positions, "{what}");
+                assert_eq!(isc(&twice), again, "{what}");
+            }
+        }
+    }
+    let e = write_scene(&load("@cube:1").unwrap(), &dir.path().join("cube.txt")).unwrap_err();
+    assert!(
+        e.to_string()
+            .contains(".obj (with its .mtl), .ply, .stl, .gltf, .glb"),
+        "{e}"
+    );
+    assert!(!dir.path().join("cube.txt").exists());
+}
