@@ -39,8 +39,11 @@ pub struct RenderArgs {
     #[command(flatten)]
     run: RunOptions,
     /// The camera, in the scene's units: `ex,ey,ez,tx,ty,tz,ux,uy,uz,fov` (eye, target, up, vertical
-    /// field of view in degrees). Default: inside a room, near the middle of its -z wall looking at
-    /// the far wall (+y up); outside an object, from the front, above and to the right.
+    /// field of view in degrees). Default: chosen from the geometry (+y up): small probe pictures
+    /// from inside each wall of the bounding box, from outside each side (a room open on one side is
+    /// seen through the opening) and around an object, the one showing most of the scene's area from
+    /// the front, with fewest back sides, kept (the classic view from the -z wall unless another is
+    /// over 10% better).
     #[arg(long, value_parser = parse_camera, allow_negative_numbers = true)]
     camera: Option<Camera>,
     /// The picture's size in pixels, WIDTHxHEIGHT (the colour bar is added on the right).
