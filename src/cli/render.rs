@@ -4,6 +4,7 @@
 use std::path::{Path, PathBuf};
 
 use plotters::prelude::*;
+use scene_complexity::render::colour::short_number;
 use scene_complexity::render::{
     default_camera, trace_view, write_ply, Camera, ColourScale, Quantity, Sample, BACK_SIDE,
     NO_DATA,
@@ -40,8 +41,11 @@ pub struct RenderArgs {
     #[command(flatten)]
     run: RunOptions,
     /// The camera, in the scene's units: `ex,ey,ez,tx,ty,tz,ux,uy,uz,fov` (eye, target, up, vertical
-    /// field of view in degrees). Default: inside a room, near the middle of its -z wall looking at
-    /// the far wall (+y up); outside an object, from the front, above and to the right.
+    /// field of view in degrees). Default: chosen from the geometry (+y up): small probe pictures
+    /// from inside each wall of the bounding box, from outside each side (a room open on one side is
+    /// seen through the opening) and around an object, the one showing most of the scene's area from
+    /// the front, with fewest back sides, kept (the classic view from the -z wall unless another is
+    /// over 10% better).
     #[arg(long, value_parser = parse_camera, allow_negative_numbers = true)]
     camera: Option<Camera>,
     /// The picture's size in pixels, WIDTHxHEIGHT (the colour bar is added on the right).
@@ -315,19 +319,6 @@ struct Legend {
     clipped_high: bool,
 }
 
-/// A tick label: few significant digits, exponents for very large or small values.
-fn tick(v: f64) -> String {
-    let a = v.abs();
-    if v == 0.0 {
-        "0".into()
-    } else if !(1e-3..1e5).contains(&a) {
-        format!("{v:.2e}")
-    } else {
-        let digits = (3 - a.log10().floor() as i32).clamp(0, 6) as usize;
-        format!("{v:.digits$}")
-    }
-}
-
 fn draw_png(
     path: &Path,
     (w, h, pixels): (usize, usize, Vec<u8>),
@@ -374,18 +365,26 @@ fn draw<DB: DrawingBackend>(
         ))?;
     }
     root.draw(&Rectangle::new([(x0, top), (x0 + 26, top + height)], BLACK))?;
-    let ticks = 6;
-    for k in 0..ticks {
-        let f = f64::from(k) / f64::from(ticks - 1);
-        let value = scale.value_at(f);
-        let y = top + ((1.0 - f) * f64::from(height - 1)).round() as i32;
-        let mut label = tick(value);
-        if k == 0 && legend.clipped_low {
-            label = format!("≤ {label}");
+    let y_of =
+        |value: f64| top + ((1.0 - scale.position(value)) * f64::from(height - 1)).round() as i32;
+    // Values beyond an end take its colour: the end is labelled `≥`/`≤` with its value to three
+    // significant digits, and round ticks too close to it give way.
+    let ends = [
+        (legend.clipped_high, scale.hi, "≥"),
+        (legend.clipped_low, scale.lo, "≤"),
+    ];
+    let mut labels: Vec<(i32, String)> = ends
+        .iter()
+        .filter(|(clipped, ..)| *clipped)
+        .map(|&(_, value, mark)| (y_of(value), format!("{mark} {}", three_digits(value))))
+        .collect();
+    for tick in scale.ticks() {
+        let y = y_of(tick.value);
+        if labels.iter().all(|(at, _)| (at - y).abs() >= 16) {
+            labels.push((y, tick.label));
         }
-        if k == ticks - 1 && legend.clipped_high {
-            label = format!("≥ {label}");
-        }
+    }
+    for (y, label) in labels {
         root.draw(&PathElement::new(vec![(x0 + 26, y), (x0 + 32, y)], BLACK))?;
         root.draw(&Text::new(label, (x0 + 36, y - 7), text(14)))?;
     }
@@ -415,6 +414,12 @@ fn draw<DB: DrawingBackend>(
         y += 44;
     }
     Ok(())
+}
+
+/// `v` to three significant digits, without trailing zeros (an end of the bar is not a round value).
+fn three_digits(v: f64) -> String {
+    let rounded: f64 = format!("{v:.2e}").parse().unwrap_or(v);
+    short_number(rounded)
 }
 
 /// A whole number with its digits in groups of three (`10 000 000`).
@@ -467,9 +472,9 @@ mod tests {
         assert!(parse_size("640").is_err() && parse_size("10x10").is_err());
         assert_eq!(parse_range("-1,2"), Ok((-1.0, 2.0)));
         assert!(parse_range("2,1").is_err());
-        assert_eq!(tick(0.012345), "0.01235");
-        assert_eq!(tick(1234.4), "1234");
-        assert_eq!(tick(2.5e-5), "2.50e-5");
+        assert_eq!(three_digits(0.48884), "0.489");
+        assert_eq!(three_digits(0.0118), "0.0118");
+        assert_eq!(three_digits(2.0), "2");
         assert_eq!(grouped(10_000_000), "10 000 000");
         assert_eq!(grouped(999), "999");
     }

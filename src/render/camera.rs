@@ -1,12 +1,30 @@
 //! The pinhole camera of a picture, and the view chosen when none is given.
 //!
-//! Every built-in scene is an enclosure (a room seen from inside: its walls face inwards), and a room
-//! seen from outside shows only the back of one wall. So the default view first tries to stand inside:
-//! near the middle of the room's `-z` wall, looking along `+z` at the far wall with `+y` up (the Cornell
-//! box's own view, and OBJ's usual up), the field of view a little wider than the far wall. A place
-//! counts as inside when almost every ray from it meets the front side of a surface. A scene with no
-//! such place (an object in open space) is seen from outside its bounding sphere, from the front, above
-//! and to the right.
+//! The default view is chosen from the geometry, by tracing. Candidate views are each traced as a
+//! small probe picture and scored by what they show:
+//!
+//! `score = F x A - B`
+//!
+//! where `F` is the share of the probe's samples that see a front side, `B` the share that see a back
+//! side (a wall seen from behind says nothing about the colours, and hides what is behind it), and `A`
+//! the share of the scene's area seen from the front in the probe (each sample stands for the surface
+//! its pixel covers: a view of one wall, or of a box just in front of the eye, scores less than a view
+//! of the whole room). `+y` is up (OBJ's usual up).
+//!
+//! The candidates, each a way to look at a room or at an object:
+//!
+//! * from inside, near the middle of each vertical wall of the bounding box (`-z` first: the Cornell
+//!   box's own view, the classic view), looking at the opposite wall, the field of view a little wider
+//!   than that wall, the eye moved further in or aside until almost every ray from it meets a front
+//!   side (a closed room);
+//! * from outside the bounding sphere, above and from each of the four diagonals around it, front and
+//!   right first (an object in open space);
+//! * from outside, in front of each of the four vertical faces of the bounding box and above it,
+//!   looking in with the face filling the picture (a room open on one side is seen through its
+//!   opening; from a closed side the probe sees back sides and scores below zero).
+//!
+//! The first candidate (the classic view) is kept unless another scores more than 10% higher, so that
+//! a room whose classic view already shows the room keeps the same picture.
 
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
@@ -75,59 +93,308 @@ impl Camera {
     }
 }
 
-/// Rays from a point of tracing space that meet a front side, out of those cast, for the test of
-/// being inside an enclosure.
+/// Rays cast in uniform directions from a place, to tell what surrounds it.
 const INSIDE_PROBES: usize = 512;
 
-/// The share of the probes that must meet a front side for a place to count as inside.
+/// The share of those rays that must meet a front side for a place to count as inside a room.
 const INSIDE_SHARE: f64 = 0.98;
+
+/// The probe picture each candidate view is scored on (4:3, the default picture's shape).
+const PROBE: (usize, usize) = (64, 48);
+
+/// The smallest cosine a surface seen at a grazing angle counts with (its area in view would grow
+/// without bound).
+const GRAZING: f64 = 0.2;
+
+/// The width over the height the views are framed for.
+const ASPECT: f64 = 4.0 / 3.0;
+
+/// The field of view from outside a room's bounding box, degrees.
+const OUTSIDE_FOV: f64 = 40.0;
+
+/// How much of the bounding box's face fills the picture from outside: a little under 1, so that the
+/// edges of an opening fall just outside the picture.
+const FRAMING: f64 = 0.88;
+
+/// How much more another view must score to replace the classic view.
+const KEEP_CLASSIC: f64 = 1.1;
 
 /// The default view of a scene (module documentation).
 pub fn default_camera(scene: &Scene, tracer: &dyn Tracer) -> Result<Camera, TraceError> {
-    let (lo, hi) = bounds(scene);
-    let size = hi - lo;
-    let middle = 0.5 * (lo + hi);
-    // In from the -z wall by a few per cent of the depth; further in when an object stands there.
-    for depth in [0.01, 0.03, 0.08, 0.15, 0.25] {
-        for offset in [(0.0, 0.0), (0.1, 0.0), (-0.1, 0.0), (0.0, 0.1), (0.0, -0.1)] {
-            let eye = Point::new(
-                middle.x + offset.0 * size.x,
-                middle.y + offset.1 * size.y,
-                lo.z + depth * size.z,
-            );
-            if inside_share(scene, tracer, eye)? >= INSIDE_SHARE {
-                let far = hi.z - eye.z;
-                let half = 0.5 * size.x.max(size.y);
-                return Ok(Camera {
-                    eye,
-                    target: Point::new(middle.x, middle.y, hi.z),
-                    up: Vector::Y,
-                    // Wider than the far wall, so that the floor, the ceiling and the side walls show.
-                    fov_degrees: (2.0 * (1.3 * half / far).atan()).to_degrees().min(120.0),
-                });
-            }
-        }
+    let bounds = Bounds::of(scene);
+    let mut candidates = Vec::new();
+    for (axis, sign) in [(2, 1.0), (2, -1.0), (0, 1.0), (0, -1.0)] {
+        let eye = inside_place(scene, tracer, &bounds, axis, sign)?;
+        candidates.push(bounds.inside_view(eye, axis, sign));
     }
-    let radius = 0.5 * size.length();
-    let direction = unit_vector(Vector::new(0.45, 0.55, -1.0));
-    Ok(Camera {
-        eye: middle + 2.6 * radius * direction,
-        target: middle,
-        up: Vector::Y,
-        fov_degrees: 46.0,
+    candidates.extend(bounds.object_views());
+    candidates.extend(
+        [(2, 1.0), (2, -1.0), (0, 1.0), (0, -1.0), (1, -1.0)]
+            .map(|(axis, sign)| bounds.outside_view(axis, sign)),
+    );
+    best_view(scene, tracer, &candidates)
+}
+
+/// The candidate that scores best, the first kept unless beaten by more than [`KEEP_CLASSIC`].
+fn best_view(
+    scene: &Scene,
+    tracer: &dyn Tracer,
+    candidates: &[Camera],
+) -> Result<Camera, TraceError> {
+    let scores = candidates
+        .iter()
+        .map(|c| view_score(scene, tracer, c).map(|s| s.score()))
+        .collect::<Result<Vec<f64>, _>>()?;
+    let (best, top) =
+        scores.iter().enumerate().fold(
+            (0, f64::NEG_INFINITY),
+            |(b, t), (k, &s)| {
+                if s > t {
+                    (k, s)
+                } else {
+                    (b, t)
+                }
+            },
+        );
+    // Scores may be negative: "within 10%" is measured on the distance to the best.
+    let classic_kept = scores[0] >= top - (KEEP_CLASSIC - 1.0) * top.abs();
+    Ok(candidates[if classic_kept { 0 } else { best }])
+}
+
+/// What a view shows, as shares (module documentation).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ViewScore {
+    /// The share of the picture's samples that see a front side.
+    pub front: f64,
+    /// The share that see a back side.
+    pub back: f64,
+    /// The share of the scene's area seen from the front in the picture.
+    pub area: f64,
+}
+
+impl ViewScore {
+    /// `front x area - back`: how good the view is (module documentation).
+    pub fn score(&self) -> f64 {
+        self.front * self.area - self.back
+    }
+}
+
+/// Scores the view `camera` gives of `scene` on a small probe picture ([`PROBE`] samples, one ray
+/// each). A sample that sees a front side stands for the surface its pixel covers there (its solid
+/// angle x distance² / |cos|, the cosine at least [`GRAZING`]); a patch shows at most its own area.
+pub fn view_score(
+    scene: &Scene,
+    tracer: &dyn Tracer,
+    camera: &Camera,
+) -> Result<ViewScore, TraceError> {
+    let (eye, [right, up, forward]) = camera.frame(scene);
+    let (w, h) = PROBE;
+    let half_height = (0.5 * camera.fov_degrees.to_radians()).tan();
+    let pixel = 2.0 * half_height / h as f64;
+    let dirs: Vec<Vector> = (0..w * h)
+        .map(|k| {
+            let u = ((k % w) as f64 + 0.5 - 0.5 * w as f64) * pixel;
+            let v = half_height - ((k / w) as f64 + 0.5) * pixel;
+            (forward + u * right + v * up).normalize()
+        })
+        .collect();
+    let t_max = (eye.length() + 2.0 * scene.bounding_radius()) as f32;
+    let lines: Vec<Line> = dirs
+        .iter()
+        .map(|d| Line {
+            origin: eye.as_vec3().to_array(),
+            dir: d.as_vec3().to_array(),
+            t_max,
+        })
+        .collect();
+    let mut hits = Vec::new();
+    tracer.first_hits(&lines, &mut hits)?;
+    let mut shown = vec![0.0; scene.patch_count()];
+    let (mut front, mut back) = (0usize, 0usize);
+    for (hit, d) in hits.iter().zip(&dirs) {
+        let Some(hit) = hit else { continue };
+        let patch = scene.triangle_patch[hit.triangle as usize] as usize;
+        let cos = scene.patches[patch].normal.dot(*d);
+        if cos >= 0.0 {
+            back += 1;
+            continue;
+        }
+        front += 1;
+        // The pixel's solid angle: pixel² on the image plane at distance 1, seen at d·forward.
+        let solid_angle = pixel * pixel * d.dot(forward).powi(3);
+        let t = f64::from(hit.t);
+        shown[patch] += solid_angle * t * t / cos.abs().max(GRAZING);
+    }
+    let area: f64 = scene
+        .patches
+        .iter()
+        .zip(&shown)
+        .map(|(p, &s)| s.min(p.area))
+        .sum();
+    let n = (w * h) as f64;
+    Ok(ViewScore {
+        front: front as f64 / n,
+        back: back as f64 / n,
+        area: area / scene.total_area(),
     })
 }
 
-/// The scene's axis-aligned bounds in its own units.
-fn bounds(scene: &Scene) -> (Point, Point) {
-    scene.vertices.iter().fold(
-        (Point::splat(f64::INFINITY), Point::splat(f64::NEG_INFINITY)),
-        |(lo, hi), v| (lo.min(*v), hi.max(*v)),
-    )
+/// The first place near the wall at the `-sign` end of `axis`, in from it by a growing share of the
+/// depth and moved aside a little, from which almost every ray meets a front side; the best-surrounded
+/// place tried when none does.
+fn inside_place(
+    scene: &Scene,
+    tracer: &dyn Tracer,
+    bounds: &Bounds,
+    axis: usize,
+    sign: f64,
+) -> Result<Point, TraceError> {
+    let (size, middle) = (bounds.size(), bounds.middle());
+    let across = 2 - axis;
+    let mut best: Option<(Point, f64)> = None;
+    for depth in [0.01, 0.03, 0.08, 0.15, 0.25] {
+        for (a, b) in [(0.0, 0.0), (0.1, 0.0), (-0.1, 0.0), (0.0, 0.1), (0.0, -0.1)] {
+            let mut eye = middle.to_array();
+            eye[axis] = bounds.wall(axis, -sign) + sign * depth * size[axis];
+            eye[across] += a * size[across];
+            eye[1] += b * size.y;
+            let eye = Point::from_array(eye);
+            let surround = surround(scene, tracer, eye)?;
+            if surround.front >= INSIDE_SHARE {
+                return Ok(eye);
+            }
+            if best.is_none_or(|(_, front)| surround.front > front) {
+                best = Some((eye, surround.front));
+            }
+        }
+    }
+    Ok(best.expect("places were tried").0)
 }
 
-/// The share of rays from `eye` (scene units), in uniform directions, whose first hit is a front side.
-fn inside_share(scene: &Scene, tracer: &dyn Tracer, eye: Point) -> Result<f64, TraceError> {
+/// The scene's axis-aligned bounds in its own units.
+struct Bounds {
+    lo: Point,
+    hi: Point,
+}
+
+impl Bounds {
+    fn of(scene: &Scene) -> Self {
+        let (lo, hi) = scene.vertices.iter().fold(
+            (Point::splat(f64::INFINITY), Point::splat(f64::NEG_INFINITY)),
+            |(lo, hi), v| (lo.min(*v), hi.max(*v)),
+        );
+        Bounds { lo, hi }
+    }
+
+    fn size(&self) -> Vector {
+        self.hi - self.lo
+    }
+
+    fn middle(&self) -> Point {
+        0.5 * (self.lo + self.hi)
+    }
+
+    /// The coordinate of the bounding box's wall at the `sign` end of `axis`.
+    fn wall(&self, axis: usize, sign: f64) -> f64 {
+        if sign > 0.0 {
+            self.hi[axis]
+        } else {
+            self.lo[axis]
+        }
+    }
+
+    /// From `eye` inside, looking along `sign` x `axis` (horizontal) at the middle of the far wall, the
+    /// field of view wider than that wall so that the floor, the ceiling and the side walls show.
+    fn inside_view(&self, eye: Point, axis: usize, sign: f64) -> Camera {
+        let size = self.size();
+        let mut target = self.middle().to_array();
+        target[axis] = self.wall(axis, sign);
+        let far = (target[axis] - eye[axis]).abs();
+        let half = 0.5 * size[2 - axis].max(size.y);
+        Camera {
+            eye,
+            target: Point::from_array(target),
+            up: Vector::Y,
+            fov_degrees: (2.0 * (1.3 * half / far).atan()).to_degrees().min(120.0),
+        }
+    }
+
+    /// From outside the face at the `-sign` end of `axis`, looking along `sign` x `axis` at the middle,
+    /// the face filling the picture ([`FRAMING`]).
+    fn outside_view(&self, axis: usize, sign: f64) -> Camera {
+        let size = self.size();
+        // The picture's vertical is y, or z when looking along y.
+        let (vertical, up) = if axis == 1 {
+            (2, Vector::Z)
+        } else {
+            (1, Vector::Y)
+        };
+        let horizontal = 3 - axis - vertical;
+        let half = (0.5 * size[vertical]).max(0.5 * size[horizontal] / ASPECT);
+        let distance = FRAMING * half / (0.5 * OUTSIDE_FOV).to_radians().tan();
+        let middle = self.middle();
+        let mut eye = middle.to_array();
+        eye[axis] = self.wall(axis, -sign) - sign * distance;
+        Camera {
+            eye: Point::from_array(eye),
+            target: middle,
+            up,
+            fov_degrees: OUTSIDE_FOV,
+        }
+    }
+
+    /// From outside the bounding sphere, above and from each diagonal (front and right first), the
+    /// field of view closed in on the bounding box (a long, flat object fills the picture).
+    fn object_views(&self) -> Vec<Camera> {
+        let radius = 0.5 * self.size().length();
+        [(0.45, -1.0), (-0.45, -1.0), (0.45, 1.0), (-0.45, 1.0)]
+            .map(|(x, z)| {
+                let camera = Camera {
+                    eye: self.middle() + 2.6 * radius * unit_vector(Vector::new(x, 0.55, z)),
+                    target: self.middle(),
+                    up: Vector::Y,
+                    fov_degrees: 46.0,
+                };
+                Camera {
+                    fov_degrees: self.fitting_fov(&camera).min(camera.fov_degrees),
+                    ..camera
+                }
+            })
+            .to_vec()
+    }
+
+    /// The vertical field of view in which the bounding box's corners all show, with a margin, in a
+    /// picture of [`ASPECT`] (the eye outside the box).
+    fn fitting_fov(&self, camera: &Camera) -> f64 {
+        let forward = unit_vector(camera.target - camera.eye);
+        let right = unit_vector(forward.cross(camera.up));
+        let up = right.cross(forward);
+        let half = (0..8)
+            .map(|k| {
+                let corner = Point::new(
+                    if k & 1 == 0 { self.lo.x } else { self.hi.x },
+                    if k & 2 == 0 { self.lo.y } else { self.hi.y },
+                    if k & 4 == 0 { self.lo.z } else { self.hi.z },
+                );
+                let to = corner - camera.eye;
+                let depth = to.dot(forward);
+                (to.dot(up) / depth)
+                    .abs()
+                    .max((to.dot(right) / depth).abs() / ASPECT)
+            })
+            .fold(0.0, f64::max);
+        (2.0 * (1.05 * half).atan()).to_degrees()
+    }
+}
+
+/// What the rays from a place meet first, as shares of the rays.
+#[derive(Clone, Copy, Debug)]
+struct Surround {
+    front: f64,
+}
+
+/// What rays from `eye` (scene units) in uniform directions meet first.
+fn surround(scene: &Scene, tracer: &dyn Tracer, eye: Point) -> Result<Surround, TraceError> {
     let norm = scene.normalization;
     let origin = (eye - norm.center) / norm.scale;
     // A fixed stream: the same scene always gets the same view.
@@ -155,5 +422,7 @@ fn inside_share(scene: &Scene, tracer: &dyn Tracer, eye: Point) -> Result<f64, T
             })
         })
         .count();
-    Ok(front as f64 / INSIDE_PROBES as f64)
+    Ok(Surround {
+        front: front as f64 / INSIDE_PROBES as f64,
+    })
 }

@@ -176,6 +176,106 @@ impl ColourScale {
     }
 }
 
+/// A labelled mark on a colour bar.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Tick {
+    /// The value marked.
+    pub value: f64,
+    /// The value as the bar shows it: as few digits as give it exactly (`0.025`, `2e-5`, `1000`).
+    pub label: String,
+}
+
+/// About how many ticks a colour bar carries.
+const TICKS: usize = 6;
+
+impl ColourScale {
+    /// The colour bar's ticks, on round values within the scale: 1, 2, 2.5 or 5 x 10^k apart on a
+    /// linear scale (or a log scale under a decade); 1, 2 and 5 x 10^k on a log scale over a few
+    /// decades, powers of ten (every few) over more.
+    pub fn ticks(&self) -> Vec<Tick> {
+        let values = if self.log && self.hi / self.lo > 10.0 {
+            log_ticks(self.lo, self.hi)
+        } else {
+            nice_ticks(self.lo, self.hi, TICKS)
+        };
+        values
+            .into_iter()
+            .map(|value| Tick {
+                value,
+                label: short_number(value),
+            })
+            .collect()
+    }
+}
+
+/// Round values from `lo` to `hi`, about `about` of them: the multiples of a step among 1, 2, 2.5 and
+/// 5 x 10^k, the step whose count is nearest `about`, a step of 2.5 counting as one further (its
+/// ticks take a digit more: 0.0375); on a tie, not 2.5, then the fewer ticks.
+pub fn nice_ticks(lo: f64, hi: f64, about: usize) -> Vec<f64> {
+    let raw = (hi - lo) / about.max(1) as f64;
+    if !(raw > 0.0 && raw.is_finite()) {
+        return vec![lo];
+    }
+    let magnitude = 10f64.powf(raw.log10().floor());
+    let steps = [0.1, 1.0, 10.0].into_iter().flat_map(|scale| {
+        [(1.0, 0), (2.0, 0), (2.5, 1), (5.0, 0)].map(|(m, extra)| (m * scale * magnitude, extra))
+    });
+    let ticks = |step: f64| -> Vec<f64> {
+        // Whole multiples of the step, each from its index (no sum drifting off the round value).
+        let first = (lo / step - 1e-9).ceil() as i64;
+        let last = (hi / step + 1e-9).floor() as i64;
+        (first..=last).map(|k| k as f64 * step).collect()
+    };
+    steps
+        .map(|(step, extra)| (ticks(step), extra))
+        .min_by_key(|(t, extra)| (t.len().abs_diff(about) + extra, *extra, t.len()))
+        .map_or_else(|| vec![lo], |(t, _)| t)
+}
+
+/// 1, 2 and 5 x 10^k from `lo` to `hi` (`0 < lo < hi`) when they span at most three decades; powers of
+/// ten over more, every second, third... so that at most about [`TICKS`] + 2 remain.
+fn log_ticks(lo: f64, hi: f64) -> Vec<f64> {
+    let (first, last) = (lo.log10().floor() as i32, hi.log10().ceil() as i32);
+    let decades = last - first;
+    let within = |v: &f64| *v >= lo * (1.0 - 1e-9) && *v <= hi * (1.0 + 1e-9);
+    if decades <= 3 {
+        return (first..=last)
+            .flat_map(|k| [1.0, 2.0, 5.0].map(|m| m * 10f64.powi(k)))
+            .filter(within)
+            .collect();
+    }
+    let every = (decades as usize).div_ceil(TICKS + 1).max(1);
+    (first..=last)
+        .filter(|k| (k - first) as usize % every == 0)
+        .map(|k| 10f64.powi(k))
+        .filter(within)
+        .collect()
+}
+
+/// `v` with as few digits as give it back to 1e-9 relative: `0.025`, `1000`, exponents beyond 1e5 and
+/// under 1e-3 (`2.5e-5`).
+pub fn short_number(v: f64) -> String {
+    if v == 0.0 || !v.is_finite() {
+        return if v == 0.0 { "0".into() } else { v.to_string() };
+    }
+    let close = |s: &str| {
+        s.parse::<f64>()
+            .is_ok_and(|x| (x - v).abs() <= 1e-9 * v.abs())
+    };
+    let a = v.abs();
+    if (1e-3..1e5).contains(&a) {
+        (0..=9)
+            .map(|d| format!("{v:.d$}"))
+            .find(|s| close(s))
+            .unwrap_or_else(|| format!("{v:.9}"))
+    } else {
+        (0..=9)
+            .map(|d| format!("{v:.d$e}"))
+            .find(|s| close(s))
+            .unwrap_or_else(|| format!("{v:.9e}"))
+    }
+}
+
 /// Viridis at `t` in [0, 1].
 pub fn viridis(t: f64) -> [u8; 3] {
     let c = colorous::VIRIDIS.eval_continuous(t.clamp(0.0, 1.0));
@@ -185,6 +285,54 @@ pub fn viridis(t: f64) -> [u8; 3] {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The bar (0.01368 to 0.0389) gets ticks 0.015 to 0.035, 0.005 apart; other ranges get
+    /// 1, 2, 2.5 or 5 x 10^k steps, labels without spurious digits.
+    #[test]
+    fn ticks_fall_on_round_values() {
+        let labels =
+            |s: ColourScale| -> Vec<String> { s.ticks().into_iter().map(|t| t.label).collect() };
+        let linear = |lo, hi| ColourScale { lo, hi, log: false };
+        assert_eq!(
+            labels(linear(0.01368, 0.0389)),
+            ["0.015", "0.02", "0.025", "0.03", "0.035"]
+        );
+        assert_eq!(
+            labels(linear(0.0, 1.0)),
+            ["0", "0.2", "0.4", "0.6", "0.8", "1"]
+        );
+        assert_eq!(
+            labels(linear(4.674, 6.141)),
+            ["4.8", "5", "5.2", "5.4", "5.6", "5.8", "6"]
+        );
+        assert_eq!(labels(linear(0.0, 2.203)), ["0", "0.5", "1", "1.5", "2"]);
+        assert_eq!(labels(linear(-1.0, 1.0)), ["-1", "-0.5", "0", "0.5", "1"]);
+        assert_eq!(labels(linear(0.0, 11.0)), ["0", "2", "4", "6", "8", "10"]);
+        assert_eq!(
+            labels(linear(1e-5, 5.2e-5)),
+            ["1e-5", "2e-5", "3e-5", "4e-5", "5e-5"]
+        );
+        assert_eq!(
+            labels(linear(0.0, 1.2e6)),
+            ["0", "2e5", "4e5", "6e5", "8e5", "1e6", "1.2e6"]
+        );
+        let log = |lo, hi| ColourScale { lo, hi, log: true };
+        assert_eq!(labels(log(0.0118, 0.4888)), ["0.02", "0.05", "0.1", "0.2"]);
+        assert_eq!(labels(log(0.035, 0.05)), ["0.035", "0.04", "0.045", "0.05"]);
+        assert_eq!(
+            labels(log(1e-6, 10.0)),
+            ["1e-6", "1e-5", "1e-4", "0.001", "0.01", "0.1", "1", "10"]
+        );
+        assert_eq!(labels(log(1e-9, 1e9)).len(), 7);
+        for s in [linear(0.01368, 0.0389), log(0.0118, 0.4888)] {
+            for t in s.ticks() {
+                assert!(t.value >= s.lo && t.value <= s.hi, "{t:?} within {s:?}");
+            }
+        }
+        assert_eq!(short_number(0.1 + 0.2), "0.3");
+        assert_eq!(short_number(1234.0), "1234");
+        assert_eq!(short_number(2.5e-5), "2.5e-5");
+    }
 
     #[test]
     fn quantity_names_round_trip() {

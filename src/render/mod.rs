@@ -12,7 +12,7 @@ pub mod colour;
 pub mod image;
 pub mod ply;
 
-pub use camera::{default_camera, Camera, CameraError};
-pub use colour::{ColourScale, Quantity, NO_DATA};
+pub use camera::{default_camera, view_score, Camera, CameraError, ViewScore};
+pub use colour::{ColourScale, Quantity, Tick, NO_DATA};
 pub use image::{trace_view, PatchImage, Sample, BACKGROUND, BACK_SIDE};
 pub use ply::write_ply;

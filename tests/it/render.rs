@@ -76,3 +76,147 @@ fn a_camera_outside_a_room_sees_the_back_of_a_wall() {
     let s = samples(&scene, Some(inside));
     assert_eq!(count(&s, |x| matches!(x, Sample::Front { .. })), s.len());
 }
+
+/// The share of the samples that see a front side.
+fn front_share(s: &[Sample]) -> f64 {
+    count(s, |x| matches!(x, Sample::Front { .. })) as f64 / s.len() as f64
+}
+
+/// An axis-aligned rectangle at `at` on `axis`, spanning `u` and `v` on the next two axes (cyclic),
+/// its front facing `+axis` when `facing > 0`, as an OBJ face after the vertices so far.
+fn rectangle(obj: &mut String, axis: usize, at: f64, u: (f64, f64), v: (f64, f64), facing: f64) {
+    let mut corners = [(u.0, v.0), (u.1, v.0), (u.1, v.1), (u.0, v.1)];
+    if facing < 0.0 {
+        corners.reverse();
+    }
+    for (a, b) in corners {
+        let mut p = [0.0; 3];
+        p[axis] = at;
+        p[(axis + 1) % 3] = a;
+        p[(axis + 2) % 3] = b;
+        obj.push_str(&format!("v {} {} {}\n", p[0], p[1], p[2]));
+    }
+    obj.push_str("f -4 -3 -2 -1\n");
+}
+
+/// A room of 2 x 2 x 2 (x and z from -1 to 1, y from 0 to 2), walls facing in, open at +z like
+/// McGuire's Cornell boxes, with a tall block near the back wall (faces out).
+fn open_room() -> Scene {
+    let mut obj = String::new();
+    rectangle(&mut obj, 1, 0.0, (-1.0, 1.0), (-1.0, 1.0), 1.0); // floor: y, spans z then x
+    rectangle(&mut obj, 1, 2.0, (-1.0, 1.0), (-1.0, 1.0), -1.0);
+    rectangle(&mut obj, 2, -1.0, (-1.0, 1.0), (0.0, 2.0), 1.0); // back wall: z, spans x then y
+    rectangle(&mut obj, 0, -1.0, (0.0, 2.0), (-1.0, 1.0), 1.0); // side walls: x, spans y then z
+    rectangle(&mut obj, 0, 1.0, (0.0, 2.0), (-1.0, 1.0), -1.0);
+    let (x, y, z) = ((-0.7, -0.1), (0.0, 1.2), (-0.8, -0.2));
+    rectangle(&mut obj, 0, x.0, y, z, -1.0);
+    rectangle(&mut obj, 0, x.1, y, z, 1.0);
+    rectangle(&mut obj, 2, z.0, x, y, -1.0);
+    rectangle(&mut obj, 2, z.1, x, y, 1.0);
+    rectangle(&mut obj, 1, y.1, z, x, 1.0);
+    obj::load_text("open-room.obj", &obj, &|_| {
+        Err(obj::MtlError::other("no MTL"))
+    })
+    .unwrap()
+}
+
+/// The eye is inside the scene's bounds, or outside them on one side only (`open`, the axis and end
+/// of the opening), level with the bounds on the other two axes.
+fn eye_inside_or_at(scene: &Scene, eye: Point, open: Option<(usize, f64)>) -> bool {
+    let (lo, hi) = scene.vertices.iter().fold(
+        (Point::splat(f64::INFINITY), Point::splat(f64::NEG_INFINITY)),
+        |(lo, hi), v| (lo.min(*v), hi.max(*v)),
+    );
+    (0..3).all(|k| {
+        let within = (lo[k]..=hi[k]).contains(&eye[k]);
+        match open {
+            Some((axis, sign)) if axis == k => {
+                within || (eye[k] - 0.5 * (lo[k] + hi[k])) * sign > 0.0
+            }
+            _ => within,
+        }
+    })
+}
+
+#[test]
+fn the_default_view_of_a_room_open_on_one_side_looks_in_through_the_opening() {
+    let scene = open_room();
+    let tracer = make_tracer(Backend::Rust, &scene, Query::Single).unwrap();
+    let camera = default_camera(&scene, tracer.as_ref()).unwrap();
+    let s = samples(&scene, Some(camera));
+    let front = front_share(&s);
+    eprintln!("open room: eye {:?}, front share {front:.3}", camera.eye);
+    assert!(
+        eye_inside_or_at(&scene, camera.eye, Some((2, 1.0))),
+        "{camera:?}"
+    );
+    assert!(front > 0.8, "front share {front}");
+    assert_eq!(count(&s, |x| matches!(x, Sample::Back { .. })), 0);
+    // The floor, the ceiling, the back wall, both side walls and the block's front (patches 0 to 4
+    // and 8, in the order above) all show.
+    let seen: std::collections::BTreeSet<u32> = s.iter().filter_map(Sample::patch).collect();
+    assert!(
+        [0, 1, 2, 3, 4, 8].iter().all(|p| seen.contains(p)),
+        "{seen:?}"
+    );
+}
+
+/// McGuire's Cornell boxes (public, Morgan McGuire's Computer Graphics Archive), when a copy is under
+/// `../shared/real-scenes` or the folder `SCX_REAL_SCENES` names: both are open at +z.
+fn mcguire_boxes() -> Vec<std::path::PathBuf> {
+    let root = std::env::var_os("SCX_REAL_SCENES")
+        .map(std::path::PathBuf::from)
+        .unwrap_or_else(|| {
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/real-scenes")
+        });
+    let mut found = Vec::new();
+    let mut folders = vec![root];
+    while let Some(folder) = folders.pop() {
+        for entry in std::fs::read_dir(&folder).into_iter().flatten().flatten() {
+            let path = entry.path();
+            let name = path.file_name().unwrap().to_string_lossy().to_string();
+            if path.is_dir() {
+                folders.push(path);
+            } else if name == "CornellBox-Original.obj" || name == "CornellBox-Glossy.obj" {
+                found.push(path);
+            }
+        }
+    }
+    found.sort();
+    found
+}
+
+#[test]
+fn the_default_view_of_mcguires_cornell_boxes_shows_their_inside() {
+    let files = mcguire_boxes();
+    if files.is_empty() {
+        eprintln!(
+            "skipped: no CornellBox-Original.obj or CornellBox-Glossy.obj in the real scenes"
+        );
+        return;
+    }
+    for file in files {
+        let scene = scenes::load(file.to_str().unwrap()).unwrap();
+        let tracer = make_tracer(Backend::Rust, &scene, Query::Single).unwrap();
+        let camera = default_camera(&scene, tracer.as_ref()).unwrap();
+        let s = samples(&scene, Some(camera));
+        let front = front_share(&s);
+        let back = count(&s, |x| matches!(x, Sample::Back { .. }));
+        eprintln!(
+            "{}: eye {:?}, front share {front:.3}",
+            file.display(),
+            camera.eye
+        );
+        assert!(front > 0.8, "{}: front share {front}", file.display());
+        assert!(
+            back * 50 < s.len(),
+            "{}: {back} back-side samples",
+            file.display()
+        );
+        assert!(
+            eye_inside_or_at(&scene, camera.eye, Some((2, 1.0))),
+            "{}: {camera:?}",
+            file.display()
+        );
+    }
+}
