@@ -37,8 +37,7 @@ pub(crate) fn warnings(scene: &Scene, total: &Tally, enclosed: bool) -> Vec<RunW
         return Vec::new();
     }
     let front = front_seen(scene, total);
-    let mut inside_out = Vec::new();
-    let mut one_sided = Vec::new();
+    let (mut inside_out, mut one_sided, mut lights, mut solids) = (vec![], vec![], vec![], vec![]);
     for (k, s) in sides.iter().enumerate() {
         let reached = s.back_seen + front.all[k];
         if s.back_seen < MIN_BACK_SEGMENTS || (s.back_seen as f64) < BACK_SHARE * reached as f64 {
@@ -46,41 +45,112 @@ pub(crate) fn warnings(scene: &Scene, total: &Tally, enclosed: bool) -> Vec<RunW
         }
         if front.from_outside[k] as f64 * 100.0 < s.back_seen as f64 {
             inside_out.push(k);
+        } else if emits(scene, k) {
+            lights.push(k);
+        } else if is_closed(scene, k) {
+            solids.push(k);
         } else {
             one_sided.push(k);
         }
     }
     let mut out = Vec::new();
     if !inside_out.is_empty() {
-        out.push(RunWarning::new(
-            RunWarningKind::InsideOut,
-            format!(
-                "{}: normals face inwards: {} look(s) inside out: segments from front sides outside them \
-                 arrive at their back sides and are absorbed there, while their front sides are seen only \
-                 from inside them; try --flip-normals{}",
-                scene.name,
-                named(scene, sides, &inside_out),
-                names_argument(scene, &inside_out)
-            ),
-        )
-        .about(names(scene, &inside_out)));
+        out.push(
+            RunWarning::new(
+                RunWarningKind::InsideOut,
+                format!(
+                    "{}: normals face inwards: {} look(s) inside out: segments from front sides outside \
+                     them arrive at their back sides and are absorbed there, while their front sides are \
+                     seen only from inside them; try --flip-normals{}",
+                    scene.name,
+                    named(scene, sides, &inside_out),
+                    names_argument(scene, &inside_out)
+                ),
+            )
+            .about(names(scene, &inside_out)),
+        );
     }
     if !one_sided.is_empty() {
-        out.push(RunWarning::new(
-            RunWarningKind::OneSided,
-            format!(
-                "{}: one-sided surface(s) seen from behind: {}: segments from front sides arrive at \
-                 their back sides and are absorbed there (they count in their rows, as escapes do: the form \
-                 factors between the other surfaces stay right); if they are thin surfaces meant to be seen \
-                 from both sides, try --two-sided{}",
-                scene.name,
-                named(scene, sides, &one_sided),
-                names_argument(scene, &one_sided)
-            ),
-        )
-        .about(names(scene, &one_sided)));
+        out.push(
+            RunWarning::new(
+                RunWarningKind::OneSided,
+                format!(
+                    "{}: one-sided surface(s) seen from behind: {}: segments from front sides arrive at \
+                     their back sides and are absorbed there (they count in their rows, as escapes do: the \
+                     form factors between the other surfaces stay right). If they are thin surfaces meant \
+                     to be seen from both sides (a leaf, a sign, a single-polygon wall), try --two-sided{}; \
+                     if they are open solids standing on or cutting through another surface (a box without \
+                     a bottom on a floor that runs under it), the hidden part of that surface is what sees \
+                     their inside, and --two-sided would only add surfaces inside the solid",
+                    scene.name,
+                    named(scene, sides, &one_sided),
+                    names_argument(scene, &one_sided)
+                ),
+            )
+            .about(names(scene, &one_sided)),
+        );
+    }
+    if !lights.is_empty() {
+        out.push(
+            RunWarning::new(
+                RunWarningKind::LightSeenFromBehind,
+                format!(
+                    "{}: light(s) seen from behind: {}: segments from front sides arrive at their dark \
+                     back sides and are absorbed there, as at a lamp's housing (the form factors between \
+                     the other surfaces stay right); a light emits from its front side only, so do not make \
+                     it two-sided",
+                    scene.name,
+                    named(scene, sides, &lights)
+                ),
+            )
+            .about(names(scene, &lights)),
+        );
+    }
+    if !solids.is_empty() {
+        out.push(
+            RunWarning::new(
+                RunWarningKind::SeenInsideSolid,
+                format!(
+                    "{}: closed solid(s) seen from inside: {}: front sides inside them (objects inside or \
+                     cutting through them) see their back sides, and those segments are absorbed there; \
+                     --two-sided would add surfaces inside the solid: move or cut what lies inside it",
+                    scene.name,
+                    named(scene, sides, &solids)
+                ),
+            )
+            .about(names(scene, &solids)),
+        );
     }
     out
+}
+
+/// Whether any patch of object `k` emits (a light: seen from behind, its back is a housing, not a
+/// surface to make two-sided).
+fn emits(scene: &Scene, k: usize) -> bool {
+    scene
+        .patches
+        .iter()
+        .any(|p| p.object as usize == k && scene.materials[p.material as usize].emission > 0.0)
+}
+
+/// Whether object `k` is a closed surface: every edge of its triangles, its corners matched by
+/// position (so that meshes whose faces do not share vertex indices count too), is shared by exactly
+/// two of them.
+fn is_closed(scene: &Scene, k: usize) -> bool {
+    let mut edges: std::collections::HashMap<([u32; 3], [u32; 3]), u32> = Default::default();
+    let key = |v: u32| scene.positions[v as usize].map(f32::to_bits);
+    for p in scene.patches.iter().filter(|p| p.object as usize == k) {
+        let first = p.first_triangle as usize;
+        for t in &scene.triangles[first..first + p.triangle_count as usize] {
+            for e in 0..3 {
+                let (a, b) = (key(t[e]), key(t[(e + 1) % 3]));
+                *edges
+                    .entry(if a < b { (a, b) } else { (b, a) })
+                    .or_default() += 1;
+            }
+        }
+    }
+    !edges.is_empty() && edges.values().all(|&n| n == 2)
 }
 
 /// Pair ends on each object's front sides, in all and from other objects or open space.

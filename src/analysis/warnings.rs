@@ -23,6 +23,10 @@ pub enum RunWarningKind {
     InsideOut,
     /// One-sided surfaces seen from behind: segments from front sides arrive at their back sides.
     OneSided,
+    /// Lights seen from behind: their back sides are dark (never advised two-sided).
+    LightSeenFromBehind,
+    /// Closed solids whose back sides are seen from front sides inside them.
+    SeenInsideSolid,
 }
 
 impl RunWarningKind {
@@ -36,6 +40,8 @@ impl RunWarningKind {
             RunWarningKind::NoPairs => "no-pairs",
             RunWarningKind::InsideOut => "inside-out",
             RunWarningKind::OneSided => "one-sided",
+            RunWarningKind::LightSeenFromBehind => "light-seen-from-behind",
+            RunWarningKind::SeenInsideSolid => "seen-inside-solid",
         }
     }
 }

@@ -291,6 +291,7 @@ pub fn load_text_with(
             }
             check_used_materials(&shown, &mats, &models, &defined)?;
             warn_undefined_materials(&mut b, &shown, &prepared.usemtl, &mats);
+            warn_lights_in_other_conventions(&mut b, &shown, &mats);
             if mats.is_empty() {
                 None
             } else {
@@ -504,6 +505,37 @@ fn warn_ignored_statements(
              have no area"
         ));
     }
+}
+
+/// One warning naming the materials that look like lights in another convention than `Ke`: an ambient
+/// `Ka` above 1 (tinyobjloader's Cornell box marks its light with `Ka 20 20 20`) with no emission. scx
+/// reads emission from `Ke` only, so their faces do not emit, and the radiosity measures may then be left
+/// out ("nothing emits").
+fn warn_lights_in_other_conventions(b: &mut SceneBuilder, shown: &str, mats: &[tobj::Material]) {
+    let looks_lit = |m: &tobj::Material| {
+        let ambient = m.ambient.unwrap_or([0.0; 3]);
+        convert_material(m).emission == 0.0 && ambient.iter().any(|&a| a > 1.0)
+    };
+    let lit: Vec<&tobj::Material> = mats.iter().filter(|m| looks_lit(m)).collect();
+    if lit.is_empty() {
+        return;
+    }
+    let named: Vec<String> = lit
+        .iter()
+        .map(|m| {
+            let [r, g, bl] = m.ambient.unwrap_or([0.0; 3]);
+            format!("`{}` (Ka {r} {g} {bl})", m.name)
+        })
+        .collect();
+    b.warn(
+        SceneWarningKind::LightInOtherConvention,
+        format!(
+            "{shown}: material(s) {} have an ambient colour above 1, as some files mark lights, but no \
+             emission: scx takes emission from `Ke` only, so their faces do not emit; add `Ke r g b` to \
+             the library to make them lights",
+            named.join(", ")
+        ),
+    );
 }
 
 /// Faces of a tobj mesh (triangles when it gives no arities).

@@ -22,6 +22,8 @@ pub enum SceneWarningKind {
     UndefinedMaterials,
     /// Vertex weights of rational curves were ignored.
     VertexWeights,
+    /// Materials that look like lights in another convention (`Ka` above 1) but do not emit.
+    LightInOtherConvention,
     /// Any other reading problem.
     Other,
 }
@@ -39,6 +41,7 @@ impl SceneWarningKind {
             SceneWarningKind::MaterialLibrary => "material-library",
             SceneWarningKind::UndefinedMaterials => "undefined-materials",
             SceneWarningKind::VertexWeights => "vertex-weights",
+            SceneWarningKind::LightInOtherConvention => "light-in-other-convention",
             SceneWarningKind::Other => "scene",
         }
     }

@@ -318,6 +318,83 @@ fn one_sided_surfaces_are_diagnosed_and_made_two_sided() {
     assert!(touching(6) > 0 && touching(7) > 0);
 }
 
+/// Advice that keeps the scene's meaning: a light seen from behind (a lamp under the ceiling, whose back
+/// the ceiling sees) is said to be one, never advised two-sided (it would emit from its back); a closed
+/// solid whose inside is seen (a box holding another box) is said to be one, never advised two-sided
+/// either; only the open surface seen from behind (the sign) gets the `--two-sided` advice.
+#[test]
+fn lights_and_closed_solids_are_not_advised_two_sided() {
+    let dir = tempfile::tempdir().unwrap();
+    write(
+        dir.path(),
+        "lamp.mtl",
+        b"newmtl wall\nKd 0.5 0.5 0.5\nnewmtl lamp\nKd 0 0 0\nKe 5 5 5\n",
+    );
+    let mut obj = String::from("mtllib lamp.mtl\nusemtl wall\n");
+    obj.push_str(&boxes_obj(&[
+        ([0.0; 3], [4.0; 3], true, "room"),
+        ([0.5, 0.5, 0.5], [1.8, 1.8, 1.8], false, "crate"),
+        ([0.9, 0.9, 0.9], [1.4, 1.4, 1.4], false, "inner"),
+    ]));
+    // A lamp 0.1 below the ceiling, facing down; a one-sided sign facing +y, seen from behind.
+    obj.push_str(
+        "o lamp\nusemtl lamp\nv 1 1 3.9\nv 1 3 3.9\nv 3 3 3.9\nv 3 1 3.9\nf 25 26 27 28\n",
+    );
+    obj.push_str(
+        "o sign\nusemtl wall\nv 2.5 2 0.5\nv 3.5 2 0.5\nv 3.5 2 1.5\nv 2.5 2 1.5\nf 29 30 31 32\n",
+    );
+    let path = write(dir.path(), "lamp.obj", obj.as_bytes());
+    let a = run(
+        &load_file(&path, &SceneOptions::default()),
+        200_000,
+        1,
+        Measures::VISIBILITY,
+    );
+    let by_kind = |kind: RunWarningKind| a.warnings.iter().find(|w| w.kind == kind);
+    let light = by_kind(RunWarningKind::LightSeenFromBehind).expect("the lamp is named");
+    assert_eq!(light.objects, ["lamp"]);
+    assert!(
+        !light.message.contains("--two-sided lamp"),
+        "{}",
+        light.message
+    );
+    let solid = by_kind(RunWarningKind::SeenInsideSolid).expect("the crate is named");
+    assert_eq!(solid.objects, ["crate"]);
+    let sign = by_kind(RunWarningKind::OneSided).expect("the sign is named");
+    assert_eq!(sign.objects, ["sign"]);
+    assert!(
+        sign.message.contains("--two-sided sign"),
+        "{}",
+        sign.message
+    );
+    assert_eq!(a.warnings.len(), 3, "{:?}", kinds(&a));
+}
+
+/// A light marked as some files do, by an ambient `Ka` above 1 and no `Ke`, does not emit in scx, and
+/// the scene's warning says so, naming the material and its `Ka`.
+#[test]
+fn a_light_marked_by_ka_is_named() {
+    let dir = tempfile::tempdir().unwrap();
+    write(
+        dir.path(),
+        "ka.mtl",
+        b"newmtl wall\nKd 0.5 0.5 0.5\nnewmtl lamp\nKa 20 20 20\nKd 0.78 0.78 0.78\n",
+    );
+    let mut obj = String::from("mtllib ka.mtl\nusemtl lamp\n");
+    obj.push_str(&boxes_obj(&[([0.0; 3], [1.0; 3], true, "room")]));
+    let scene = load_file(
+        &write(dir.path(), "ka.obj", obj.as_bytes()),
+        &SceneOptions::default(),
+    );
+    assert!(scene.materials.iter().all(|m| m.emission == 0.0));
+    let w = scene
+        .warnings
+        .iter()
+        .find(|w| w.kind.code() == "light-in-other-convention")
+        .unwrap_or_else(|| panic!("{}", messages(&scene.warnings)));
+    assert!(w.message.contains("`lamp` (Ka 20 20 20)"), "{}", w.message);
+}
+
 /// glTF JSON with a buffer in a data URI: a unit quad's mesh placed by a node chain (parent translation,
 /// child scale 2 and a mirror in z), two materials (one double-sided and emitting with a strength).
 #[test]
