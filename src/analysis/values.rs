@@ -45,13 +45,34 @@ impl GroupValues {
             let (enclosed, areas) = t.enclosed(scene);
             return GroupValues {
                 environment_area: Some(t.environment_area(scene)),
-                ..GroupValues::plain(&areas, &enclosed, estimator, extrapolate)
+                ..GroupValues::plain(
+                    &areas,
+                    &enclosed,
+                    estimator,
+                    extrapolate,
+                    scene.patch_count(),
+                )
             };
         }
-        GroupValues::plain(&areas(scene), t, estimator, extrapolate)
+        GroupValues::plain(
+            &areas(scene),
+            t,
+            estimator,
+            extrapolate,
+            scene.patch_count(),
+        )
     }
 
-    fn plain(areas: &[f64], t: &Tally, estimator: EntropyEstimator, extrapolate: bool) -> Self {
+    /// The values of a tally over patches of `areas`, of which the first `scene_rows` are the scene's
+    /// own (the rest, the environment of an enclosed scene, is left out of the sampling report: its
+    /// row, huge in area and segments, would stand for the scene's rows in the area-weighted means).
+    fn plain(
+        areas: &[f64],
+        t: &Tally,
+        estimator: EntropyEstimator,
+        extrapolate: bool,
+        scene_rows: usize,
+    ) -> Self {
         let mut values = GroupValues {
             discrete: None,
             corrected: None,
@@ -74,9 +95,11 @@ impl GroupValues {
         let rows = Rows::gather(a, c, &lost, estimator);
         values.discrete = Some(visibility::discrete_from_rows(a, &rows.sums));
         values.corrected = Some(bias::corrected_from_rows(a, &rows, c, &lost));
-        values.sampling = Some(Sampling::of_rows(a, &rows.sums));
+        let own = scene_rows.min(a.len());
+        values.sampling = Some(Sampling::of_rows(&a[..own], &rows.sums[..own]));
         if extrapolate {
-            values.lines_factor = lines_factor_for_coverage(a, &rows.sums, COVERAGE_OK);
+            values.lines_factor =
+                lines_factor_for_coverage(&a[..own], &rows.sums[..own], COVERAGE_OK);
         }
         values
     }

@@ -508,7 +508,11 @@ pub fn table(run: &RunInfo, a: &Analysis) -> String {
             smp.sampling.rows,
             smp.sampling.coverage,
             100.0 * smp.sampling.singleton_share,
-            String::new()
+            if a.environment_area.is_some() {
+                " (the scene's own rows; the environment's row apart)"
+            } else {
+                ""
+            }
         );
     }
     if !a.is_complete() {

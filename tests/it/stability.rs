@@ -1101,6 +1101,33 @@ fn zero_area_triangles_are_dropped_with_a_warning() {
 const OPEN_BOX: &str = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nv 0 0 1\nv 1 0 1\nv 0 1 1\nv 1 1 1\n\
                         f 1 3 7 5\nf 2 6 8 4\nf 1 5 6 2\nf 3 4 8 7\nf 1 2 4 3\n";
 
+/// The sampling report of an enclosed scene is that of the scene's own rows: the same segments per row
+/// and coverage as the same lines without `--enclose` (an escape is a pair with the environment, one
+/// outcome either way), never the environment row's millions of segments standing for the scene's.
+#[test]
+fn enclosing_leaves_the_sampling_of_the_scenes_rows_alone() {
+    let scene = scenes::load("@cornell-open").unwrap();
+    let sampling = |enclose: bool| {
+        let cfg = RunSpec {
+            enclose,
+            ..RunSpec::new(200_000, 5)
+        };
+        let a = analyze(&scene, tracer(&scene).as_ref(), &cfg, &RunControl::default()).unwrap();
+        let report = a.sampling.expect("pairs were counted");
+        (report.sampling, report.lines_for_coverage)
+    };
+    let ((plain, plain_lines), (enclosed, enclosed_lines)) = (sampling(false), sampling(true));
+    assert_eq!(enclosed.rows, scene.patch_count());
+    assert!(
+        (enclosed.segments_per_row - plain.segments_per_row).abs() < 1e-9 * plain.segments_per_row,
+        "{} against {}",
+        enclosed.segments_per_row,
+        plain.segments_per_row
+    );
+    assert!((enclosed.coverage - plain.coverage).abs() < 1e-12);
+    assert_eq!(enclosed_lines, plain_lines);
+}
+
 /// The environment patch closes an open scene consistently.
 ///
 /// Expected, a cube object in open space (outward normals, side 1, bounding radius R = sqrt(3)/2): every
