@@ -87,17 +87,24 @@ fn read_libraries(folder: &Folder, mtl: &Path) -> Result<(String, String), MtlEr
 /// files written with another machine's paths) its base name there. `Err` is [`MtlError::missing`]
 /// when neither exists, else why it was not read.
 fn read_library(folder: &Folder, written: &str) -> Result<(String, String), MtlError> {
+    let shown = |name: &str| folder.shown(Path::new(name)).display().to_string();
     let as_written = match folder.fetch(Path::new(written)) {
         Ok(fetched) => return library_text(fetched),
+        Err(RefError::Missing(_)) => MtlErrorKind::Missing {
+            tried: vec![shown(written)],
+        },
         Err(e) => MtlErrorKind::refused(written, e),
     };
-    let Some(base) = read::base_name(written) else {
+    let Some(base) = read::base_name(written).filter(|&b| b != written) else {
         return Err(as_written.into());
     };
     match folder.fetch(Path::new(base)) {
         Ok(fetched) => library_text(fetched),
-        Err(RefError::Missing(_)) if matches!(as_written, MtlErrorKind::Missing) => {
-            Err(MtlErrorKind::Missing.into())
+        Err(RefError::Missing(_)) if matches!(as_written, MtlErrorKind::Missing { .. }) => {
+            Err(MtlErrorKind::Missing {
+                tried: vec![shown(written), shown(base)],
+            }
+            .into())
         }
         Err(RefError::Missing(_)) => Err(MtlErrorKind::NoBaseName {
             written: Box::new(as_written),
@@ -141,7 +148,7 @@ pub struct MtlError {
 impl MtlError {
     /// No library of that name exists.
     pub fn missing() -> Self {
-        MtlErrorKind::Missing.into()
+        MtlErrorKind::Missing { tried: Vec::new() }.into()
     }
 
     /// The library could not be read, for a reason of the source's own (its message is the reason).
@@ -151,16 +158,19 @@ impl MtlError {
 
     /// Whether no library of that name exists (not that one exists and was refused or unreadable).
     pub fn is_missing(&self) -> bool {
-        matches!(self.kind, MtlErrorKind::Missing)
+        matches!(self.kind, MtlErrorKind::Missing { .. })
     }
 }
 
 /// What kept an MTL library from being read.
 #[derive(Debug, thiserror::Error)]
 enum MtlErrorKind {
-    /// No such file (neither the name as written nor its base name); the warning has always said so.
-    #[error("cannot open the file")]
-    Missing,
+    /// No such file (neither the name as written nor its base name): the paths tried, when known.
+    #[error("{}", missing_text(tried))]
+    Missing {
+        /// The paths looked for, as shown in messages (empty: a source that did not say).
+        tried: Vec<String>,
+    },
     /// The reading policy keeps the name out of reach.
     #[error(transparent)]
     Outside(Escape),
@@ -200,13 +210,26 @@ impl MtlErrorKind {
     /// Why the library named `name` (as written) was not fetched.
     fn refused(name: &str, e: RefError) -> Self {
         match e {
-            RefError::Missing(_) => MtlErrorKind::Missing,
+            RefError::Missing(_) => MtlErrorKind::Missing { tried: Vec::new() },
             RefError::Outside(escape) => MtlErrorKind::Outside(escape),
             RefError::Unreadable(error) => MtlErrorKind::Unreadable {
                 name: name.to_string(),
                 error,
             },
         }
+    }
+}
+
+/// The reason of a missing library: the paths tried (as written, then its base name in the scene's
+/// folder), so that a user sees where scx looked.
+fn missing_text(tried: &[String]) -> String {
+    match tried {
+        [] => "cannot open the file".into(),
+        [one] => format!("no file `{one}`"),
+        [written, base] => {
+            format!("no file `{written}`, nor `{base}` (its base name in the scene's folder)")
+        }
+        more => format!("no file among {}", more.join(", ")),
     }
 }
 

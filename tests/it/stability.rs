@@ -1112,7 +1112,13 @@ fn enclosing_leaves_the_sampling_of_the_scenes_rows_alone() {
             enclose,
             ..RunSpec::new(200_000, 5)
         };
-        let a = analyze(&scene, tracer(&scene).as_ref(), &cfg, &RunControl::default()).unwrap();
+        let a = analyze(
+            &scene,
+            tracer(&scene).as_ref(),
+            &cfg,
+            &RunControl::default(),
+        )
+        .unwrap();
         let report = a.sampling.expect("pairs were counted");
         (report.sampling, report.lines_for_coverage)
     };
