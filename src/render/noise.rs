@@ -286,7 +286,7 @@ fn relative_error(p: &PatchResult, quantity: Quantity) -> Spread {
     };
     match stderr {
         Some(e) if value != 0.0 => Spread::Relative(e / value.abs()),
-        Some(e) if e == 0.0 => Spread::Zero,
+        Some(0.0) => Spread::Zero,
         Some(_) => Spread::Relative(f64::INFINITY),
         None => Spread::Unknown,
     }
@@ -374,7 +374,7 @@ mod tests {
         };
         assert!(s.is_noisy());
         assert_eq!(s.lines_needed(), Some(1.6e7));
-        let text = s.warning(&PatchMeasure::RowEntropy.info().label).unwrap();
+        let text = s.warning(PatchMeasure::RowEntropy.info().label).unwrap();
         assert_eq!(
             text,
             "the colours (row entropy H_i (plug-in)) are mostly noise at 1000000 lines: the values have a \
