@@ -196,7 +196,11 @@ fn no_pairs(scene: &Scene, total: &Tally) -> RunWarning {
     let fronts: Vec<usize> = (0..sides.len())
         .filter(|&k| sides[k].front_open > 0)
         .collect();
-    let diagnosis = if backs.is_empty() {
+    let diagnosis = if is_flat(scene) {
+        "every patch lies in one plane, and a flat surface sees nothing of itself from either side \
+         (--two-sided and --flip-normals cannot change that); there is no complexity to measure"
+            .to_string()
+    } else if backs.is_empty() {
         format!(
             "every line that meets the scene meets front sides from open space only, so the objects are \
              closed solids (or surfaces) seen from outside and no surface sees another. If {} is a room \
@@ -228,6 +232,20 @@ fn no_pairs(scene: &Scene, total: &Tally) -> RunWarning {
         ("escapes", c.escapes as f64),
         ("unpaired", c.unpaired as f64),
     ])
+}
+
+/// Whether every patch lies in one plane (tracing space: the unit bounding sphere, so the tolerance is
+/// relative to the scene's size).
+fn is_flat(scene: &Scene) -> bool {
+    const TOLERANCE: f64 = 1e-9;
+    let Some(first) = scene.patches.first() else {
+        return false;
+    };
+    let (n, d) = (first.normal, first.offset);
+    scene.patches.iter().all(|p| {
+        let cos = p.normal.dot(n);
+        (cos.abs() - 1.0).abs() < TOLERANCE && (p.offset * cos.signum() - d).abs() < TOLERANCE
+    })
 }
 
 /// The objects for a message, the most affected first: `name` (back sides met N times), ...

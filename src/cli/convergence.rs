@@ -6,13 +6,14 @@ use std::path::PathBuf;
 
 use clap::ValueEnum;
 use scene_complexity::Analysis;
+use scene_complexity::RunWarningKind;
 use scene_complexity::StopReason;
 use scene_complexity::{Estimate, Measure};
 use serde_json::json;
 
 use super::args::{parse_count, parse_whole_in, ReportOutput, RunOptions};
 use super::exit::{Exit, Failure};
-use super::output::{self, check_all, note};
+use super::output::{self, check_all, note, warn};
 use super::plot::{self, Curve, Series};
 use super::report;
 use super::runner::Runner;
@@ -150,6 +151,9 @@ pub fn run(args: &ConvergenceArgs) -> Result<Exit, Failure> {
         note("interrupted: reporting the runs finished so far");
     }
     let info = runner.info();
+    if let Some(message) = undefined_measures(&runner.scene.name, &levels) {
+        warn(&message);
+    }
     if let Some(path) = &args.csv {
         output::write_file(path, csv(&info, &levels).as_bytes())?;
     }
@@ -160,11 +164,16 @@ pub fn run(args: &ConvergenceArgs) -> Result<Exit, Failure> {
             runner.tracer.name(),
             runner.threads
         );
-        plot::write(path, &title, &curves(&levels)).map_err(|message| Failure {
-            code: Exit::Io,
-            message,
-        })?;
-        output::wrote(path);
+        let curves = curves(&levels);
+        if let Some(why) = empty_plot(&levels, &curves) {
+            note(&format!("no plot written: {}: {why}", path.display()));
+        } else {
+            plot::write(path, &title, &curves).map_err(|message| Failure {
+                code: Exit::Io,
+                message,
+            })?;
+            output::wrote(path);
+        }
     }
     let text = match args.format {
         ConvergenceFormat::Table => table(&info, &levels, args.repeats),
@@ -176,6 +185,65 @@ pub fn run(args: &ConvergenceArgs) -> Result<Exit, Failure> {
     } else {
         Exit::Ok
     })
+}
+
+/// The followed measures no run estimated.
+fn undefined(levels: &[Level]) -> Vec<Measure> {
+    followed()
+        .into_iter()
+        .filter(|&m| {
+            levels
+                .iter()
+                .flat_map(|l| l.runs.iter())
+                .all(|a| a.estimate(m).is_none())
+        })
+        .collect()
+}
+
+/// Which measures no run estimated, and why (the runs' `no-pairs` warning when they gave one);
+/// `None` when every measure has a value somewhere.
+fn undefined_measures(scene: &str, levels: &[Level]) -> Option<String> {
+    let undefined = undefined(levels);
+    if undefined.is_empty() || levels.is_empty() {
+        return None;
+    }
+    let symbols: Vec<&str> = undefined.iter().map(|m| m.info().symbol).collect();
+    let prefix = format!("{scene}: ");
+    let why = levels
+        .iter()
+        .flat_map(|l| l.runs.iter())
+        .flat_map(|a| a.warnings.iter())
+        .find(|w| w.kind == RunWarningKind::NoPairs)
+        .map(|w| {
+            w.message
+                .strip_prefix(&prefix)
+                .unwrap_or(&w.message)
+                .to_string()
+        })
+        .unwrap_or_else(|| "no run could estimate them".to_string());
+    Some(format!(
+        "{prefix}{} undefined at every line count: {why}",
+        symbols.join(", ")
+    ))
+}
+
+/// Why the plot would be empty (`None`: it has points).
+fn empty_plot(levels: &[Level], curves: &[Curve]) -> Option<&'static str> {
+    if curves.iter().any(|c| !c.points.is_empty()) {
+        return None;
+    }
+    let undefined = undefined(levels);
+    Some(
+        if followed()
+            .into_iter()
+            .filter(|&m| plotted(m))
+            .all(|m| undefined.contains(&m))
+        {
+            "every measure it would show is undefined"
+        } else {
+            "no measure it shows has a positive error at any line count"
+        },
+    )
 }
 
 /// Every run's `analyze --format csv` rows (which hold its seconds), with the repeat in front.

@@ -5,14 +5,17 @@
 //! * [`image`]: first-hit rays through the camera, traced by the run's own tracer, and the picture's
 //!   pixels (shaded by the viewing angle, back sides grey, patch outlines darkened);
 //! * [`colour`]: the quantities and the viridis colour scale;
-//! * [`ply`]: the mesh with a colour per patch.
+//! * [`ply`]: the mesh with a colour per patch;
+//! * [`noise`]: whether the colours are mostly noise, and the lines that would fix it.
 
 pub mod camera;
 pub mod colour;
 pub mod image;
+pub mod noise;
 pub mod ply;
 
 pub use camera::{default_camera, view_score, Camera, CameraError, ViewScore};
 pub use colour::{ColourScale, Quantity, Tick, NO_DATA};
 pub use image::{trace_view, PatchImage, Sample, BACKGROUND, BACK_SIDE};
-pub use ply::write_ply;
+pub use noise::{noise_summary, NoiseSummary};
+pub use ply::{write_ply, PlyFormat};

@@ -308,6 +308,42 @@ fn convergence_writes_a_table_a_csv_and_a_plot() {
     );
 }
 
+/// One flat quad sees nothing of itself: `convergence` names the undefined measures and says why (the
+/// `no-pairs` warning, which knows the scene is flat), writes no plot and says so, and exits 0.
+#[test]
+fn convergence_on_a_scene_with_undefined_measures_says_so_and_draws_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let quad = dir.path().join("quad.obj");
+    std::fs::write(&quad, "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n").unwrap();
+    let svg = dir.path().join("c.svg");
+    let out = scx(&[
+        "convergence",
+        quad.to_str().unwrap(),
+        "--lines",
+        "1e3,1e4",
+        "--plot",
+        svg.to_str().unwrap(),
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(0), "{err}");
+    assert!(
+        err.contains(
+            "quad.obj: I_s, I_s corrected, H_s, H_s corrected, I_s^c undefined at every line count: \
+             no line segment joined two patches"
+        ) && err.contains("every patch lies in one plane"),
+        "{err}"
+    );
+    assert!(
+        err.contains("no plot written:")
+            && err.contains("every measure it would show is undefined"),
+        "{err}"
+    );
+    assert!(!svg.exists(), "no empty plot");
+    let table = String::from_utf8_lossy(&out.stdout);
+    let rows: Vec<&str> = table.lines().filter(|l| l.contains(" - ")).collect();
+    assert_eq!(rows.len(), 2, "a row of - per line count: {table}");
+}
+
 /// With bundles the table says that the bias corrections assume independent lines (8 x 8 bundles moved
 /// the corrected I_s of `@cube:30` by 7.7 standard errors over 200 seeds: docs/performance.md, Bundles);
 /// without bundles, or without corrected values, it does not.

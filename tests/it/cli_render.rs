@@ -4,24 +4,34 @@
 use crate::support::scx;
 use scene_complexity::internals::scenes;
 
-/// A careful ASCII PLY reader for the files `scx render` writes: the header's elements and properties,
-/// then the vertices `(x, y, z, r, g, b)` and the faces `(indices, r, g, b, value)`.
+/// A careful PLY reader for the files `scx render` writes, ASCII or binary little-endian: the header's
+/// elements and properties, then the vertices `(x, y, z, r, g, b)` and the faces
+/// `(indices, r, g, b, value)`.
+#[derive(Debug, PartialEq)]
 struct Ply {
     vertices: Vec<([f64; 3], [u8; 3])>,
     faces: Vec<(Vec<usize>, [u8; 3], f64)>,
 }
 
-fn read_ply(text: &str) -> Ply {
-    let mut lines = text.lines();
+/// The header's format name and element counts, and the body's bytes.
+fn read_header(bytes: &[u8]) -> (String, usize, usize, &[u8]) {
+    let end = b"end_header\n";
+    let at = bytes
+        .windows(end.len())
+        .position(|w| w == end)
+        .expect("a header")
+        + end.len();
+    let header = std::str::from_utf8(&bytes[..at]).unwrap();
+    let mut lines = header.lines();
     assert_eq!(lines.next(), Some("ply"));
-    assert_eq!(lines.next(), Some("format ascii 1.0"));
-    let (mut n_vertices, mut n_faces) = (None, None);
+    let (mut format, mut n_vertices, mut n_faces) = (None, None, None);
     let mut properties: Vec<String> = Vec::new();
-    for line in lines.by_ref() {
+    for line in lines {
         let words: Vec<&str> = line.split_whitespace().collect();
         match words.as_slice() {
             ["end_header"] => break,
             ["comment", ..] => {}
+            ["format", f, "1.0"] => format = Some(f.to_string()),
             ["element", "vertex", n] => n_vertices = Some(n.parse::<usize>().unwrap()),
             ["element", "face", n] => n_faces = Some(n.parse::<usize>().unwrap()),
             ["property", ..] => properties.push(words[1..].join(" ")),
@@ -44,7 +54,29 @@ fn read_ply(text: &str) -> Ply {
             "double value"
         ]
     );
-    let (n_vertices, n_faces) = (n_vertices.unwrap(), n_faces.unwrap());
+    (
+        format.unwrap(),
+        n_vertices.unwrap(),
+        n_faces.unwrap(),
+        &bytes[at..],
+    )
+}
+
+fn read_ply(bytes: &[u8]) -> (String, Ply) {
+    let (format, n_vertices, n_faces, body) = read_header(bytes);
+    let ply = match format.as_str() {
+        "ascii" => read_ascii(std::str::from_utf8(body).unwrap(), n_vertices, n_faces),
+        "binary_little_endian" => read_binary(body, n_vertices, n_faces),
+        other => panic!("format {other}"),
+    };
+    for (idx, ..) in &ply.faces {
+        assert!(idx.iter().all(|&i| i < n_vertices));
+    }
+    (format, ply)
+}
+
+fn read_ascii(text: &str, n_vertices: usize, n_faces: usize) -> Ply {
+    let mut lines = text.lines();
     let mut vertices = Vec::new();
     for _ in 0..n_vertices {
         let w: Vec<&str> = lines.next().unwrap().split(' ').collect();
@@ -59,11 +91,43 @@ fn read_ply(text: &str) -> Ply {
         let k: usize = w[0].parse().unwrap();
         assert_eq!(w.len(), 1 + k + 4);
         let idx: Vec<usize> = w[1..=k].iter().map(|x| x.parse().unwrap()).collect();
-        assert!(idx.iter().all(|&i| i < n_vertices));
         let c = [k + 1, k + 2, k + 3].map(|i| w[i].parse::<u8>().unwrap());
         faces.push((idx, c, w[k + 4].parse::<f64>().unwrap()));
     }
     assert_eq!(lines.next(), None, "nothing after the faces");
+    Ply { vertices, faces }
+}
+
+/// Takes `n` bytes off the front of `body`.
+fn take<'a>(body: &mut &'a [u8], n: usize) -> &'a [u8] {
+    let (head, rest) = body.split_at(n);
+    *body = rest;
+    head
+}
+
+fn f64_of(body: &mut &[u8]) -> f64 {
+    f64::from_le_bytes(take(body, 8).try_into().unwrap())
+}
+
+fn rgb_of(body: &mut &[u8]) -> [u8; 3] {
+    take(body, 3).try_into().unwrap()
+}
+
+fn read_binary(mut body: &[u8], n_vertices: usize, n_faces: usize) -> Ply {
+    let body = &mut body;
+    let vertices = (0..n_vertices)
+        .map(|_| ([(); 3].map(|_| f64_of(body)), rgb_of(body)))
+        .collect();
+    let faces = (0..n_faces)
+        .map(|_| {
+            let k = take(body, 1)[0] as usize;
+            let idx = (0..k)
+                .map(|_| i32::from_le_bytes(take(body, 4).try_into().unwrap()) as usize)
+                .collect();
+            (idx, rgb_of(body), f64_of(body))
+        })
+        .collect();
+    assert!(body.is_empty(), "nothing after the faces");
     Ply { vertices, faces }
 }
 
@@ -107,7 +171,8 @@ fn render_writes_a_png_and_a_ply_that_parse() {
     assert!(colours.len() > 50, "{} colours", colours.len());
 
     let scene = scenes::load("@cornell:2").unwrap();
-    let mesh = read_ply(&std::fs::read_to_string(&ply).unwrap());
+    let (format, mesh) = read_ply(&std::fs::read(&ply).unwrap());
+    assert_eq!(format, "binary_little_endian", "binary by default");
     assert_eq!(mesh.faces.len(), scene.patch_count(), "one face per patch");
     for (p, (idx, colour, value)) in mesh.faces.iter().enumerate() {
         let polygon = &scene.patches[p].polygon;
@@ -161,6 +226,19 @@ fn bad_render_requests_fail_before_work() {
                 "segments",
                 "-o",
                 "x.png",
+                "--patches-mesh-format",
+                "ascii",
+            ],
+            "--patches-mesh",
+        ),
+        (
+            &[
+                "render",
+                "@cube:2",
+                "--color",
+                "segments",
+                "-o",
+                "x.png",
                 "--camera",
                 "0,0,0,0,0,0,0,1,0,60",
             ],
@@ -200,4 +278,90 @@ fn bad_render_requests_fail_before_work() {
         "/no/such/dir/x.png",
     ]);
     assert_eq!(out.status.code(), Some(3));
+}
+
+/// Renders `scene` at `lines` lines, coloured by I_s^c's terms, into `dir`, with `extra` arguments;
+/// returns the standard error.
+fn render(dir: &std::path::Path, scene: &str, lines: &str, extra: &[&str]) -> String {
+    let png = dir.join("p.png");
+    let mut args = vec![
+        "render",
+        scene,
+        "--color",
+        "continuous-mutual-information",
+        "--lines",
+        lines,
+        "--size",
+        "128x96",
+        "-o",
+        png.to_str().unwrap(),
+    ];
+    args.extend_from_slice(extra);
+    let out = scx(&args);
+    let err = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert!(out.status.success(), "{err}");
+    err
+}
+
+/// The binary PLY (the default) and the ASCII one (on request) hold the same vertices, faces, colours
+/// and values, and the binary one is smaller (on an icosphere, whose coordinates have many digits).
+#[test]
+fn the_patches_mesh_is_binary_by_default_and_ascii_on_request() {
+    let dir = tempfile::tempdir().unwrap();
+    let (bin, text) = (dir.path().join("b.ply"), dir.path().join("a.ply"));
+    let b = bin.to_str().unwrap();
+    render(dir.path(), "@sphere:2", "1e5", &["--patches-mesh", b]);
+    let a = text.to_str().unwrap();
+    let ascii = ["--patches-mesh", a, "--patches-mesh-format", "ascii"];
+    render(dir.path(), "@sphere:2", "1e5", &ascii);
+    let (bytes_b, bytes_a) = (std::fs::read(&bin).unwrap(), std::fs::read(&text).unwrap());
+    let (format_b, mesh_b) = read_ply(&bytes_b);
+    let (format_a, mesh_a) = read_ply(&bytes_a);
+    assert_eq!(
+        (format_b.as_str(), format_a.as_str()),
+        ("binary_little_endian", "ascii")
+    );
+    assert_eq!(mesh_b.faces.len(), 320);
+    assert_eq!(mesh_b.vertices.len(), 960);
+    assert_eq!(mesh_b, mesh_a, "the same mesh, colours and values");
+    assert!(
+        bytes_b.len() * 10 < bytes_a.len() * 8,
+        "binary {} bytes, ASCII {}",
+        bytes_b.len(),
+        bytes_a.len()
+    );
+}
+
+/// A fine mesh at few lines: the picture is noise, and the warning says how much and how many lines
+/// would fix it; a coarse mesh at many lines gets no such warning.
+#[test]
+fn render_warns_when_the_colours_are_mostly_noise() {
+    let dir = tempfile::tempdir().unwrap();
+    let err = render(dir.path(), "@cube:30", "2e4", &[]);
+    let warning = err
+        .lines()
+        .find(|l| l.contains("mostly noise"))
+        .unwrap_or_else(|| panic!("{err}"));
+    assert!(warning.starts_with("scx: warning: @cube:30: the colours (share of I_s^c"));
+    let number_before = |s: &str, end: &str| -> f64 {
+        let head = &s[..s.find(end).unwrap_or_else(|| panic!("{end}: {s}"))];
+        let word = head.split_whitespace().last().unwrap();
+        word.trim_matches(|c: char| !c.is_ascii_digit() && c != '.' && c != 'e')
+            .parse()
+            .unwrap()
+    };
+    let median = number_before(warning, "% (area-weighted)");
+    assert!((40.0..80.0).contains(&median), "{warning}");
+    let unsampled = number_before(warning, " of 5400 patches) has no value");
+    assert!((10.0..200.0).contains(&unsampled), "{warning}");
+    // 10% from the median: lines x (median / 10%)^2.
+    let lines = number_before(warning, " lines would bring the median error to 10%");
+    let expected = 2e4 * (median / 10.0).powi(2);
+    assert!(
+        (lines / expected - 1.0).abs() < 0.1,
+        "{lines} against {expected}: {warning}"
+    );
+
+    let err = render(dir.path(), "@cube:3", "1e6", &[]);
+    assert!(!err.contains("noise"), "{err}");
 }

@@ -220,3 +220,46 @@ fn the_default_view_of_mcguires_cornell_boxes_shows_their_inside() {
         );
     }
 }
+
+/// The noise summary of a picture's values: on `@cube:30` at few lines I_s^c's per-patch terms are
+/// noise and some patches unsampled; the median relative error falls as 1/sqrt(lines), so the lines it
+/// asks for hold from one line count to the next; `@cube:3` at 10^6 lines is not noisy.
+#[test]
+fn the_noise_summary_follows_the_square_root_law() {
+    use scene_complexity::internals::measure::PatchMeasure;
+    use scene_complexity::render::{noise_summary, Quantity};
+    use scene_complexity::{analyze, RunControl, RunSpec};
+    let summary = |spec: &str, lines: u64| {
+        let scene = scenes::load(spec).unwrap();
+        let tracer = make_tracer(Backend::Rust, &scene, Query::Single).unwrap();
+        let cfg = RunSpec {
+            per_patch: true,
+            ..RunSpec::new(lines, 3)
+        };
+        let a = analyze(&scene, tracer.as_ref(), &cfg, &RunControl::default()).unwrap();
+        let areas: Vec<f64> = scene.patches.iter().map(|p| p.area).collect();
+        let q = Quantity::Patch(PatchMeasure::ContinuousTerm);
+        noise_summary(a.patches.as_ref().unwrap(), &areas, q, lines)
+    };
+    let few = summary("@cube:30", 20_000);
+    let more = summary("@cube:30", 80_000);
+    assert!(few.is_noisy() && more.is_noisy());
+    assert_eq!(few.patches, 5400);
+    assert!(few.unsampled_patches > 10, "{few:?}");
+    assert!(
+        more.unsampled_patches < few.unsampled_patches / 4,
+        "{more:?}"
+    );
+    let (r1, r2) = (
+        few.median_relative_error.unwrap(),
+        more.median_relative_error.unwrap(),
+    );
+    assert!(r1 > 0.4 && r1 < 0.8, "{few:?}");
+    assert!((0.4..0.62).contains(&(r2 / r1)), "{r1} -> {r2}");
+    let (n1, n2) = (few.lines_needed().unwrap(), more.lines_needed().unwrap());
+    assert!((n1 / n2 - 1.0).abs() < 0.3, "{n1} against {n2}");
+    let coarse = summary("@cube:3", 1_000_000);
+    assert!(!coarse.is_noisy(), "{coarse:?}");
+    assert!(coarse.median_relative_error.unwrap() < 0.05, "{coarse:?}");
+    assert_eq!(coarse.unsampled_patches, 0);
+}
