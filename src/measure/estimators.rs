@@ -56,7 +56,7 @@ pub fn grassberger_g(n: f64) -> f64 {
 /// `A = 2 f2 / ((N-1) f1 + 2 f2)` (or its f2 = 0 form). Written as the tail `sum_{m>=1} x^m / (m + N - 1)`,
 /// `x = 1 - A`, which needs no cancellation: summed directly when it converges fast, otherwise from the
 /// complement, and, when both would take more than [`UNSEEN_TERMS`] terms (a row of millions of samples
-/// with few repeats, or a forged state), from its integral form ([`unseen_tail_of_long_rows`]): the
+/// with few repeats, or a forged state), from its integral form (`unseen_tail_of_long_rows`): the
 /// work per row is bounded whatever the counts.
 pub fn chao_wang_jost_unseen(n: f64, f1: f64, f2: f64) -> f64 {
     if f1 == 0.0 || n < 2.0 {

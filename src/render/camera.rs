@@ -179,9 +179,9 @@ impl ViewScore {
     }
 }
 
-/// Scores the view `camera` gives of `scene` on a small probe picture ([`PROBE`] samples, one ray
+/// Scores the view `camera` gives of `scene` on a small probe picture (`PROBE` samples, one ray
 /// each). A sample that sees a front side stands for the surface its pixel covers there (its solid
-/// angle x distance² / |cos|, the cosine at least [`GRAZING`]); a patch shows at most its own area.
+/// angle x distance² / |cos|, the cosine at least `GRAZING`); a patch shows at most its own area.
 pub fn view_score(
     scene: &Scene,
     tracer: &dyn Tracer,

@@ -198,7 +198,10 @@ fn bad_materials_are_errors_and_a_missing_library_a_warning() {
     );
     // The path looked for is named.
     let looked = dir.path().join("nowhere.mtl");
-    assert!(err.contains(&format!("no file `{}`", looked.display())), "{err}");
+    assert!(
+        err.contains(&format!("no file `{}`", looked.display())),
+        "{err}"
+    );
     let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(doc["patches"], 4);
     assert_eq!(doc["warnings"][0]["code"], "material-library");
@@ -206,7 +209,10 @@ fn bad_materials_are_errors_and_a_missing_library_a_warning() {
     let path = write(dir.path(), "moved.obj", obj("scenes/lib.mtl").as_bytes());
     let out = scx(&["analyze", &path, "--lines", "1000", "--tracer", "rust"]);
     let err = String::from_utf8_lossy(&out.stderr);
-    let (written, base) = (dir.path().join("scenes/lib.mtl"), dir.path().join("lib.mtl"));
+    let (written, base) = (
+        dir.path().join("scenes/lib.mtl"),
+        dir.path().join("lib.mtl"),
+    );
     assert!(
         err.contains(&format!(
             "no file `{}`, nor `{}` (its base name",
