@@ -157,7 +157,7 @@ pub fn run(args: &ConvergenceArgs) -> Result<Exit, Failure> {
         let title = format!(
             "{}: error against run time ({} tracer, {} thread(s))",
             runner.scene.name,
-            runner.tracer.name(),
+            runner.tracer().name(),
             runner.threads
         );
         plot::write(path, &title, &curves(&levels)).map_err(|message| Failure {

@@ -19,7 +19,7 @@ pub fn write_ply(
     values: &[Option<f64>],
     comment: &str,
 ) -> io::Result<()> {
-    let corners: usize = scene.patches.iter().map(|p| p.polygon.len()).sum();
+    let corners: usize = scene.patches.iter().map(|p| scene.polygon(p).len()).sum();
     writeln!(out, "ply")?;
     writeln!(out, "format ascii 1.0")?;
     for line in comment.lines() {
@@ -41,7 +41,7 @@ pub fn write_ply(
     writeln!(out, "end_header")?;
     for (p, patch) in scene.patches.iter().enumerate() {
         let [r, g, b] = colours[p];
-        for &v in &patch.polygon {
+        for &v in scene.polygon(patch) {
             let x = scene.vertices[v as usize];
             writeln!(out, "{} {} {} {r} {g} {b}", x.x, x.y, x.z)?;
         }
@@ -49,8 +49,8 @@ pub fn write_ply(
     let mut next = 0usize;
     for (p, patch) in scene.patches.iter().enumerate() {
         let [r, g, b] = colours[p];
-        write!(out, "{}", patch.polygon.len())?;
-        for _ in &patch.polygon {
+        write!(out, "{}", scene.polygon(patch).len())?;
+        for _ in scene.polygon(patch) {
             write!(out, " {next}")?;
             next += 1;
         }
