@@ -68,8 +68,9 @@ d = json.load(open(sys.argv[1]))
 kb, name, fmt, tracer = int(sys.argv[2]), sys.argv[3], sys.argv[4], sys.argv[5]
 tri = d["triangles"]
 rate = d["lines"] / d["seconds"] if d["seconds"] > 0 else float("nan")
-print(f"| {name} | {fmt} | {tri} | {tracer} | {kb / 1024:.0f} | {kb * 1024 / tri:.0f} | "
-      f"{d['build_seconds']:.2f} | {rate:.3g} |")
+build = d.get("build_seconds")  # absent from reports of scx before issue 29
+build = "-" if build is None else f"{build:.2f}"
+print(f"| {name} | {fmt} | {tri} | {tracer} | {kb / 1024:.0f} | {kb * 1024 / tri:.0f} | {build} | {rate:.3g} |")
 EOF
 }
 run "$base.ply" "binary PLY" rust

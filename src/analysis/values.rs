@@ -245,8 +245,9 @@ fn jackknife_replicates(
 }
 
 /// Scenes with at most this many patches evaluate their groups' rows in parallel. Each evaluation holds
-/// a row of sums per patch (some hundred bytes each): one evaluation per thread at once would make a
-/// scene of millions of patches need that many times the memory, more than its scene and run together.
+/// a row of sums per patch (about a hundred bytes each, with its vectors): one evaluation per thread at
+/// once would make a scene of millions of patches need that many times the memory, more than its scene
+/// and run together.
 const PARALLEL_ROWS_MAX_PATCHES: usize = 1 << 16;
 
 /// Whether the groups' rows of `scene` are evaluated in parallel ([`PARALLEL_ROWS_MAX_PATCHES`]); the
