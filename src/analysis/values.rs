@@ -154,10 +154,17 @@ pub(super) fn visibility_estimates(
     wanted: Wanted,
 ) -> VisibilityOfRun {
     let values_of = |t: &Tally| GroupValues::of(scene, t, estimator, enclose, false);
-    let (all, per_group): (GroupValues, Vec<GroupValues>) = rayon::join(
-        || GroupValues::of(scene, &run.total, estimator, enclose, true),
-        || run.groups.par_iter().map(values_of).collect(),
-    );
+    let (all, per_group): (GroupValues, Vec<GroupValues>) = if rows_in_parallel(scene) {
+        rayon::join(
+            || GroupValues::of(scene, &run.total, estimator, enclose, true),
+            || run.groups.par_iter().map(values_of).collect(),
+        )
+    } else {
+        (
+            GroupValues::of(scene, &run.total, estimator, enclose, true),
+            run.groups.iter().map(values_of).collect(),
+        )
+    };
     // Below the coverage of an ok verdict the bias changes no verdict: the replicates cost only then.
     let covered = all.sampling.is_some_and(|s| s.coverage >= COVERAGE_OK);
     let replicates = (jackknife || (replicable && covered))
@@ -235,27 +242,41 @@ fn jackknife_replicates(
     let a = a.as_slice()?;
     let total_lost = total.lost_by_patch();
     let rows = Rows::gather(a, total_counts, &total_lost, estimator);
-    groups
-        .par_iter()
-        .map(|g| {
-            let counts = g.counts.as_ref()?;
-            let group_lost = g.lost_by_patch();
-            let left = rows.without_group(a, (total_counts, &total_lost), (counts, &group_lost));
-            Some(GroupValues {
-                discrete: Some(visibility::discrete_from_rows(a, &left.sums)),
-                // The counts are read only by Chao–Shen, excluded by the caller.
-                corrected: Some(bias::corrected_from_rows(a, &left, counts, &group_lost)),
-                continuous: ContinuousValues::from_sum(
-                    total.counters.cmi_sum.minus(g.counters.cmi_sum).value(),
-                    total.counters.cmi_pairs - g.counters.cmi_pairs,
-                    lost(&total.counters) - lost(&g.counters),
-                ),
-                environment_area: None,
-                sampling: None,
-                lines_factor: None,
-            })
+    let replicate = |g: &Tally| {
+        let counts = g.counts.as_ref()?;
+        let group_lost = g.lost_by_patch();
+        let left = rows.without_group(a, (total_counts, &total_lost), (counts, &group_lost));
+        Some(GroupValues {
+            discrete: Some(visibility::discrete_from_rows(a, &left.sums)),
+            // The counts are read only by Chao–Shen, excluded by the caller.
+            corrected: Some(bias::corrected_from_rows(a, &left, counts, &group_lost)),
+            continuous: ContinuousValues::from_sum(
+                total.counters.cmi_sum.minus(g.counters.cmi_sum).value(),
+                total.counters.cmi_pairs - g.counters.cmi_pairs,
+                lost(&total.counters) - lost(&g.counters),
+            ),
+            environment_area: None,
+            sampling: None,
+            lines_factor: None,
         })
-        .collect()
+    };
+    if rows_in_parallel(scene) {
+        groups.par_iter().map(replicate).collect()
+    } else {
+        groups.iter().map(replicate).collect()
+    }
+}
+
+/// Scenes with at most this many patches evaluate their groups' rows in parallel. Each evaluation holds
+/// a row of sums per patch (about a hundred bytes each, with its vectors): one evaluation per thread at
+/// once would make a scene of millions of patches need that many times the memory, more than its scene
+/// and run together.
+const PARALLEL_ROWS_MAX_PATCHES: usize = 1 << 16;
+
+/// Whether the groups' rows of `scene` are evaluated in parallel ([`PARALLEL_ROWS_MAX_PATCHES`]); the
+/// values are the same either way.
+fn rows_in_parallel(scene: &Scene) -> bool {
+    scene.patch_count() <= PARALLEL_ROWS_MAX_PATCHES
 }
 
 /// The estimates of a run in which no segment joined two patches: only the positional entropy (exact,

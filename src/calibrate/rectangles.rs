@@ -53,8 +53,8 @@ impl AxisRect {
     /// The rectangle of a patch whose polygon is an axis-aligned rectangle (scene units); `None` when it
     /// is not one.
     pub fn of_patch(scene: &Scene, p: usize) -> Option<AxisRect> {
-        let pts: Vec<[f64; 3]> = scene.patches[p]
-            .polygon
+        let pts: Vec<[f64; 3]> = scene
+            .polygon(&scene.patches[p])
             .iter()
             .map(|&v| scene.vertices[v as usize].to_array())
             .collect();

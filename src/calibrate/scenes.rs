@@ -194,7 +194,7 @@ fn flipped_cube(name: &str, n: usize) -> Result<Scene, SceneError> {
     }
     let ids: Vec<u32> = cube.vertices.iter().map(|&v| b.vertex(v)).collect();
     for (k, p) in cube.patches.iter().enumerate() {
-        let mut corners: Vec<u32> = p.polygon.iter().map(|&v| ids[v as usize]).collect();
+        let mut corners: Vec<u32> = cube.polygon(p).iter().map(|&v| ids[v as usize]).collect();
         if on_flipped_face(k, n) {
             corners.reverse();
         }

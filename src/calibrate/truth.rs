@@ -412,8 +412,8 @@ fn patch_triangles(scene: &Scene) -> Vec<Vec<Triangle>> {
         .patches
         .iter()
         .map(|p| {
-            let c: Vec<_> = p
-                .polygon
+            let c: Vec<_> = scene
+                .polygon(p)
                 .iter()
                 .map(|&v| scene.vertices[v as usize])
                 .collect();

@@ -357,7 +357,7 @@ pub fn run(args: &AnalyzeArgs) -> Result<Exit, Failure> {
     check_patch_files(args)?;
     let _locks = output::lock_states(save.into_iter().chain(checkpoint))?;
     let Prepared {
-        runner,
+        mut runner,
         identity,
         mut state,
         seconds: before,
@@ -387,7 +387,7 @@ pub fn run(args: &AnalyzeArgs) -> Result<Exit, Failure> {
         .in_pool(total, "", || {
             cast(
                 &runner.scene,
-                runner.tracer.as_ref(),
+                runner.tracer(),
                 &cfg,
                 &mut state,
                 CastOptions {
@@ -403,6 +403,7 @@ pub fn run(args: &AnalyzeArgs) -> Result<Exit, Failure> {
             message: e.to_string(),
         })?;
     let seconds = checkpoints.seconds();
+    runner.release_tracer();
     // The state's bytes are taken now (the analysis consumes the state) and saved after the report, so
     // that a save that fails never costs the report of the finished work.
     let saves: Vec<&Path> = save.into_iter().chain(checkpoint).collect();

@@ -161,7 +161,7 @@ pub fn run(args: &ConvergenceArgs) -> Result<Exit, Failure> {
         let title = format!(
             "{}: error against run time ({} tracer, {} thread(s))",
             runner.scene.name,
-            runner.tracer.name(),
+            runner.tracer().name(),
             runner.threads
         );
         let curves = curves(&levels);

@@ -229,7 +229,7 @@ pub fn run(args: &RenderArgs) -> Result<Exit, Failure> {
     let colours: Vec<[u8; 3]> = values.iter().map(|&v| scale.colour(v)).collect();
     let camera = match args.camera {
         Some(c) => c,
-        None => default_camera(scene, runner.tracer.as_ref()).map_err(tracer_failure)?,
+        None => default_camera(scene, runner.tracer()).map_err(tracer_failure)?,
     };
     let (w, h) = args.size;
     let image = runner
@@ -237,7 +237,7 @@ pub fn run(args: &RenderArgs) -> Result<Exit, Failure> {
         .install(|| {
             trace_view(
                 scene,
-                runner.tracer.as_ref(),
+                runner.tracer(),
                 &camera,
                 w * SUPERSAMPLING,
                 h * SUPERSAMPLING,

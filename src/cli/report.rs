@@ -49,6 +49,8 @@ pub struct RunInfo<'a> {
     pub scene: &'a Scene,
     pub tracing: Tracing,
     pub threads: usize,
+    /// How long building the tracer's acceleration structure took, in seconds.
+    pub build_seconds: f64,
     /// The shard, when the run was one.
     pub shard: Option<Shard>,
 }
@@ -219,6 +221,7 @@ pub fn json(run: &RunInfo, a: &Analysis) -> String {
             "degrees_of_freedom": a.groups.saturating_sub(1),
         }),
         "seconds": a.seconds,
+        "build_seconds": run.build_seconds,
         "stop_reason": a.stop_reason.name(),
         "interrupted": a.stop_reason == StopReason::Interrupted,
         "complete": a.is_complete(),

@@ -15,11 +15,14 @@ use super::{progress, report};
 /// A scene with its tracer and thread pool, ready to run analyses.
 pub struct Runner {
     pub scene: Scene,
-    pub tracer: Box<dyn Tracer>,
+    /// `None` once released ([`Runner::release_tracer`]).
+    tracer: Option<Box<dyn Tracer>>,
     pub pool: rayon::ThreadPool,
     pub threads: usize,
     /// The backend and query the tracer was built with.
     pub tracing: Tracing,
+    /// How long building the tracer's acceleration structure took, in seconds.
+    pub build_seconds: f64,
     pub control: Arc<RunControl>,
 }
 
@@ -43,17 +46,20 @@ impl Runner {
         threads: Option<usize>,
     ) -> Result<Runner, Failure> {
         let scene = load_scene(name, options, policy)?;
+        let building = std::time::Instant::now();
         let tracer =
             make_tracer(tracing.backend, &scene, tracing.query).map_err(Failure::bad_input)?;
+        let build_seconds = building.elapsed().as_secs_f64();
         let (threads, pool) = thread_pool(threads)?;
         let control = Arc::new(RunControl::default());
         watch_ctrl_c(&control);
         Ok(Runner {
             scene,
-            tracer,
+            tracer: Some(tracer),
             pool,
             threads,
             tracing,
+            build_seconds,
             control,
         })
     }
@@ -77,9 +83,25 @@ impl Runner {
     ) -> Result<Analysis, Failure> {
         progress::while_running(&self.control, total, label, || {
             self.pool
-                .install(|| analyze(&self.scene, self.tracer.as_ref(), cfg, &self.control))
+                .install(|| analyze(&self.scene, self.tracer(), cfg, &self.control))
         })
         .map_err(Failure::of)
+    }
+
+    /// The scene's tracer.
+    ///
+    /// # Panics
+    /// When it was released ([`Runner::release_tracer`]).
+    pub fn tracer(&self) -> &dyn Tracer {
+        self.tracer
+            .as_deref()
+            .expect("the tracer is used only before it is released")
+    }
+
+    /// Frees the tracer once no more lines will be cast: on a large scene its acceleration structure
+    /// is a good part of the memory, which the measures then need.
+    pub fn release_tracer(&mut self) {
+        self.tracer = None;
     }
 
     /// Facts about the run for the reports.
@@ -88,6 +110,7 @@ impl Runner {
             scene: &self.scene,
             tracing: self.tracing,
             threads: self.threads,
+            build_seconds: self.build_seconds,
             shard: None,
         }
     }

@@ -58,7 +58,7 @@ impl Mesh {
         let ids: Vec<u32> = scene.vertices.iter().map(|&p| mesh.vertex(p)).collect();
         for p in &scene.patches {
             mesh.elements.push(Element {
-                corners: p.polygon.iter().map(|&v| ids[v as usize]).collect(),
+                corners: scene.polygon(p).iter().map(|&v| ids[v as usize]).collect(),
                 material: p.material,
                 object: p.object,
             });

@@ -118,8 +118,8 @@ pub fn trace_view(
 
 /// The centroid of a patch's corners in tracing space.
 fn centroid(scene: &Scene, patch: usize) -> crate::geom::Point {
-    let corners: Vec<crate::geom::Point> = scene.patches[patch]
-        .polygon
+    let corners: Vec<crate::geom::Point> = scene
+        .polygon(&scene.patches[patch])
         .iter()
         .map(|&v| crate::geom::DVec3::from_array(scene.positions[v as usize].map(f64::from)))
         .collect();

@@ -56,7 +56,7 @@ fn write_header(
     comment: &str,
     format: PlyFormat,
 ) -> io::Result<()> {
-    let corners: usize = scene.patches.iter().map(|p| p.polygon.len()).sum();
+    let corners: usize = scene.patches.iter().map(|p| scene.polygon(p).len()).sum();
     writeln!(out, "ply")?;
     writeln!(out, "format {} 1.0", format.header_name())?;
     for line in comment.lines() {
@@ -86,7 +86,7 @@ fn write_ascii_body(
 ) -> io::Result<()> {
     for (p, patch) in scene.patches.iter().enumerate() {
         let [r, g, b] = colours[p];
-        for &v in &patch.polygon {
+        for &v in scene.polygon(patch) {
             let x = scene.vertices[v as usize];
             writeln!(out, "{} {} {} {r} {g} {b}", x.x, x.y, x.z)?;
         }
@@ -94,8 +94,8 @@ fn write_ascii_body(
     let mut next = 0usize;
     for (p, patch) in scene.patches.iter().enumerate() {
         let [r, g, b] = colours[p];
-        write!(out, "{}", patch.polygon.len())?;
-        for _ in &patch.polygon {
+        write!(out, "{}", scene.polygon(patch).len())?;
+        for _ in scene.polygon(patch) {
             write!(out, " {next}")?;
             next += 1;
         }

@@ -82,22 +82,63 @@ pub struct SceneBuilder {
     vertices: Vec<Point>,
     weld: HashMap<[u64; 3], u32>,
     polygons: Vec<Polygon>,
+    /// Every polygon's corners, one after the other ([`Polygon::corners`]): one list rather than one per
+    /// polygon, as a scene of millions of triangles would spend more on the lists' own keeping than on
+    /// their corners.
+    corners: Vec<u32>,
+    /// Every polygon's origin text, one after the other ([`Polygon::origin`]), for the same reason.
+    origins: String,
     materials: Vec<Material>,
     objects: Vec<String>,
     current_object: Option<u32>,
     warnings: Vec<SceneWarning>,
 }
 
-#[derive(Clone, Debug)]
+#[derive(Clone, Copy, Debug)]
 struct Polygon {
-    vertices: Vec<u32>,
+    /// Where its corners start in the builder's `corners`.
+    start: usize,
+    /// How many corners it has.
+    len: usize,
     material: u32,
     object: u32,
     sides: Sides,
-    /// Where it came from, for messages (`face 12`, `line 40`).
-    origin: String,
+    /// Where its origin text starts in the builder's `origins`, and its length: where it came from, for
+    /// messages (`face 12`, `line 40`).
+    origin_start: usize,
+    origin_len: usize,
     /// Whether it is the back side of a two-sided polygon (the reverse of the one before it).
     back: bool,
+}
+
+impl Polygon {
+    fn corners<'a>(&self, corners: &'a [u32]) -> &'a [u32] {
+        &corners[self.start..self.start + self.len]
+    }
+
+    /// Where it came from, for messages (the back side of a two-sided polygon says so).
+    fn origin<'a>(&self, origins: &'a str) -> Origin<'a> {
+        Origin {
+            text: &origins[self.origin_start..self.origin_start + self.origin_len],
+            back: self.back,
+        }
+    }
+}
+
+/// A polygon's origin as messages show it.
+struct Origin<'a> {
+    text: &'a str,
+    back: bool,
+}
+
+impl std::fmt::Display for Origin<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.text)?;
+        if self.back {
+            f.write_str(" (back side)")?;
+        }
+        Ok(())
+    }
 }
 
 /// The polygons split because they were not planar, for the one warning about them.
@@ -121,6 +162,8 @@ impl SceneBuilder {
             vertices: Vec::new(),
             weld: HashMap::new(),
             polygons: Vec::new(),
+            corners: Vec::new(),
+            origins: String::new(),
             materials: Vec::new(),
             objects: Vec::new(),
             current_object: None,
@@ -188,14 +231,19 @@ impl SceneBuilder {
         sides: Sides,
     ) {
         let object = self.current_object();
+        let origin = origin.into();
         self.polygons.push(Polygon {
-            vertices: vertices.to_vec(),
+            start: self.corners.len(),
+            len: vertices.len(),
             material,
             object,
             sides,
-            origin: origin.into(),
+            origin_start: self.origins.len(),
+            origin_len: origin.len(),
             back: false,
         });
+        self.corners.extend_from_slice(vertices);
+        self.origins.push_str(&origin);
     }
 
     /// Records a non-fatal problem to report with the scene.
@@ -224,10 +272,18 @@ impl SceneBuilder {
             let name = self.name.clone();
             self.object(&name);
         }
+        // The weld table is done with once every vertex is in; a large scene needs its memory for what
+        // follows.
+        self.weld = HashMap::new();
         self.check_finite()?;
         let flip = self.chosen_objects(&options.flip_normals, "--flip-normals")?;
         let two_sided = self.chosen_objects(&options.two_sided, "--two-sided")?;
-        self.polygons = sided_polygons(std::mem::take(&mut self.polygons), &flip, &two_sided);
+        self.polygons = sided_polygons(
+            std::mem::take(&mut self.polygons),
+            &mut self.corners,
+            &flip,
+            &two_sided,
+        );
         let normalization = self.normalization()?;
         let traced: Vec<Point> = self
             .vertices
@@ -237,10 +293,20 @@ impl SceneBuilder {
 
         // Vertices that round to the same f32 point are one vertex for the tracers: weld them, so that
         // triangles meeting there share the index (the hit rules merge a crossing of a shared vertex).
-        let remap = weld_f32(&traced, &mut self.polygons);
-        drop_duplicates(&self.name, &mut self.polygons, &mut self.warnings);
+        let remap = weld_f32(&traced, &self.polygons, &mut self.corners);
+        drop_duplicates(
+            &self.name,
+            &mut self.polygons,
+            &self.corners,
+            &self.origins,
+            &mut self.warnings,
+        );
         let vertices: Vec<Point> = remap.iter().map(|&v| self.vertices[v as usize]).collect();
-        let traced: Vec<Point> = remap.iter().map(|&v| traced[v as usize]).collect();
+        self.vertices = Vec::new();
+        let traced_all = traced;
+        let traced: Vec<Point> = remap.iter().map(|&v| traced_all[v as usize]).collect();
+        drop(traced_all);
+        drop(remap);
 
         let mut scene = Scene {
             name: self.name.clone(),
@@ -248,6 +314,7 @@ impl SceneBuilder {
             vertices,
             triangles: Vec::new(),
             triangle_patch: Vec::new(),
+            corners: Vec::new(),
             patches: Vec::new(),
             materials: std::mem::take(&mut self.materials),
             objects: std::mem::take(&mut self.objects),
@@ -256,41 +323,42 @@ impl SceneBuilder {
             warnings: std::mem::take(&mut self.warnings),
         };
         let mut dropped_triangles = 0usize;
-        let mut dropped_polygons = Vec::new();
+        // How many polygons were dropped, and the first of them.
+        let mut dropped_polygons = (0usize, None::<String>);
         let mut splits = Splits::default();
         for poly in &self.polygons {
-            if poly.vertices.len() < 3 {
+            let origin = poly.origin(&self.origins);
+            let poly_corners = poly.corners(&self.corners);
+            if poly.len < 3 {
                 return Err(self.geometry_error(format!(
-                    "{}: a face needs at least 3 vertices, it has {}",
-                    poly.origin,
-                    poly.vertices.len()
+                    "{origin}: a face needs at least 3 vertices, it has {}",
+                    poly.len
                 )));
             }
             if poly.material as usize >= scene.materials.len() {
                 return Err(self.geometry_error(format!(
-                    "{}: material index {} out of range",
-                    poly.origin, poly.material
+                    "{origin}: material index {} out of range",
+                    poly.material
                 )));
             }
-            let pts: Vec<Point> = poly.vertices.iter().map(|&v| traced[v as usize]).collect();
+            let pts: Vec<Point> = poly_corners.iter().map(|&v| traced[v as usize]).collect();
             let deviation = planarity_deviation(&pts);
             let created = if deviation > options.planarity.tolerance {
                 if options.planarity.strict {
                     return Err(self.geometry_error(format!(
-                        "{}: non-planar polygon with {} vertices: a vertex is {deviation:.3e} of the \
-                         face's size off its plane (tolerance {:e}); triangulate it, or leave \
+                        "{origin}: non-planar polygon with {} vertices: a vertex is {deviation:.3e} of \
+                         the face's size off its plane (tolerance {:e}); triangulate it, or leave \
                          --strict-planarity out to have it split into planar triangles",
-                        poly.origin,
                         pts.len(),
                         options.planarity.tolerance
                     )));
                 }
                 let pieces = planar_pieces(&pts)
-                    .map_err(|e| self.geometry_error(format!("{}: {e}", poly.origin)))?;
-                splits.add(poly, deviation, pieces.len());
+                    .map_err(|e| self.geometry_error(format!("{origin}: {e}")))?;
+                splits.add(poly, &origin, deviation, pieces.len());
                 let mut any = false;
                 for piece in pieces {
-                    let corners = piece.map(|k| poly.vertices[k]);
+                    let corners = piece.map(|k| poly_corners[k]);
                     any |= add_patch(
                         &mut scene,
                         &traced,
@@ -302,21 +370,41 @@ impl SceneBuilder {
                 }
                 any
             } else {
-                let triangles = triangulate(&pts)
-                    .map_err(|e| self.geometry_error(format!("{}: {e}", poly.origin)))?;
+                let triangles =
+                    triangulate(&pts).map_err(|e| self.geometry_error(format!("{origin}: {e}")))?;
                 add_patch(
                     &mut scene,
                     &traced,
                     poly,
-                    &poly.vertices,
+                    poly_corners,
                     &triangles,
                     &mut dropped_triangles,
                 )
             };
             if !created {
-                dropped_polygons.push(poly.origin.clone());
+                dropped_polygons.0 += 1;
+                dropped_polygons.1.get_or_insert_with(|| origin.to_string());
             }
         }
+        // Patches address their corners and triangles with 32-bit offsets.
+        if scene.corners.len() > u32::MAX as usize || scene.triangles.len() > u32::MAX as usize {
+            return Err(self.geometry_error(format!(
+                "{} polygon corners and {} triangles: more than the {} scx can address",
+                scene.corners.len(),
+                scene.triangles.len(),
+                u32::MAX
+            )));
+        }
+        // The polygons are patches now. Their vectors grew by doubling: a large scene keeps them for
+        // the whole run, so they give back what they overshot, after the polygons made room.
+        drop(traced);
+        self.polygons = Vec::new();
+        self.corners = Vec::new();
+        self.origins = String::new();
+        scene.triangles.shrink_to_fit();
+        scene.triangle_patch.shrink_to_fit();
+        scene.patches.shrink_to_fit();
+        scene.corners.shrink_to_fit();
         if let Some(w) = splits.warning(&self.name, options.planarity.tolerance, &scene.objects) {
             scene.warnings.push(w);
         }
@@ -332,19 +420,17 @@ impl SceneBuilder {
                 .warnings
                 .push(w.with_numbers(&[("triangles", dropped_triangles as f64)]));
         }
-        if !dropped_polygons.is_empty() {
+        if let (count, Some(first)) = dropped_polygons {
             let w = SceneWarning::new(
                 SceneWarningKind::ZeroAreaFaces,
                 format!(
-                    "{}: dropped {} zero-area face(s), first: {}",
+                    "{}: dropped {count} zero-area face(s), first: {first}",
                     self.name,
-                    dropped_polygons.len(),
-                    dropped_polygons[0]
                 ),
             );
             scene
                 .warnings
-                .push(w.with_numbers(&[("faces", dropped_polygons.len() as f64)]));
+                .push(w.with_numbers(&[("faces", count as f64)]));
         }
         if scene.patches.is_empty() {
             return Err(self.geometry_error("the scene has no faces of non-zero area".into()));
@@ -398,14 +484,14 @@ impl SceneBuilder {
 
     fn check_finite(&self) -> Result<(), SceneError> {
         for poly in &self.polygons {
-            for &v in &poly.vertices {
+            for &v in poly.corners(&self.corners) {
+                let origin = poly.origin(&self.origins);
                 let p = self.vertices.get(v as usize).ok_or_else(|| {
-                    self.geometry_error(format!("{}: vertex index {v} out of range", poly.origin))
+                    self.geometry_error(format!("{origin}: vertex index {v} out of range"))
                 })?;
                 if !p.is_finite() {
                     return Err(self.geometry_error(format!(
-                        "{}: vertex {} has a non-finite coordinate ({}, {}, {})",
-                        poly.origin,
+                        "{origin}: vertex {} has a non-finite coordinate ({}, {}, {})",
                         v + 1,
                         p.x,
                         p.y,
@@ -419,27 +505,28 @@ impl SceneBuilder {
 
     /// Centre of the bounding box of the used vertices, and the largest distance from it.
     fn normalization(&self) -> Result<Normalization, SceneError> {
-        let used: Vec<Point> = self
-            .polygons
-            .iter()
-            .flat_map(|p| p.vertices.iter().map(|&v| self.vertices[v as usize]))
-            .collect();
-        if used.is_empty() {
+        // The used vertices, each as often as a corner names it (twice over them, rather than a list of
+        // them all: a large scene needs the memory).
+        let used = || {
+            self.polygons.iter().flat_map(|p| {
+                p.corners(&self.corners)
+                    .iter()
+                    .map(|&v| self.vertices[v as usize])
+            })
+        };
+        if used().next().is_none() {
             return Err(self.geometry_error("the scene is empty: no faces".into()));
         }
         let mut lo = Point::INFINITY;
         let mut hi = Point::NEG_INFINITY;
-        for p in &used {
+        for p in used() {
             for a in 0..3 {
                 lo[a] = lo[a].min(p[a]);
                 hi[a] = hi[a].max(p[a]);
             }
         }
         let center = 0.5 * (lo + hi);
-        let radius = used
-            .iter()
-            .map(|&p| (p - center).length())
-            .fold(0.0f64, f64::max);
+        let radius = used().map(|p| (p - center).length()).fold(0.0f64, f64::max);
         if !radius.is_finite() {
             // Each coordinate is finite (checked before), but the extent is beyond f64's range.
             return Err(self.geometry_error(format!(
@@ -463,12 +550,12 @@ impl SceneBuilder {
 
 /// Renumbers vertices so that those with equal f32 tracing positions become one, rewriting the polygons;
 /// returns, for each new vertex, the old vertex it stands for (unused vertices are dropped).
-fn weld_f32(traced: &[Point], polygons: &mut [Polygon]) -> Vec<u32> {
+fn weld_f32(traced: &[Point], polygons: &[Polygon], corners: &mut [u32]) -> Vec<u32> {
     let mut by_position: HashMap<[u32; 3], u32> = HashMap::new();
     let mut new_of_old: Vec<Option<u32>> = vec![None; traced.len()];
     let mut old_of_new: Vec<u32> = Vec::new();
-    for poly in polygons.iter_mut() {
-        for v in poly.vertices.iter_mut() {
+    for poly in polygons {
+        for v in corners[poly.start..poly.start + poly.len].iter_mut() {
             let old = *v as usize;
             let new = *new_of_old[old].get_or_insert_with(|| {
                 let key = traced[old].to_array().map(|c| ((c as f32) + 0.0).to_bits());
@@ -487,21 +574,38 @@ fn weld_f32(traced: &[Point], polygons: &mut [Polygon]) -> Vec<u32> {
 /// coincide with it and face the same way, so they could never be seen (of overlapping faces the first
 /// in the scene is the one seen, see `sample::order`). The same corners in the opposite order are the
 /// two sides of a thin panel, which stay.
-fn drop_duplicates(name: &str, polygons: &mut Vec<Polygon>, warnings: &mut Vec<SceneWarning>) {
-    let mut seen: HashMap<Vec<u32>, usize> = HashMap::new();
+fn drop_duplicates(
+    name: &str,
+    polygons: &mut Vec<Polygon>,
+    corners: &[u32],
+    origins: &str,
+    warnings: &mut Vec<SceneWarning>,
+) {
+    // Each polygon's corners from its lowest, all in one list (keys of their own would cost a large
+    // scene more than their corners).
+    let mut rotated: Vec<u32> = Vec::with_capacity(polygons.iter().map(|p| p.len).sum());
+    for poly in polygons.iter() {
+        let v = poly.corners(corners);
+        if let Some(lowest) = (0..v.len()).min_by_key(|&i| v[i]) {
+            rotated.extend((0..v.len()).map(|i| v[(lowest + i) % v.len()]));
+        }
+    }
+    let mut seen: HashMap<&[u32], usize> = HashMap::with_capacity(polygons.len());
     let mut duplicates = Vec::new();
+    let mut at = 0;
     for (k, poly) in polygons.iter().enumerate() {
-        let v = &poly.vertices;
-        let Some(lowest) = (0..v.len()).min_by_key(|&i| v[i]) else {
+        if poly.len == 0 {
             continue;
-        };
-        let key: Vec<u32> = (0..v.len()).map(|i| v[(lowest + i) % v.len()]).collect();
-        if let Some(&first) = seen.get(&key) {
+        }
+        let key = &rotated[at..at + poly.len];
+        at += poly.len;
+        if let Some(&first) = seen.get(key) {
             duplicates.push((first, k));
         } else {
             seen.insert(key, k);
         }
     }
+    drop(seen);
     let Some(&(first, again)) = duplicates.first() else {
         return;
     };
@@ -509,8 +613,8 @@ fn drop_duplicates(name: &str, polygons: &mut Vec<Polygon>, warnings: &mut Vec<S
         "{name}: dropped {} face(s) repeating an earlier face (same corners, facing the same way: never \
          seen), first: {} repeats {}",
         duplicates.len(),
-        polygons[again].origin,
-        polygons[first].origin
+        polygons[again].origin(origins),
+        polygons[first].origin(origins)
     );
     warnings.push(
         SceneWarning::new(SceneWarningKind::DuplicateFaces, message)
@@ -530,19 +634,35 @@ fn to_tracing_space(p: Point, n: &Normalization) -> Point {
 
 /// The polygons with flipped objects' corners reversed, and each two-sided polygon followed by its
 /// reverse (the back side as a patch of its own).
-fn sided_polygons(polygons: Vec<Polygon>, flip: &[bool], two_sided: &[bool]) -> Vec<Polygon> {
-    let mut out = Vec::with_capacity(polygons.len());
-    for mut poly in polygons {
+fn sided_polygons(
+    polygons: Vec<Polygon>,
+    corners: &mut Vec<u32>,
+    flip: &[bool],
+    two_sided: &[bool],
+) -> Vec<Polygon> {
+    let backs = polygons
+        .iter()
+        .filter(|p| p.sides == Sides::Both || two_sided[p.object as usize])
+        .count();
+    if backs == 0 && !flip.contains(&true) {
+        return polygons;
+    }
+    let mut out = Vec::with_capacity(polygons.len() + backs);
+    for poly in polygons {
+        let range = poly.start..poly.start + poly.len;
         if flip[poly.object as usize] {
-            reverse_corners(&mut poly.vertices);
+            reverse_corners(&mut corners[range.clone()]);
         }
         let both = poly.sides == Sides::Both || two_sided[poly.object as usize];
         let back = both.then(|| {
-            let mut back = poly.clone();
-            reverse_corners(&mut back.vertices);
-            back.origin = format!("{} (back side)", poly.origin);
-            back.back = true;
-            back
+            let start = corners.len();
+            corners.extend_from_within(range);
+            reverse_corners(&mut corners[start..]);
+            Polygon {
+                start,
+                back: true,
+                ..poly
+            }
         });
         out.push(poly);
         out.extend(back);
@@ -604,18 +724,19 @@ fn add_patch(
         object: poly.object,
         first_triangle: first,
         triangle_count: count,
-        polygon: corners.to_vec(),
+        first_corner: scene.corners.len() as u32,
+        corner_count: corners.len() as u32,
     });
+    scene.corners.extend_from_slice(corners);
     true
 }
 
 impl Splits {
-    fn add(&mut self, poly: &Polygon, deviation: f64, pieces: usize) {
+    fn add(&mut self, poly: &Polygon, origin: &Origin<'_>, deviation: f64, pieces: usize) {
         if poly.back {
             self.back_pieces += pieces;
             return;
         }
-        let origin = &poly.origin;
         self.objects.insert(poly.object);
         self.count += 1;
         self.pieces += pieces;

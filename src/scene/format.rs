@@ -182,7 +182,15 @@ fn load_detected(
         })?;
         return obj::load_obj_text(shown, &text, folder, options);
     }
-    load_format(format, shown, &bytes, path, folder, options)
+    // A single-object file is read whole before its scene is built: the file's bytes can go first, as a
+    // large scene needs the memory to build.
+    let builder = match format {
+        Format::Ply => ply::read_bytes(shown, &bytes, path)?,
+        Format::StlAscii | Format::StlBinary => stl::read_bytes(shown, &bytes, path)?,
+        _ => return load_format(format, shown, &bytes, path, folder, options),
+    };
+    drop(bytes);
+    builder.build_with(options)
 }
 
 /// Loads bytes as `format`.

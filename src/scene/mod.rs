@@ -130,8 +130,10 @@ pub struct Patch {
     pub first_triangle: u32,
     /// How many triangles the patch has.
     pub triangle_count: u32,
-    /// The polygon's vertices (indices into [`Scene::vertices`]), in order, front side counter-clockwise.
-    pub polygon: Vec<u32>,
+    /// Where the polygon's vertices start in [`Scene::corners`] ([`Scene::polygon`]).
+    pub first_corner: u32,
+    /// How many vertices the polygon has.
+    pub corner_count: u32,
 }
 
 /// The object name of a single-object file (PLY, STL): its name without the extension.
@@ -163,6 +165,9 @@ pub struct Scene {
     pub triangles: Vec<[u32; 3]>,
     /// The patch of each triangle.
     pub triangle_patch: Vec<u32>,
+    /// The patches' polygons one after the other (see [`Scene::polygon`]): one list for all, as a list
+    /// per patch would take a scene of millions of patches more memory than its corners.
+    pub corners: Vec<u32>,
     /// The patches.
     pub patches: Vec<Patch>,
     /// The materials patches refer to.
@@ -179,6 +184,13 @@ pub struct Scene {
 }
 
 impl Scene {
+    /// A patch's polygon: its vertices (indices into [`Scene::vertices`]), in order, front side
+    /// counter-clockwise.
+    pub fn polygon(&self, patch: &Patch) -> &[u32] {
+        let start = patch.first_corner as usize;
+        &self.corners[start..start + patch.corner_count as usize]
+    }
+
     /// Number of patches `n_p`.
     pub fn patch_count(&self) -> usize {
         self.patches.len()

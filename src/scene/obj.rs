@@ -676,7 +676,11 @@ pub fn to_text(scene: &Scene, mtl_name: &str) -> (String, String) {
             let _ = writeln!(obj, "usemtl {}", material_label(k, &scene.materials[k]));
             current = Some(p.material);
         }
-        let idx: Vec<String> = p.polygon.iter().map(|v| (v + 1).to_string()).collect();
+        let idx: Vec<String> = scene
+            .polygon(p)
+            .iter()
+            .map(|v| (v + 1).to_string())
+            .collect();
         let _ = writeln!(obj, "f {}", idx.join(" "));
     }
     (obj, mtl)

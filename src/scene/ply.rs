@@ -15,7 +15,7 @@
 use std::path::Path;
 
 use ply_rs_bw::parser::Parser;
-use ply_rs_bw::ply::{DefaultElement, ElementDef, Property, PropertyType};
+use ply_rs_bw::ply::{ElementDef, Property, PropertyAccess, PropertyType};
 
 use super::{Material, Scene, SceneBuilder, SceneError, SceneOptions};
 
@@ -38,13 +38,22 @@ pub(crate) fn load_bytes(
     path: &Path,
     options: &SceneOptions,
 ) -> Result<Scene, SceneError> {
+    read_bytes(shown, bytes, path)?.build_with(options)
+}
+
+/// The scene of PLY bytes read from `path`, ready to build: the bytes may go before it is built.
+pub(crate) fn read_bytes(
+    shown: &str,
+    bytes: &[u8],
+    path: &Path,
+) -> Result<SceneBuilder, SceneError> {
     let file_error = |message: String| SceneError::in_file(shown, message);
     let mut cursor = std::io::Cursor::new(bytes);
-    let ply = Parser::<DefaultElement>::new()
+    let ply = Parser::<Item>::new()
         .read_ply(&mut cursor)
         .map_err(|e| file_error(format!("not a readable PLY file: {e}")))?;
     let vertices = ply.payload.get("vertex").map(Vec::as_slice).unwrap_or(&[]);
-    let sources: Vec<(&str, Kind, &[DefaultElement])> = ply
+    let sources: Vec<(&str, Kind, &[Item])> = ply
         .header
         .elements
         .values()
@@ -62,28 +71,29 @@ pub(crate) fn load_bytes(
     b.object(&super::object_name(path));
     let mut ids = Vec::with_capacity(vertices.len());
     for (k, v) in vertices.iter().enumerate() {
-        let coordinate = |name: &str| {
-            v.get(name).and_then(number).ok_or_else(|| {
+        let coordinate = |axis: usize| {
+            let given = v.xyz_given & (1 << axis) != 0;
+            given.then_some(v.xyz[axis]).ok_or_else(|| {
                 file_error(format!(
-                    "vertex {k}: no number `{name}` (x, y and z are needed)"
+                    "vertex {k}: no number `{}` (x, y and z are needed)",
+                    ["x", "y", "z"][axis]
                 ))
             })
         };
-        ids.push(b.vertex([coordinate("x")?, coordinate("y")?, coordinate("z")?]));
+        ids.push(b.vertex([coordinate(0)?, coordinate(1)?, coordinate(2)?]));
     }
     let mut materials = Materials::default();
     for (element, kind, items) in sources {
         for (k, item) in items.iter().enumerate() {
             let at = |message: String| file_error(format!("{element} {k}: {message}"));
-            let indices = INDEX_LISTS
-                .iter()
-                .find_map(|name| item.get(*name))
-                .and_then(index_list)
+            let indices = item
+                .indices
+                .as_deref()
                 .ok_or_else(|| at("no list `vertex_indices`".into()))?;
             let material = materials.of(&mut b, item);
             match kind {
                 Kind::Faces => {
-                    let corners = corners(&indices, &ids).map_err(at)?;
+                    let corners = corners(indices, &ids).map_err(at)?;
                     if corners.len() < 3 {
                         return Err(at(format!(
                             "a face needs at least 3 vertices, it has {}",
@@ -93,7 +103,7 @@ pub(crate) fn load_bytes(
                     b.polygon(&corners, material, format!("{element} {k}"));
                 }
                 Kind::Strips => {
-                    for (t, triangle) in strip_triangles(&indices).into_iter().enumerate() {
+                    for (t, triangle) in strip_triangles(indices).into_iter().enumerate() {
                         let corners = corners(&triangle, &ids).map_err(at)?;
                         b.polygon(&corners, material, format!("{element} {k} triangle {t}"));
                     }
@@ -101,7 +111,56 @@ pub(crate) fn load_bytes(
             }
         }
     }
-    b.build_with(options)
+    Ok(b)
+}
+
+/// What scx reads of one item of any element: the coordinates of a vertex, the index list and colour of a
+/// face or strip. Kept this small (rather than ply-rs-bw's map of every property by name) because a
+/// large file has millions of items, all in memory until the last one is read.
+struct Item {
+    /// `x`, `y`, `z`: those given as numbers have their bit in `xyz_given` (an `Option` each would make
+    /// every item 24 bytes larger).
+    xyz: [f64; 3],
+    xyz_given: u8,
+    /// The first of [`INDEX_LISTS`] given (its rank there) and its values when it is a list of integers.
+    indices_rank: u8,
+    indices: Option<Box<[i64]>>,
+    /// `red`, `green`, `blue` as reflectance (see [`face_colour`]), when any channel is given.
+    colour: Option<Box<[Option<f64>; 3]>>,
+}
+
+impl PropertyAccess for Item {
+    fn new() -> Self {
+        Item {
+            xyz: [0.0; 3],
+            xyz_given: 0,
+            indices_rank: u8::MAX,
+            indices: None,
+            colour: None,
+        }
+    }
+
+    fn set_property(&mut self, name: &str, property: Property) {
+        if let Some(axis) = ["x", "y", "z"].iter().position(|&a| a == name) {
+            match number(&property) {
+                Some(v) => {
+                    self.xyz[axis] = v;
+                    self.xyz_given |= 1 << axis;
+                }
+                None => self.xyz_given &= !(1 << axis),
+            }
+        } else if let Some(rank) = INDEX_LISTS.iter().position(|&l| l == name) {
+            // The first name of the list given wins, whatever the order of the properties.
+            let rank = rank as u8;
+            if rank <= self.indices_rank {
+                self.indices_rank = rank;
+                self.indices = index_list(&property).map(Vec::into_boxed_slice);
+            }
+        } else if let Some(channel) = ["red", "green", "blue"].iter().position(|&c| c == name) {
+            let colour = self.colour.get_or_insert_with(|| Box::new([None; 3]));
+            colour[channel] = channel_value(&property);
+        }
+    }
 }
 
 /// Whether an element holds faces, strips, or neither: `vertex` never does; `tristrips` (or
@@ -190,7 +249,7 @@ struct Materials {
 
 impl Materials {
     /// The material of a face (or strip), added to the builder the first time it is met.
-    fn of(&mut self, b: &mut SceneBuilder, item: &DefaultElement) -> u32 {
+    fn of(&mut self, b: &mut SceneBuilder, item: &Item) -> u32 {
         let Some(rgb) = face_colour(item) else {
             return *self
                 .default
@@ -235,16 +294,18 @@ fn index_list(p: &Property) -> Option<Vec<i64>> {
 }
 
 /// A face's colour as reflectance in [0, 1]: integer channels are 0-255, float channels 0-1.
-fn face_colour(f: &DefaultElement) -> Option<[f64; 3]> {
-    let channel = |name: &str| {
-        let p = f.get(name)?;
-        let v = number(p)?;
-        Some(match p {
-            Property::Float(_) | Property::Double(_) => v,
-            _ => v / 255.0,
-        })
-    };
-    Some([channel("red")?, channel("green")?, channel("blue")?])
+fn face_colour(f: &Item) -> Option<[f64; 3]> {
+    let [r, g, b] = **f.colour.as_ref()?;
+    Some([r?, g?, b?])
+}
+
+/// A colour channel as reflectance (see [`face_colour`]).
+fn channel_value(p: &Property) -> Option<f64> {
+    let v = number(p)?;
+    Some(match p {
+        Property::Float(_) | Property::Double(_) => v,
+        _ => v / 255.0,
+    })
 }
 
 /// A scene as binary little-endian PLY (see the module's documentation): every vertex as f64 `x`, `y`,
@@ -255,7 +316,7 @@ pub fn to_bytes(scene: &Scene) -> Vec<u8> {
     let wide = scene
         .patches
         .iter()
-        .any(|p| p.polygon.len() > usize::from(u8::MAX));
+        .any(|p| scene.polygon(p).len() > usize::from(u8::MAX));
     let count_type = if wide { "uint" } else { "uchar" };
     let mut out = format!(
         "ply\nformat binary_little_endian 1.0\ncomment written by scx {}: {} patches\n\
@@ -275,13 +336,13 @@ pub fn to_bytes(scene: &Scene) -> Vec<u8> {
     }
     for p in &scene.patches {
         // A polygon has at most u32::MAX corners: its corners are u32 vertex indices of one scene.
-        let n = p.polygon.len() as u32;
+        let n = scene.polygon(p).len() as u32;
         if wide {
             out.extend_from_slice(&n.to_le_bytes());
         } else {
             out.push(n as u8);
         }
-        for v in &p.polygon {
+        for v in scene.polygon(p) {
             out.extend_from_slice(&v.to_le_bytes());
         }
         for c in scene.materials[p.material as usize].reflectance_rgb {

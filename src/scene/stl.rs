@@ -18,6 +18,15 @@ pub(crate) fn load_bytes(
     path: &Path,
     options: &SceneOptions,
 ) -> Result<Scene, SceneError> {
+    read_bytes(shown, bytes, path)?.build_with(options)
+}
+
+/// The scene of STL bytes read from `path`, ready to build: the bytes may go before it is built.
+pub(crate) fn read_bytes(
+    shown: &str,
+    bytes: &[u8],
+    path: &Path,
+) -> Result<SceneBuilder, SceneError> {
     let file_error = |message: String| SceneError::in_file(shown, message);
     // A binary STL's 80-byte header is free text, and some exporters start it with `solid`, which
     // stl_io would take for the ASCII form: hide the word from it (the header carries no geometry).
@@ -41,7 +50,7 @@ pub(crate) fn load_bytes(
         let corners = t.vertices.map(|v| b.vertex(v.0.map(f64::from)));
         b.polygon(&corners, material, format!("triangle {}", k + 1));
     }
-    b.build_with(options)
+    Ok(b)
 }
 
 /// Whether bytes are a binary STL by their size: an 80-byte header, a triangle count, and 50 bytes per

@@ -180,7 +180,7 @@ fn rebuild(scene: &Scene, options: &SceneOptions) -> Result<Scene, SceneError> {
     let ids: Vec<u32> = scene.vertices.iter().map(|&v| b.vertex(v)).collect();
     for (k, p) in scene.patches.iter().enumerate() {
         b.object(&scene.objects[p.object as usize]);
-        let corners: Vec<u32> = p.polygon.iter().map(|&v| ids[v as usize]).collect();
+        let corners: Vec<u32> = scene.polygon(p).iter().map(|&v| ids[v as usize]).collect();
         b.polygon(&corners, p.material, format!("patch {k}"));
     }
     b.build_with(options)

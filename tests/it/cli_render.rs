@@ -175,7 +175,7 @@ fn render_writes_a_png_and_a_ply_that_parse() {
     assert_eq!(format, "binary_little_endian", "binary by default");
     assert_eq!(mesh.faces.len(), scene.patch_count(), "one face per patch");
     for (p, (idx, colour, value)) in mesh.faces.iter().enumerate() {
-        let polygon = &scene.patches[p].polygon;
+        let polygon = scene.polygon(&scene.patches[p]);
         assert_eq!(idx.len(), polygon.len());
         for (&i, &v) in idx.iter().zip(polygon) {
             let (x, c) = mesh.vertices[i];

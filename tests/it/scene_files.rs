@@ -60,7 +60,7 @@ fn a_slightly_non_planar_quad_becomes_two_planar_triangles() {
     let exact = 0.5 + 0.5 * (1.0 + 2.0 * h * h).sqrt();
     assert!((scene.total_area_scene_units() - exact).abs() < 1e-12);
     for p in &scene.patches {
-        assert_eq!(p.polygon.len(), 3);
+        assert_eq!(scene.polygon(p).len(), 3);
         assert_eq!(scene.objects[p.object as usize], "bent");
     }
     let warning = messages(&scene.warnings);
@@ -448,7 +448,7 @@ fn gltf_nodes_place_meshes_and_materials_carry_over() {
     let mut lamp_normals = Vec::new();
     for p in &scene.patches {
         let m = &scene.materials[p.material as usize];
-        let corner = scene.vertices[p.polygon[0] as usize];
+        let corner = scene.vertices[scene.polygon(p)[0] as usize];
         if scene.objects[p.object as usize] == "panel" {
             assert!(
                 (10.0..=12.0).contains(&corner.x) && corner.z == 0.0,
@@ -550,7 +550,7 @@ fn stl_and_ply_in_ascii_and_binary() {
             vec![name.split('.').next().unwrap().to_string()]
         );
         for p in &scene.patches {
-            let centroid = scene.vertices[p.polygon[0] as usize];
+            let centroid = scene.vertices[scene.polygon(p)[0] as usize];
             let outward = (centroid - scene.normalization.center).dot(p.normal);
             assert!(outward > 0.0, "{name}: a face looks into the cube");
         }
@@ -602,7 +602,7 @@ fn continuous_mutual_information_is_the_same_in_every_format() {
         ply.push_str(&format!("{:?} {:?} {:?}\n", v.x, v.y, v.z));
     }
     for p in &scene.patches {
-        let idx: Vec<String> = p.polygon.iter().map(|i| i.to_string()).collect();
+        let idx: Vec<String> = scene.polygon(p).iter().map(|i| i.to_string()).collect();
         ply.push_str(&format!("{} {}\n", idx.len(), idx.join(" ")));
     }
     let ply_path = write(dir.path(), "room.ply", ply.as_bytes());
@@ -894,7 +894,7 @@ fn ply_triangle_strips_read_as_the_same_triangles() {
             "{name}"
         );
         for p in &scene.patches {
-            let corner = scene.vertices[p.polygon[0] as usize];
+            let corner = scene.vertices[scene.polygon(p)[0] as usize];
             let inward = (scene.normalization.center - corner).dot(p.normal);
             assert!(inward > 0.0, "{name}: a triangle faces out of the room");
         }

@@ -164,8 +164,8 @@ fn room_with_floor_square(b: &mut SceneBuilder, a: f64, c: f64, m: u32) {
         if k == 4 {
             continue;
         }
-        let idx: Vec<u32> = patch
-            .polygon
+        let idx: Vec<u32> = room
+            .polygon(patch)
             .iter()
             .map(|&v| b.vertex(room.vertices[v as usize]))
             .collect();
@@ -204,8 +204,8 @@ fn icosphere(level: usize) -> Vec<[[f64; 3]; 3]> {
         .iter()
         .map(|p| {
             // The built-in faces inwards: reverse to face outwards.
-            let v: Vec<[f64; 3]> = p
-                .polygon
+            let v: Vec<[f64; 3]> = s
+                .polygon(p)
                 .iter()
                 .map(|&k| s.vertices[k as usize].to_array())
                 .collect();
@@ -857,7 +857,8 @@ fn lines_through_stiff_vertices_and_edges_keep_parity() {
     let inner_vertices: Vec<[f64; 3]> = scene.patches[n..]
         .iter()
         .flat_map(|p| {
-            p.polygon
+            scene
+                .polygon(p)
                 .iter()
                 .map(|&v| scene.positions[v as usize].map(f64::from))
         })

@@ -111,8 +111,8 @@ pub struct AxisRect {
 impl AxisRect {
     /// The rectangle of a patch whose polygon is axis-aligned (the patches of `@cube:N`).
     pub fn of_patch(scene: &Scene, p: usize) -> AxisRect {
-        let pts: Vec<[f64; 3]> = scene.patches[p]
-            .polygon
+        let pts: Vec<[f64; 3]> = scene
+            .polygon(&scene.patches[p])
             .iter()
             .map(|&v| scene.vertices[v as usize].to_array())
             .collect();

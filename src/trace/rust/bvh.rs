@@ -37,11 +37,10 @@
 //! proposed at most once per line; repeats would be harmless anyway ([`crate::trace::HitRules`] removes
 //! exact `(t, triangle)` repeats).
 
-use std::time::Duration;
-
 use glam::{Vec3A, Vec4};
 use obvhs::aabb::Aabb;
-use obvhs::cwbvh::{builder::build_cwbvh, CwBvh};
+use obvhs::bvh2::reinsertion::ReinsertionOptimizer;
+use obvhs::cwbvh::{bvh2_to_cwbvh::bvh2_to_cwbvh, CwBvh};
 use obvhs::ray::safe_inverse;
 use obvhs::BvhBuildParams;
 
@@ -111,6 +110,22 @@ struct Node {
     wide: bool,
 }
 
+/// obvhs's `build_cwbvh` (PLOC, reinsertion, collapse to 8-wide nodes with leaves of at most 3), the
+/// same steps on the same boxes, without the copy of the boxes it makes, and the boxes freed before the
+/// collapse: on a large scene the build is the peak of a run's memory.
+fn build_cwbvh(boxes: Vec<Aabb>, params: BvhBuildParams) -> CwBvh {
+    let indices = (0..boxes.len() as u32).collect();
+    let mut bvh2 = params.ploc_search_distance.build(
+        &boxes,
+        indices,
+        params.sort_precision,
+        params.search_depth_threshold,
+    );
+    drop(boxes);
+    ReinsertionOptimizer::run(&mut bvh2, params.reinsertion_batch_ratio, None);
+    bvh2_to_cwbvh(&bvh2, params.max_prims_per_leaf.clamp(1, 3), true, false)
+}
+
 /// A line prepared for the slab tests of [`Node`]s.
 struct BoxRay {
     origin: [Vec4; 3],
@@ -171,17 +186,18 @@ impl BvhTracer {
             .iter()
             .map(|t| inflated_box(t.map(|v| scene.positions[v as usize]), m))
             .collect();
-        let cw = if boxes.is_empty() {
+        let mut cw = if boxes.is_empty() {
             CwBvh::default()
         } else {
-            build_cwbvh(&boxes, params, &mut Duration::default())
+            build_cwbvh(boxes, params)
         };
-        let ids = cw.primitive_indices.clone();
-        let triangles = ids
+        let ids = std::mem::take(&mut cw.primitive_indices);
+        let triangles: Vec<[[f32; 3]; 3]> = ids
             .iter()
             .map(|&i| scene.triangles[i as usize].map(|v| scene.positions[v as usize]))
             .collect();
-        let ordered_boxes: Vec<Aabb> = ids.iter().map(|&i| boxes[i as usize]).collect();
+        // The same boxes again (the same operations on the same corners), in BVH order.
+        let ordered_boxes: Vec<Aabb> = triangles.iter().map(|&t| inflated_box(t, m)).collect();
         let mut nodes = Vec::with_capacity(cw.nodes.len());
         if !cw.nodes.is_empty() {
             convert(&cw, 0, &ordered_boxes, &mut nodes);
