@@ -112,7 +112,7 @@ fn write_binary_body(
     values: &[Option<f64>],
 ) -> io::Result<()> {
     for (p, patch) in scene.patches.iter().enumerate() {
-        for &v in &patch.polygon {
+        for &v in scene.polygon(patch) {
             let x = scene.vertices[v as usize];
             for c in [x.x, x.y, x.z] {
                 out.write_all(&c.to_le_bytes())?;
@@ -122,8 +122,8 @@ fn write_binary_body(
     }
     let mut next = 0i32;
     for (p, patch) in scene.patches.iter().enumerate() {
-        out.write_all(&[corner_count(patch.polygon.len())?])?;
-        for _ in &patch.polygon {
+        out.write_all(&[corner_count(scene.polygon(patch).len())?])?;
+        for _ in scene.polygon(patch) {
             out.write_all(&next.to_le_bytes())?;
             next = next.checked_add(1).ok_or_else(too_many_corners)?;
         }
