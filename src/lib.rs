@@ -83,7 +83,7 @@ pub use scene::{
     SceneOptions, DEFAULT_PLANARITY,
 };
 pub use scene::{Reach, ReadPolicy, SceneWarning, SceneWarningKind};
-pub use scenes::{load, load_with, load_with_policy, Builtin, CATALOGUE};
+pub use scenes::{load, load_with, load_with_policy, Builtin, CATALOGUE, MAX_BUILTIN_PATCHES};
 
 // Tracing.
 pub use trace::{make_tracer, Backend, Query, QueryError, TraceError, Tracer};

@@ -10,9 +10,7 @@ use scene_complexity::{make_tracer, Query};
 use std::sync::Arc;
 
 use super::args::SceneArgs;
-use super::args::{
-    parse_count, parse_positive, parse_whole_in, Seed, Threads, Tracer, TracerArg, MAX_WHOLE,
-};
+use super::args::{parse_count, parse_positive, parse_whole_in, Seed, Threads, Tracer, TracerArg};
 use super::exit::{Exit, Failure};
 use super::input::load_scene;
 use super::output::{self, note};
@@ -60,9 +58,16 @@ enum StrategyArg {
     Information,
 }
 
-/// `--patches`: the patch count to refine towards, a whole number >= 1.
+/// `--patches`: the patch count to refine towards, a whole number from 1 to the most patches a built-in
+/// scene may have ([`scene_complexity::MAX_BUILTIN_PATCHES`]): a refined mesh grows by every split, and a
+/// target beyond what memory can hold would be found only after hours of rounds.
 fn parse_patches(s: &str) -> Result<u64, String> {
-    parse_whole_in(s, "the number of patches to refine towards", 1, MAX_WHOLE)
+    parse_whole_in(
+        s,
+        "the number of patches to refine towards",
+        1,
+        scene_complexity::MAX_BUILTIN_PATCHES as u64,
+    )
 }
 
 /// Runs `scx refine`.

@@ -749,7 +749,8 @@ fn numeric_flags_name_their_range() {
     }
 }
 
-/// `refine --patches 0` speaks of patches, not of "a line count".
+/// `refine --patches 0` speaks of patches, not of "a line count"; a target beyond the largest scene scx
+/// builds (2^22 patches) is refused.
 #[test]
 fn refine_patches_says_what_it_needs() {
     let dir = tempfile::tempdir().unwrap();
@@ -768,6 +769,22 @@ fn refine_patches_says_what_it_needs() {
     );
     assert_usage(&out, &["--patches", "number of patches", "from 1"]);
     assert!(!stderr(&out).contains("line count"), "{}", stderr(&out));
+    assert!(!dir.path().join("r.obj").exists());
+    // A target no memory could hold is refused before any round, with the largest one allowed.
+    let out = scx_in(
+        dir.path(),
+        &[
+            "refine",
+            "@cube:2",
+            "--strategy",
+            "uniform",
+            "--patches",
+            "1e15",
+            "-o",
+            "r.obj",
+        ],
+    );
+    assert_usage(&out, &["--patches", "from 1 to 4194304"]);
     assert!(!dir.path().join("r.obj").exists());
 }
 
