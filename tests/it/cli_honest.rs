@@ -151,7 +151,7 @@ fn a_bad_output_path_fails_before_the_work() {
             "--strategy",
             "information",
             "--patches",
-            "1e9",
+            "4194304",
             "-o",
             "/no/such/dir/r.obj",
         ],
