@@ -3,6 +3,7 @@
 
 use crate::measure::Estimate;
 use crate::sample::tally::Counters;
+use crate::scene::Warning;
 
 /// What a warning is about.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -46,48 +47,8 @@ impl RunWarningKind {
     }
 }
 
-/// One warning about a run.
-#[derive(Clone, Debug, PartialEq)]
-pub struct RunWarning {
-    /// What it is about.
-    pub kind: RunWarningKind,
-    /// The sentence for the report, naming the scene.
-    pub message: String,
-    /// The objects it is about, by the names the scene file gives them (empty: the whole scene).
-    pub objects: Vec<String>,
-    /// The numbers it reports, by name (`escape_fraction`, `patches`), for programs.
-    pub numbers: Vec<(&'static str, f64)>,
-}
-
-impl RunWarning {
-    /// A warning of `kind` saying `message`, about no object in particular.
-    pub fn new(kind: RunWarningKind, message: String) -> Self {
-        RunWarning {
-            kind,
-            message,
-            objects: Vec::new(),
-            numbers: Vec::new(),
-        }
-    }
-
-    /// The same warning with numbers for programs.
-    pub fn with_numbers(mut self, numbers: &[(&'static str, f64)]) -> Self {
-        self.numbers = numbers.to_vec();
-        self
-    }
-
-    /// The same warning about these objects.
-    pub fn about(mut self, objects: Vec<String>) -> Self {
-        self.objects = objects;
-        self
-    }
-}
-
-impl std::fmt::Display for RunWarning {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(&self.message)
-    }
-}
+/// One warning about a run ([`Warning`] of a [`RunWarningKind`]).
+pub type RunWarning = Warning<RunWarningKind>;
 
 /// The fraction of the segments leaving a front side that escape the scene (`None` without segments).
 pub fn escape_fraction(counters: &Counters) -> Option<f64> {

@@ -362,6 +362,22 @@ fn centroid(scene: &Scene, patch: usize) -> Point {
     }
 }
 
+/// The columns of the per-patch catalogue, each value followed by its standard error.
+fn per_patch_columns() -> Vec<String> {
+    PatchMeasure::ALL
+        .iter()
+        .flat_map(|q| {
+            let name = q.info().column;
+            [name.to_string(), format!("{name}_stderr")]
+        })
+        .collect()
+}
+
+/// A number as the CSV files write it (`-0` as `0`), empty when there is none.
+fn csv_number(x: Option<f64>) -> String {
+    x.map(|v| format!("{}", v + 0.0)).unwrap_or_default()
+}
+
 fn patches_csv(w: &mut dyn Write, scene: &Scene, patches: &[PatchResult]) -> std::io::Result<()> {
     let mut out = csv::Writer::from_writer(w);
     let mut header: Vec<String> = [
@@ -383,15 +399,11 @@ fn patches_csv(w: &mut dyn Write, scene: &Scene, patches: &[PatchResult]) -> std
     ]
     .map(String::from)
     .to_vec();
-    for q in PatchMeasure::ALL {
-        let name = q.info().column;
-        header.push(name.to_string());
-        header.push(format!("{name}_stderr"));
-    }
+    header.extend(per_patch_columns());
     out.write_record(&header)?;
     let norm = scene.normalization;
     let total_area = scene.total_area();
-    let num = |x: Option<f64>| x.map(|v| format!("{}", v + 0.0)).unwrap_or_default();
+    let num = csv_number;
     for (i, (patch, p)) in scene.patches.iter().zip(patches).enumerate() {
         let c = centroid(scene, i);
         let n = patch.normal;
@@ -442,13 +454,9 @@ fn objects_csv(w: &mut dyn Write, a: &Analysis) -> std::io::Result<()> {
     ]
     .map(String::from)
     .to_vec();
-    for q in PatchMeasure::ALL {
-        let name = q.info().column;
-        header.push(name.to_string());
-        header.push(format!("{name}_stderr"));
-    }
+    header.extend(per_patch_columns());
     out.write_record(&header)?;
-    let num = |x: Option<f64>| x.map(|v| format!("{}", v + 0.0)).unwrap_or_default();
+    let num = csv_number;
     let int = |x: Option<u64>| x.map(|v| v.to_string()).unwrap_or_default();
     for o in &a.objects {
         let mut row = vec![

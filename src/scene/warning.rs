@@ -47,23 +47,28 @@ impl SceneWarningKind {
     }
 }
 
-/// One warning about how a scene was read.
+/// One warning as data: what it is about (`K`, a kind with a stable code), the sentence a person reads,
+/// the objects it is about and the numbers behind it. The scene's readers ([`SceneWarning`]) and the
+/// analysis of a run (`RunWarning`) share it.
 #[derive(Clone, Debug, PartialEq)]
-pub struct SceneWarning {
+pub struct Warning<K> {
     /// What it is about.
-    pub kind: SceneWarningKind,
-    /// The sentence for the report, naming the file.
+    pub kind: K,
+    /// The sentence for the report, naming the file or scene.
     pub message: String,
-    /// The objects it is about, by the names the file gives them (empty: the whole file).
+    /// The objects it is about, by the names the file gives them (empty: the whole scene).
     pub objects: Vec<String>,
-    /// The counts it reports, by name (`polygons`, `triangles`), for programs.
+    /// The numbers it reports, by name (`polygons`, `escape_fraction`), for programs.
     pub numbers: Vec<(&'static str, f64)>,
 }
 
-impl SceneWarning {
+/// One warning about how a scene was read.
+pub type SceneWarning = Warning<SceneWarningKind>;
+
+impl<K> Warning<K> {
     /// A warning of `kind` saying `message`, about no object in particular.
-    pub fn new(kind: SceneWarningKind, message: impl Into<String>) -> Self {
-        SceneWarning {
+    pub fn new(kind: K, message: impl Into<String>) -> Self {
+        Warning {
             kind,
             message: message.into(),
             objects: Vec::new(),
@@ -71,7 +76,7 @@ impl SceneWarning {
         }
     }
 
-    /// The same warning with counts for programs.
+    /// The same warning with numbers for programs.
     pub fn with_numbers(mut self, numbers: &[(&'static str, f64)]) -> Self {
         self.numbers = numbers.to_vec();
         self
@@ -84,7 +89,7 @@ impl SceneWarning {
     }
 }
 
-impl std::fmt::Display for SceneWarning {
+impl<K> std::fmt::Display for Warning<K> {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.write_str(&self.message)
     }
