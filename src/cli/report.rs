@@ -10,8 +10,8 @@ use scene_complexity::LineSource;
 use scene_complexity::Scene;
 use scene_complexity::VerdictRule;
 use scene_complexity::{
-    Analysis, ObjectResult, PatchMeasure, RadiosityOutcome, Reliability, TargetOutcome, Verdict,
-    COVERAGE_OK,
+    Analysis, HalfRun, LinesAdvice, ObjectResult, PatchMeasure, RadiosityOutcome, Reliability,
+    SamplingReport, TargetOutcome, Verdict, COVERAGE_OK,
 };
 use scene_complexity::{ErrorMethod, Shard, StopReason, Tracing};
 use scene_complexity::{Estimate, Family, Measure, Unit};
@@ -175,6 +175,11 @@ fn sampling_json(a: &Analysis) -> Value {
             "coverage": finite(s.sampling.coverage),
             "singleton_share": finite(s.sampling.singleton_share),
             "lines_for_coverage_0_99": s.lines_for_coverage,
+            "lines_for_coverage_0_99_from_half": match s.from_half {
+                HalfRun::Lines(n) => Some(n),
+                HalfRun::NotComputed | HalfRun::BeyondReach => None,
+            },
+            "lines_advice": s.advice.code(),
         }),
     }
 }
@@ -691,10 +696,32 @@ fn corrected_needs(a: &Analysis) -> String {
         }
         Some(n) => format!(
             "; the corrected readings need a coverage of 0.99 and a remaining bias (the jackknife's \
-             estimate) within their standard error, at least about {n:.1e} lines (an extrapolation, good \
-             to about twice the lines cast)"
+             estimate) within their standard error, at least about {n:.1e} lines ({})",
+            extrapolation_note(a.sampling.as_ref().filter(|_| coverage_short), n)
         ),
         None => String::new(),
+    }
+}
+
+/// What the advice of `n` lines is worth, from the coverage's extrapolation when the coverage is short.
+fn extrapolation_note(sampling: Option<&SamplingReport>, n: u64) -> String {
+    let Some(s) = sampling.filter(|s| s.advice == LinesAdvice::LowerBound) else {
+        return "an extrapolation, good to about twice the lines cast".into();
+    };
+    // The advice may be the bias's rather than the coverage's: then name the coverage's.
+    let what = if s.lines_for_coverage == Some(n) {
+        "it"
+    } else {
+        "the coverage's"
+    };
+    match s.advice_growth() {
+        Some(g) => format!(
+            "an extrapolation that has not settled: {what} grew {g:.1}x from half the lines, so more \
+             may be needed"
+        ),
+        None => "an extrapolation that has not settled: from half the lines a coverage of 0.99 was \
+                 beyond the extrapolation's reach, so more may be needed"
+            .into(),
     }
 }
 
