@@ -266,19 +266,12 @@ fn per_patch_file_has_the_scenes_own_geometry() {
     );
 }
 
-/// Wrong kinds of file and --enclose are refused before any line is cast, with exit code 2.
+/// Wrong kinds of file are refused before any line is cast, with exit code 2.
 #[test]
 fn per_patch_files_are_checked_before_work() {
     for args in [
         &["analyze", "@cube:2", "--patches", "p.txt"][..],
         &["analyze", "@cube:2", "--form-factors", "f.json"],
-        &[
-            "analyze",
-            "@cornell-open",
-            "--enclose",
-            "--patches",
-            "p.csv",
-        ],
         &[
             "analyze",
             "@cube:2",
