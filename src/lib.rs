@@ -114,7 +114,7 @@ pub use sample::tally::{Tally, Wanted};
 pub use analysis::{
     analyze, cast, finish, Analysis, AnalysisError, ObjectResult, PatchResult, RadiosityOutcome,
     RadiositySolve, Reliability, RunWarning, RunWarningKind, SamplingReport, SolveFailure,
-    TargetOutcome, Verdict, COVERAGE_OK, COVERAGE_UNUSABLE,
+    TargetOutcome, Verdict, COVERAGE_OK, COVERAGE_UNUSABLE, ENVIRONMENT,
 };
 pub use measure::catalogue::{
     Bound, ByMeasure, Family, Measure, MeasureInfo, Needs, PatchMeasure, PatchMeasureInfo, Unit,

@@ -16,7 +16,7 @@ pub mod warnings;
 
 use std::time::Instant;
 
-pub use object_results::ObjectResult;
+pub use object_results::{ObjectResult, ENVIRONMENT};
 pub use patch_results::{PatchLight, PatchResult};
 pub use radiosity::{RadiosityOutcome, RadiositySolve, SolveFailure, NOTHING_EMITS};
 pub use reliability::{Reliability, SamplingReport, Verdict, COVERAGE_OK, COVERAGE_UNUSABLE};
@@ -97,6 +97,10 @@ pub struct Analysis {
     /// With `--enclose` when something escaped: the environment patch's area in scene units (see
     /// [`crate::sample::environment`]); `None` otherwise.
     pub environment_area: Option<Estimate>,
+    /// Whether the measures are those of the enclosed scene (`--enclose` on a scene lines escaped):
+    /// the environment is then patch `patches` of the per-patch results and of the form factors
+    /// ([`Tally::enclosed`]).
+    pub enclosed: bool,
     /// Every reading with its standard error, by measure ([`Measure`]): the visibility measures and,
     /// when computed, the radiosity measures; `None` for a measure not computed.
     pub estimates: ByMeasure<Estimate>,
@@ -376,6 +380,7 @@ pub fn finish(
         absorbed: total.counters.absorbed,
         degenerate_pairs: total.counters.degenerate_pairs,
         environment_area: visibility.environment_area,
+        enclosed: enclose,
         distinct_pairs: total.counts.as_ref().map(|c| c.distinct_pairs()),
         unsampled: visibility.unsampled,
         estimates,

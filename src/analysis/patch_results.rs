@@ -29,6 +29,9 @@ use crate::scene::Scene;
 /// radiosities in the units of the scene's emissions.
 #[derive(Clone, Debug, PartialEq)]
 pub struct PatchResult {
+    /// The patch's area in the scene's units squared (the environment's: its counted area, the
+    /// full run's reading of [`crate::analysis::Analysis::environment_area`]).
+    pub area: f64,
     /// `a_i`, the weight of the patch's row: its share of the area of the scene whose measures are
     /// reported (of the enclosed scene, the environment's area included, when enclosed).
     pub area_fraction: f64,
@@ -67,7 +70,9 @@ pub struct PatchLight<'a> {
 
 /// One tally's per-patch values and, when lit, its radiosities `(B, B^in)`.
 struct TallyPatches {
-    /// Each row's area fraction `a_i` (the environment's last when enclosed).
+    /// Each row's area in tracing space (the environment's last when enclosed).
+    areas: Vec<f64>,
+    /// Each row's area fraction `a_i`.
     fractions: Vec<f64>,
     values: PatchValues,
     /// Escapes per patch.
@@ -94,8 +99,9 @@ pub(crate) fn estimates(
     );
     let all = all?;
     let groups: Vec<TallyPatches> = groups.into_iter().flatten().collect();
+    let scale = scene.normalization.scale;
     let patches = (0..all.fractions.len())
-        .map(|i| patch_estimate(i, &all, &groups))
+        .map(|i| patch_estimate(i, &all, &groups, scale, scene.patch_count()))
         .collect();
     Some((patches, object_values(scene, &all, &groups)))
 }
@@ -132,6 +138,7 @@ fn of_tally(
     escapes.resize(areas.len(), 0);
     Some(TallyPatches {
         fractions: fractions(&areas),
+        areas,
         values,
         escapes,
         absorbed: t.absorbed_by_patch.clone(),
@@ -186,9 +193,24 @@ fn patch_value(q: PatchMeasure, i: usize, t: &TallyPatches) -> Option<f64> {
     }
 }
 
-/// Patch `i`'s values from all the lines, with the batch-means standard errors of the groups'.
-fn patch_estimate(i: usize, all: &TallyPatches, groups: &[TallyPatches]) -> PatchResult {
+/// Patch `i`'s values from all the lines, with the batch-means standard errors of the groups' (`scale`:
+/// the scene's units per tracing unit; `own`: the scene's patches, the environment's row after them).
+fn patch_estimate(
+    i: usize,
+    all: &TallyPatches,
+    groups: &[TallyPatches],
+    scale: f64,
+    own: usize,
+) -> PatchResult {
+    // The patches' areas to the bit as the files have always written them; the environment's as the
+    // report's `environment_area`.
+    let area = if i < own {
+        all.areas[i] * scale * scale
+    } else {
+        all.areas[i] * (scale * scale)
+    };
     PatchResult {
+        area,
         area_fraction: all.fractions[i],
         segments: all.values.segments[i],
         escapes: all.escapes[i],

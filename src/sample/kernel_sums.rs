@@ -28,7 +28,7 @@ pub struct PatchKernelSums {
     /// Per patch: the pair ends that entered `log2_kernel`.
     pub ends: Vec<u64>,
     /// Per patch, for `--enclose`: the sum of the log kernel over its escapes (the segments from its
-    /// front side to the environment sphere, [`environment::escape`]), degenerate ones left out; empty
+    /// front side to the environment sphere, `environment::escape`), degenerate ones left out; empty
     /// when not gathered ([`super::tally::Wanted::environment`]).
     pub environment_log2_kernel: Vec<ExactSum>,
     /// Per patch: the escapes that entered `environment_log2_kernel` (empty when not gathered).
@@ -83,7 +83,7 @@ impl PatchKernelSums {
     }
 
     /// Credits each escape's term (`terms[k]`, from [`PatchKernelSums::pair_term`] of
-    /// [`environment::escape`], `NaN` when degenerate) to its patch `patches[k]`; kept only when the
+    /// `environment::escape`, `NaN` when degenerate) to its patch `patches[k]`; kept only when the
     /// environment's sums are.
     pub fn add_escapes(&mut self, patches: &[u32], terms: &[f64]) {
         if !self.has_environment() {
@@ -121,7 +121,7 @@ impl PatchKernelSums {
     /// The sums of the enclosed scene, whose patch `n` (after the scene's `n`) is the environment, for
     /// lines of which `misses` met nothing: each patch's pair ends and its escapes, and the environment's
     /// ends, every escape's other end (its term is the escape's: the kernel is symmetric) and both ends
-    /// of each line that met nothing (a chord of the sphere, [`environment::miss`]). `None` without the
+    /// of each line that met nothing (a chord of the sphere, `environment::miss`). `None` without the
     /// environment's sums.
     pub fn enclosed(&self, misses: u64, radius: f64) -> Option<PatchKernelSums> {
         if !self.has_environment() {

@@ -432,7 +432,6 @@ impl Tally {
     /// ([`Wanted::environment`]) for the enclosed per-patch sums (without them there are none).
     pub fn enclosed(&self, scene: &Scene) -> (Tally, Vec<f64>) {
         let n = scene.patch_count();
-        let env = n as u32;
         let mut areas: Vec<f64> = scene.patches.iter().map(|p| p.area).collect();
         let a_scene: f64 = areas.iter().sum();
         let a_env = self.environment_area(scene);
@@ -440,19 +439,7 @@ impl Tally {
 
         let c = &self.counters;
         let mut t = self.clone();
-        t.counts = self.counts.as_ref().map(|counts| {
-            let mut entries: Vec<(u64, u64)> = Vec::new();
-            counts.for_each(|i, j, k| entries.push((pair_key(i, j), k)));
-            for (i, &e) in self.escapes_by_patch.iter().enumerate() {
-                if e > 0 {
-                    entries.push((pair_key(i as u32, env), e));
-                }
-            }
-            if c.misses > 0 {
-                entries.push((pair_key(env, env), c.misses));
-            }
-            PairCounts::from_entries(n + 1, entries)
-        });
+        t.counts = self.enclosed_counts(n);
         t.escapes_by_patch = vec![0; if self.counts.is_some() { n + 1 } else { 0 }];
         if !t.absorbed_by_patch.is_empty() {
             t.absorbed_by_patch.push(0);
@@ -473,6 +460,36 @@ impl Tally {
                 + t.counters.cmi_pairs as f64 * log2_over_pi(a_scene + a_env),
         );
         (t, areas)
+    }
+
+    /// The pair counts of the enclosed scene of `n` patches (the tally's scene), whose patch `n` is the
+    /// environment ([`Tally::enclosed`]): each patch's escapes are its pairs with the environment, each
+    /// line that met nothing a pair of the environment with itself. `None` without pair counts.
+    pub fn enclosed_counts(&self, n: usize) -> Option<PairCounts> {
+        let counts = self.counts.as_ref()?;
+        let env = n as u32;
+        let mut entries: Vec<(u64, u64)> = Vec::with_capacity(counts.distinct_pairs() + n + 1);
+        counts.for_each(|i, j, k| entries.push((pair_key(i, j), k)));
+        for (i, &e) in self.escapes_by_patch.iter().enumerate() {
+            if e > 0 {
+                entries.push((pair_key(i as u32, env), e));
+            }
+        }
+        if self.counters.misses > 0 {
+            entries.push((pair_key(env, env), self.counters.misses));
+        }
+        Some(PairCounts::from_entries(n + 1, entries))
+    }
+
+    /// Per patch of the enclosed scene of `n` patches, the segments leaving its front side that arrive
+    /// at no front side: only those absorbed at back sides (the escapes are pairs with the environment,
+    /// which loses nothing); empty when there are none.
+    pub fn enclosed_lost(&self, n: usize) -> Vec<u64> {
+        let mut lost = self.absorbed_by_patch.clone();
+        if !lost.is_empty() {
+            lost.resize(n + 1, 0);
+        }
+        lost
     }
 }
 
