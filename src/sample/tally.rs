@@ -26,6 +26,21 @@ pub struct Wanted {
     /// Eq. (27)'s terms summed per patch ([`PatchKernelSums`]) for the per-patch results; needs
     /// `discrete` (the pair keys say which patches a term belongs to).
     pub per_patch: bool,
+    /// With `per_patch`, the terms of each patch's escapes summed too
+    /// ([`PatchKernelSums::environment_log2_kernel`]), for the per-patch results of an enclosed scene
+    /// (`--enclose`, [`super::environment`]).
+    pub environment: bool,
+}
+
+impl Wanted {
+    /// Empty per-patch sums for `patches` patches, when they are wanted.
+    fn kernel_sums(self, patches: usize) -> Option<PatchKernelSums> {
+        match (self.per_patch, self.environment) {
+            (false, _) => None,
+            (true, false) => Some(PatchKernelSums::new(patches)),
+            (true, true) => Some(PatchKernelSums::with_environment(patches)),
+        }
+    }
 }
 
 /// The counters and sums of a set of lines: every number a run adds up but the pair counts and the
@@ -231,9 +246,7 @@ impl Tally {
             counts: wanted
                 .discrete
                 .then(|| PairCounts::new(scene.patch_count())),
-            kernel_by_patch: wanted
-                .per_patch
-                .then(|| PatchKernelSums::new(scene.patch_count())),
+            kernel_by_patch: wanted.kernel_sums(scene.patch_count()),
         }
     }
 
@@ -371,9 +384,7 @@ impl Tally {
             },
             absorbed_by_patch: Vec::new(),
             counts: None,
-            kernel_by_patch: wanted
-                .per_patch
-                .then(|| PatchKernelSums::new(scene.patch_count())),
+            kernel_by_patch: wanted.kernel_sums(scene.patch_count()),
         };
         let mut batch_keys = Vec::with_capacity(batches.len());
         for b in batches {
@@ -381,6 +392,7 @@ impl Tally {
             b.sides.add_to(&mut tally.orientation);
             if let Some(k) = &mut tally.kernel_by_patch {
                 k.add_pairs(&b.pair_keys, &b.pair_terms);
+                k.add_escapes(&b.escape_patches, &b.escape_terms);
             }
             for &p in &b.escape_patches {
                 tally.escapes_by_patch[p as usize] += 1;
@@ -416,10 +428,10 @@ impl Tally {
 
     /// The tally of the enclosed scene, whose patch `n_p` is the environment, and the patch areas with the
     /// environment's last ([`super::environment`]). Needs the discrete counts for the pair counts
-    /// (without them only eq. (27) is enclosed).
+    /// (without them only eq. (27) is enclosed), and the environment's per-patch sums of eq. (27)
+    /// ([`Wanted::environment`]) for the enclosed per-patch sums (without them there are none).
     pub fn enclosed(&self, scene: &Scene) -> (Tally, Vec<f64>) {
         let n = scene.patch_count();
-        let env = n as u32;
         let mut areas: Vec<f64> = scene.patches.iter().map(|p| p.area).collect();
         let a_scene: f64 = areas.iter().sum();
         let a_env = self.environment_area(scene);
@@ -427,25 +439,17 @@ impl Tally {
 
         let c = &self.counters;
         let mut t = self.clone();
-        t.counts = self.counts.as_ref().map(|counts| {
-            let mut entries: Vec<(u64, u64)> = Vec::new();
-            counts.for_each(|i, j, k| entries.push((pair_key(i, j), k)));
-            for (i, &e) in self.escapes_by_patch.iter().enumerate() {
-                if e > 0 {
-                    entries.push((pair_key(i as u32, env), e));
-                }
-            }
-            if c.misses > 0 {
-                entries.push((pair_key(env, env), c.misses));
-            }
-            PairCounts::from_entries(n + 1, entries)
-        });
+        t.counts = self.enclosed_counts(n);
         t.escapes_by_patch = vec![0; if self.counts.is_some() { n + 1 } else { 0 }];
         if !t.absorbed_by_patch.is_empty() {
             t.absorbed_by_patch.push(0);
         }
         t.counters.pairs += c.escapes + c.misses;
         t.counters.escapes = 0;
+        t.kernel_by_patch = self
+            .kernel_by_patch
+            .as_ref()
+            .and_then(|k| k.enclosed(c.misses, scene.bounding_radius()));
 
         // Eq. (27) with A_T' = A_T + A_env: take the scene's log2(A_T / pi) back out of each term.
         let log2_over_pi = |a: f64| (a / std::f64::consts::PI).log2();
@@ -456,6 +460,36 @@ impl Tally {
                 + t.counters.cmi_pairs as f64 * log2_over_pi(a_scene + a_env),
         );
         (t, areas)
+    }
+
+    /// The pair counts of the enclosed scene of `n` patches (the tally's scene), whose patch `n` is the
+    /// environment ([`Tally::enclosed`]): each patch's escapes are its pairs with the environment, each
+    /// line that met nothing a pair of the environment with itself. `None` without pair counts.
+    pub fn enclosed_counts(&self, n: usize) -> Option<PairCounts> {
+        let counts = self.counts.as_ref()?;
+        let env = n as u32;
+        let mut entries: Vec<(u64, u64)> = Vec::with_capacity(counts.distinct_pairs() + n + 1);
+        counts.for_each(|i, j, k| entries.push((pair_key(i, j), k)));
+        for (i, &e) in self.escapes_by_patch.iter().enumerate() {
+            if e > 0 {
+                entries.push((pair_key(i as u32, env), e));
+            }
+        }
+        if self.counters.misses > 0 {
+            entries.push((pair_key(env, env), self.counters.misses));
+        }
+        Some(PairCounts::from_entries(n + 1, entries))
+    }
+
+    /// Per patch of the enclosed scene of `n` patches, the segments leaving its front side that arrive
+    /// at no front side: only those absorbed at back sides (the escapes are pairs with the environment,
+    /// which loses nothing); empty when there are none.
+    pub fn enclosed_lost(&self, n: usize) -> Vec<u64> {
+        let mut lost = self.absorbed_by_patch.clone();
+        if !lost.is_empty() {
+            lost.resize(n + 1, 0);
+        }
+        lost
     }
 }
 
@@ -488,6 +522,9 @@ pub struct BatchTally {
     /// Beside each pair key, its log kernel ([`PatchKernelSums::pair_term`]), when
     /// [`Wanted::per_patch`].
     pub pair_terms: Vec<f64>,
+    /// Beside each escape patch, the log kernel of its segment to the environment sphere, when
+    /// [`Wanted::environment`].
+    pub escape_terms: Vec<f64>,
 }
 
 /// Pairs the canonical hits of a batch of lines and tallies the segments (paper sec. 3.2.2): the hot
@@ -572,16 +609,18 @@ fn tally_batch(prepared: &LineTally, lines: &[Line], hits: &LineHits) -> BatchTa
         ..BatchTally::default()
     };
     let objects = &prepared.objects;
+    let (miss_cos, miss_chord) = environment::miss(scene.bounding_radius());
     let c = &mut t.counters;
     for (k, line) in lines.iter().enumerate() {
         let line_hits = hits.of_line(k);
         if line_hits.is_empty() {
             c.misses += 1;
-            env_sum.add(1.0, 2.0);
+            env_sum.add(miss_cos, miss_chord);
             continue;
         }
         let sides = &mut t.sides;
         let pair_terms = &mut t.pair_terms;
+        let escape_terms = &mut t.escape_terms;
         let ends = prepared
             .planes
             .segments_and_ends(scene, line, line_hits, |s| match s {
@@ -611,6 +650,9 @@ fn tally_batch(prepared: &LineTally, lines: &[Line], hits: &LineHits) -> BatchTa
                     sides.count(objects.object(patch), 2);
                     let (cos_product, distance) = environment::escape(scene, line, patch, at_start);
                     env_sum.add(cos_product, distance);
+                    if wanted.environment {
+                        escape_terms.push(PatchKernelSums::pair_term(cos_product, distance));
+                    }
                 }
                 Segment::BackSeen { patch, front } => {
                     c.unpaired += 1;
