@@ -105,8 +105,8 @@ fn of_tally(
     });
     Some(TallyPatches {
         values,
-        escapes: t.escapes_by_patch.clone(),
-        absorbed: t.absorbed_by_patch.clone(),
+        escapes: t.escapes_by_patch.dense().into_owned(),
+        absorbed: t.absorbed_by_patch.dense().into_owned(),
         light,
     })
 }
