@@ -111,6 +111,10 @@ pub(crate) fn of_run(
         .as_ref()
         .map(|counts| crate::measure::channel::row_totals(scene.patch_count(), counts, &lost));
     let mut values = values.map(Vec::into_iter);
+    let (escapes, absorbed) = (
+        total.escapes_by_patch.dense(),
+        total.absorbed_by_patch.dense(),
+    );
     members
         .iter()
         .enumerate()
@@ -136,8 +140,8 @@ pub(crate) fn of_run(
                 segments: segments
                     .as_ref()
                     .map(|s| patches.iter().map(|&i| s[i].round() as u64).sum()),
-                escapes: counted.then(|| sum(&total.escapes_by_patch)),
-                absorbed: counted.then(|| sum(&total.absorbed_by_patch)),
+                escapes: counted.then(|| sum(&escapes)),
+                absorbed: counted.then(|| sum(&absorbed)),
                 values: values
                     .as_mut()
                     .and_then(Iterator::next)

@@ -134,14 +134,14 @@ fn of_tally(
     });
     let lost = channel.lost_by_patch();
     let values = patch_values(&areas, counts, &lost, estimator, continuous);
-    let mut escapes = t.escapes_by_patch.clone();
+    let mut escapes = t.escapes_by_patch.dense().into_owned();
     escapes.resize(areas.len(), 0);
     Some(TallyPatches {
         fractions: fractions(&areas),
         areas,
         values,
         escapes,
-        absorbed: t.absorbed_by_patch.clone(),
+        absorbed: t.absorbed_by_patch.dense().into_owned(),
         light,
     })
 }

@@ -31,6 +31,7 @@ use super::state::RunState;
 use crate::sample::counts::{pair_key, split_key, PairCounts};
 use crate::sample::exact::ExactSum;
 use crate::sample::kernel_sums::PatchKernelSums;
+use crate::sample::patch_counts::PatchCounts;
 use crate::sample::tally::{Counters, ObjectSides, Tally, Wanted};
 use crate::scene::read as scene_read;
 use crate::scene::{Scene, SceneOptions};
@@ -288,15 +289,11 @@ struct Sparse {
 }
 
 impl Sparse {
-    /// The non-zero entries of a dense per-patch list.
-    fn of_dense(per_patch: &[u64]) -> Self {
-        Sparse::of(
-            per_patch
-                .iter()
-                .enumerate()
-                .filter(|(_, &e)| e > 0)
-                .map(|(i, &e)| (i as u64, e)),
-        )
+    /// The non-zero entries of counts per patch.
+    fn of_counts(per_patch: &PatchCounts) -> Self {
+        let mut entries = Vec::new();
+        per_patch.for_each_counted(|i, e| entries.push((u64::from(i), e)));
+        Sparse::of(entries)
     }
 
     fn of(entries: impl IntoIterator<Item = (u64, u64)>) -> Self {
@@ -334,8 +331,8 @@ impl Sparse {
 fn tally_wire(t: &Tally) -> TallyWire {
     TallyWire {
         counters: t.counters,
-        escapes: Sparse::of_dense(&t.escapes_by_patch),
-        absorbed: Sparse::of_dense(&t.absorbed_by_patch),
+        escapes: Sparse::of_counts(&t.escapes_by_patch),
+        absorbed: Sparse::of_counts(&t.absorbed_by_patch),
         counts: t.counts.as_ref().map(|c| {
             let mut entries = Vec::with_capacity(c.distinct_pairs());
             c.for_each(|i, j, n| entries.push((pair_key(i, j), n)));
@@ -355,24 +352,16 @@ fn tally_wire(t: &Tally) -> TallyWire {
     }
 }
 
-/// `n` zeros, or none when that much memory cannot be had.
-fn zeros(n: usize) -> Option<Vec<u64>> {
-    let mut v = Vec::new();
-    v.try_reserve_exact(n).ok()?;
-    v.resize(n, 0);
-    Some(v)
-}
-
-/// A dense per-patch list from sparse entries, each within the scene's patches.
-fn dense(entries: &[(u64, u64)], patches: usize, what: &str) -> Result<Vec<u64>, String> {
-    let mut list = zeros(patches).ok_or_else(|| format!("no memory for {patches} patches"))?;
-    for &(i, e) in entries {
-        let slot = usize::try_from(i).ok().and_then(|i| list.get_mut(i));
-        *slot.ok_or_else(|| {
-            format!("{what} of patch {i}, beyond the scene's {patches} patches")
-        })? = e;
+/// Counts per patch from sparse entries (sorted, distinct), each within the scene's patches.
+fn per_patch(entries: &[(u64, u64)], patches: usize, what: &str) -> Result<PatchCounts, String> {
+    if let Some(&(i, _)) = entries.iter().find(|&&(i, _)| i >= patches as u64) {
+        return Err(format!(
+            "{what} of patch {i}, beyond the scene's {patches} patches"
+        ));
     }
-    Ok(list)
+    // Below the patch count, which fits a u32 (a scene's patches are numbered by u32).
+    let entries = entries.iter().map(|&(i, e)| (i as u32, e));
+    Ok(PatchCounts::of_entries(patches, entries))
 }
 
 /// The sorted, unique entries of a sparse list, refused by name when they are not.
@@ -402,21 +391,21 @@ fn tally_of(w: &TallyWire, scene: &SceneSize, wanted: Wanted, lines: u64) -> Res
     let absorbed = entries_of(&w.absorbed, "absorbed segments")?;
     let escapes_by_patch = if wanted.discrete {
         check_sum(&escapes, w.counters.escapes, "escapes per patch")?;
-        dense(&escapes, patches, "escapes")?
+        per_patch(&escapes, patches, "escapes")?
     } else if escapes.is_empty() {
-        Vec::new()
+        PatchCounts::default()
     } else {
         return Err("it lists escapes per patch for a run that keeps none".into());
     };
     let absorbed_by_patch = if absorbed.is_empty() {
-        Vec::new()
+        PatchCounts::default()
     } else {
         check_sum(
             &absorbed,
             w.counters.absorbed,
             "absorbed segments per patch",
         )?;
-        dense(&absorbed, patches, "absorbed segments")?
+        per_patch(&absorbed, patches, "absorbed segments")?
     };
     if wanted.discrete && absorbed.is_empty() && w.counters.absorbed > 0 {
         return Err(format!(
@@ -486,7 +475,7 @@ fn tally_of(w: &TallyWire, scene: &SceneSize, wanted: Wanted, lines: u64) -> Res
                 environment_log2_kernel: k.environment_log2_kernel.clone(),
                 environment_ends: k.environment_ends.clone(),
             };
-            check_environment_sums(&sums, w, &escapes_by_patch, wanted)?;
+            check_environment_sums(&sums, w, &escapes_by_patch.dense(), wanted)?;
             Some(sums)
         }
         (None, false) => None,
@@ -1015,7 +1004,6 @@ mod tests {
             values: vec![5, 6],
         };
         assert_eq!(repeated.entries(), None);
-        assert!(zeros(usize::MAX).is_none());
     }
 
     /// A run of `cfg` on `@cube:3`, cast at once, its scene and state.

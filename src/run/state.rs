@@ -307,9 +307,17 @@ impl RunState {
             }
         }
         let groups: Vec<Tally> = self.groups.into_iter().flatten().collect();
-        // The counts are integers and the sums exact: added in any order.
-        let sums = groups.iter().map(Tally::without_counts).collect();
-        let mut total = merge_tree(sums).unwrap_or_else(|| Tally::empty(scene, self.wanted));
+        // The counts are integers and the sums exact: added in any order. Each thread adds copies of its
+        // groups (without their pair counts) into one, rather than all of them copied at once: on a
+        // large mesh each copy holds a list per patch.
+        let mut total = groups
+            .par_iter()
+            .map(Tally::without_counts)
+            .reduce_with(|mut a, b| {
+                a.merge(&b);
+                a
+            })
+            .unwrap_or_else(|| Tally::empty(scene, self.wanted));
         let counts: Vec<&PairCounts> = groups.iter().filter_map(|t| t.counts.as_ref()).collect();
         total.counts = PairCounts::sum_of(&counts);
         FinishedRun { total, groups }
@@ -329,17 +337,4 @@ pub struct StateParts<'a> {
     pub done: &'a BatchSet,
     /// The partial last batch's tally, kept apart.
     pub tail: Option<&'a (u64, Tally)>,
-}
-
-/// Merges tallies pairwise in a balanced binary tree, the two halves in parallel; every count is merged
-/// O(log G) times.
-fn merge_tree(mut tallies: Vec<Tally>) -> Option<Tally> {
-    if tallies.len() <= 1 {
-        return tallies.pop();
-    }
-    let right = tallies.split_off(tallies.len() / 2);
-    let (left, right) = rayon::join(|| merge_tree(tallies), || merge_tree(right));
-    let (mut left, right) = (left?, right?);
-    left.merge(&right);
-    Some(left)
 }

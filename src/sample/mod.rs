@@ -15,5 +15,6 @@ pub mod kernel_sums;
 pub mod lines;
 mod order;
 pub mod pairs;
+pub mod patch_counts;
 pub mod sparse;
 pub mod tally;

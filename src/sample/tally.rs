@@ -13,6 +13,7 @@ use super::exact::ExactSum;
 use super::kernel::Log2Sum;
 use super::kernel_sums::PatchKernelSums;
 use super::pairs::{PatchPlanes, Segment};
+use super::patch_counts::PatchCounts;
 use crate::scene::Scene;
 use crate::trace::{Line, LineHits};
 
@@ -220,11 +221,11 @@ pub struct Tally {
     pub counters: Counters,
     /// Per object of the scene ([`crate::scene::Scene::objects`]): how its sides were met.
     pub orientation: Vec<ObjectSides>,
-    /// Escapes per patch (empty unless the discrete measures are wanted).
-    pub escapes_by_patch: Vec<u64>,
+    /// Escapes per patch (none kept unless the discrete measures are wanted).
+    pub escapes_by_patch: PatchCounts,
     /// Segments from each patch's front side to a back side (absorbed), when the discrete measures are
-    /// wanted; empty as long as there are none (most scenes have none).
-    pub absorbed_by_patch: Vec<u64>,
+    /// wanted; none kept as long as there are none (most scenes have none).
+    pub absorbed_by_patch: PatchCounts,
     /// Pair counts (only when the discrete measures are wanted).
     pub counts: Option<PairCounts>,
     /// Eq. (27)'s terms summed per patch (only when [`Wanted::per_patch`]).
@@ -238,11 +239,11 @@ impl Tally {
             counters: Counters::default(),
             orientation: vec![ObjectSides::default(); scene.objects.len()],
             escapes_by_patch: if wanted.discrete {
-                vec![0; scene.patch_count()]
+                PatchCounts::zeros(scene.patch_count())
             } else {
-                Vec::new()
+                PatchCounts::default()
             },
-            absorbed_by_patch: Vec::new(),
+            absorbed_by_patch: PatchCounts::default(),
             counts: wanted
                 .discrete
                 .then(|| PairCounts::new(scene.patch_count())),
@@ -266,14 +267,8 @@ impl Tally {
     pub fn merge(&mut self, other: &Tally) {
         self.counters.add(&other.counters);
         add_sides(&mut self.orientation, &other.orientation);
-        for (a, b) in self
-            .escapes_by_patch
-            .iter_mut()
-            .zip(&other.escapes_by_patch)
-        {
-            *a += b;
-        }
-        add_counts(&mut self.absorbed_by_patch, &other.absorbed_by_patch);
+        self.escapes_by_patch.add(&other.escapes_by_patch);
+        self.absorbed_by_patch.add(&other.absorbed_by_patch);
         if let (Some(a), Some(b)) = (&mut self.counts, &other.counts) {
             a.merge(b);
         }
@@ -291,21 +286,8 @@ impl Tally {
         Tally {
             counters: self.counters,
             orientation: self.orientation.clone(),
-            escapes_by_patch: self
-                .escapes_by_patch
-                .iter()
-                .zip(&part.escapes_by_patch)
-                .map(|(t, p)| t - p)
-                .collect(),
-            absorbed_by_patch: if part.absorbed_by_patch.is_empty() {
-                self.absorbed_by_patch.clone()
-            } else {
-                self.absorbed_by_patch
-                    .iter()
-                    .zip(&part.absorbed_by_patch)
-                    .map(|(t, p)| t - p)
-                    .collect()
-            },
+            escapes_by_patch: self.escapes_by_patch.minus(&part.escapes_by_patch),
+            absorbed_by_patch: self.absorbed_by_patch.minus(&part.absorbed_by_patch),
             counts: match (&self.counts, &part.counts) {
                 (Some(t), Some(p)) => Some(t.without(p)),
                 _ => None,
@@ -377,16 +359,13 @@ impl Tally {
         let mut tally = Tally {
             counters: Counters::default(),
             orientation: vec![ObjectSides::default(); scene.objects.len()],
-            escapes_by_patch: if wanted.discrete {
-                vec![0; scene.patch_count()]
-            } else {
-                Vec::new()
-            },
-            absorbed_by_patch: Vec::new(),
+            escapes_by_patch: PatchCounts::default(),
+            absorbed_by_patch: PatchCounts::default(),
             counts: None,
             kernel_by_patch: wanted.kernel_sums(scene.patch_count()),
         };
         let mut batch_keys = Vec::with_capacity(batches.len());
+        let (mut escapes, mut absorbed) = (Vec::new(), Vec::new());
         for b in batches {
             tally.counters.add(&b.counters);
             b.sides.add_to(&mut tally.orientation);
@@ -394,16 +373,16 @@ impl Tally {
                 k.add_pairs(&b.pair_keys, &b.pair_terms);
                 k.add_escapes(&b.escape_patches, &b.escape_terms);
             }
-            for &p in &b.escape_patches {
-                tally.escapes_by_patch[p as usize] += 1;
-            }
-            if !b.absorbed_patches.is_empty() && tally.absorbed_by_patch.is_empty() {
-                tally.absorbed_by_patch = vec![0; scene.patch_count()];
-            }
-            for &p in &b.absorbed_patches {
-                tally.absorbed_by_patch[p as usize] += 1;
-            }
+            escapes.extend_from_slice(&b.escape_patches);
+            absorbed.extend_from_slice(&b.absorbed_patches);
             batch_keys.push(b.pair_keys);
+        }
+        let n = scene.patch_count();
+        if wanted.discrete {
+            tally.escapes_by_patch = PatchCounts::of_patches(n, escapes);
+        }
+        if !absorbed.is_empty() {
+            tally.absorbed_by_patch = PatchCounts::of_patches(n, absorbed);
         }
         (tally, batch_keys)
     }
@@ -413,11 +392,11 @@ impl Tally {
     /// `F_ij = N_ij / N_i` is the geometric form factor whatever else the row loses.
     pub fn lost_by_patch(&self) -> std::borrow::Cow<'_, [u64]> {
         if self.absorbed_by_patch.is_empty() {
-            return std::borrow::Cow::Borrowed(&self.escapes_by_patch);
+            return self.escapes_by_patch.dense();
         }
         let mut lost = self.escapes_by_patch.clone();
-        add_counts(&mut lost, &self.absorbed_by_patch);
-        std::borrow::Cow::Owned(lost)
+        lost.add(&self.absorbed_by_patch);
+        std::borrow::Cow::Owned(lost.dense().into_owned())
     }
 
     /// The environment patch's area in tracing space ([`environment::area`]).
@@ -440,9 +419,16 @@ impl Tally {
         let c = &self.counters;
         let mut t = self.clone();
         t.counts = self.enclosed_counts(n);
-        t.escapes_by_patch = vec![0; if self.counts.is_some() { n + 1 } else { 0 }];
+        t.escapes_by_patch = if self.counts.is_some() {
+            PatchCounts::zeros(n + 1)
+        } else {
+            PatchCounts::default()
+        };
         if !t.absorbed_by_patch.is_empty() {
-            t.absorbed_by_patch.push(0);
+            let mut absorbed = Vec::new();
+            self.absorbed_by_patch
+                .for_each_counted(|i, k| absorbed.push((i, k)));
+            t.absorbed_by_patch = PatchCounts::of_entries(n + 1, absorbed);
         }
         t.counters.pairs += c.escapes + c.misses;
         t.counters.escapes = 0;
@@ -470,11 +456,8 @@ impl Tally {
         let env = n as u32;
         let mut entries: Vec<(u64, u64)> = Vec::with_capacity(counts.distinct_pairs() + n + 1);
         counts.for_each(|i, j, k| entries.push((pair_key(i, j), k)));
-        for (i, &e) in self.escapes_by_patch.iter().enumerate() {
-            if e > 0 {
-                entries.push((pair_key(i as u32, env), e));
-            }
-        }
+        self.escapes_by_patch
+            .for_each_counted(|i, e| entries.push((pair_key(i, env), e)));
         if self.counters.misses > 0 {
             entries.push((pair_key(env, env), self.counters.misses));
         }
@@ -485,24 +468,11 @@ impl Tally {
     /// at no front side: only those absorbed at back sides (the escapes are pairs with the environment,
     /// which loses nothing); empty when there are none.
     pub fn enclosed_lost(&self, n: usize) -> Vec<u64> {
-        let mut lost = self.absorbed_by_patch.clone();
+        let mut lost = self.absorbed_by_patch.dense().into_owned();
         if !lost.is_empty() {
             lost.resize(n + 1, 0);
         }
         lost
-    }
-}
-
-/// Adds per-patch counts `b` into `a`, which is empty until something is counted (then as long as `b`).
-fn add_counts(a: &mut Vec<u64>, b: &[u64]) {
-    if b.is_empty() {
-        return;
-    }
-    if a.is_empty() {
-        a.resize(b.len(), 0);
-    }
-    for (x, y) in a.iter_mut().zip(b) {
-        *x += y;
     }
 }
 
