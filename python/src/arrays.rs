@@ -170,7 +170,7 @@ pub fn per_triangle(
         ))
     };
     let values: Vec<f64> = match shape.as_slice() {
-        [] => vec![c.extract::<f64>()?],
+        [] => vec![a.call_method1("astype", ("float64",))?.call_method0("item")?.extract::<f64>()?],
         [n] if *n == m => c.downcast::<PyArray1<f64>>()?.readonly().as_slice()?.to_vec(),
         [n, 3] if *n == m => c.downcast::<PyArray2<f64>>()?.readonly().as_slice()?.to_vec(),
         _ => return Err(expected()),
