@@ -37,7 +37,8 @@
 //!   [`load_state`], and parts of one run merge with
 //!   [`RunState::absorb`];
 //! * the applications: [`reproduce`] (the paper's tables), [`mod@refine`] (meshing strategies),
-//!   [`render`] (pictures of the per-patch results), [`mod@crosscheck`] (the two tracers, hit for
+//!   [`render`] (pictures of the per-patch results), [`mod@report`] (the JSON report, per-patch and
+//!   per-object tables, the form-factor matrix as data), [`mod@crosscheck`] (the two tracers, hit for
 //!   hit) and [`calibrate`] (how often the standard errors' intervals cover exact values).
 //!
 //! Inside, the layers in the order data flows (each imports only from the layers before it; a test
@@ -49,6 +50,8 @@
 //! and verdict), then the applications.
 
 #![deny(missing_docs)]
+// The JSON report is one `json!` document of some fifty fields.
+#![recursion_limit = "256"]
 #![deny(unsafe_code)]
 #![forbid(unsafe_op_in_unsafe_fn)]
 
@@ -68,6 +71,7 @@ pub mod calibrate;
 pub mod crosscheck;
 pub mod refine;
 pub mod render;
+pub mod report;
 pub mod reproduce;
 
 // Scenes: loading (files and built-ins), building from arrays, writing.

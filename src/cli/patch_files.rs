@@ -13,13 +13,12 @@ use std::path::{Path, PathBuf};
 
 use rayon::prelude::*;
 
-use scene_complexity::PairCounts;
+use scene_complexity::report::{object_table, patch_table, FormFactors, Table};
+use scene_complexity::Analysis;
 use scene_complexity::PatchMeasure;
-use scene_complexity::Point;
 use scene_complexity::RunIdentity;
 use scene_complexity::Scene;
 use scene_complexity::Wanted;
-use scene_complexity::{Analysis, PatchResult};
 
 use super::exit::Failure;
 use super::output::{self, warn};
@@ -128,8 +127,11 @@ impl PatchFiles {
     pub fn write(&self, scene: &Scene, a: &Analysis) -> Result<(), Failure> {
         write_patches(&self.patches, scene, a)?;
         write_form_factors(&self.form_factors, scene, a)?;
-        for path in &self.objects {
-            write_with(path, |w| objects_csv(w, a))?;
+        if !self.objects.is_empty() {
+            let table = object_table(a);
+            for path in &self.objects {
+                write_with(path, |w| table_csv(w, &table))?;
+            }
         }
         Ok(())
     }
@@ -188,8 +190,9 @@ fn write_patches(paths: &[PathBuf], scene: &Scene, a: &Analysis) -> Result<(), F
             "no per-patch results: the run counted no patch pairs, or closed the scene with --enclose",
         ));
     };
+    let table = patch_table(scene, patches);
     for path in paths {
-        write_with(path, |w| patches_csv(w, scene, patches))?;
+        write_with(path, |w| table_csv(w, &table))?;
     }
     Ok(())
 }
@@ -199,18 +202,16 @@ fn write_form_factors(paths: &[PathBuf], scene: &Scene, a: &Analysis) -> Result<
     if paths.is_empty() {
         return Ok(());
     }
-    let Some(counts) = &a.tally.counts else {
+    let Some(matrix) = FormFactors::of(a, scene.patch_count()) else {
         return Err(Failure::bad_input(
             "no form factors: the run counted no patch pairs (--measures without discrete)",
         ));
     };
-    let entries = ordered_entries(counts);
-    let totals = row_totals(scene.patch_count(), &entries, &a.tally.lost_by_patch());
     for path in paths {
         match matrix_format(path)? {
-            MatrixFormat::Csv => write_with(path, |w| matrix_csv(w, &entries, &totals))?,
+            MatrixFormat::Csv => write_with(path, |w| matrix_csv(w, &matrix))?,
             MatrixFormat::MatrixMarket => {
-                write_with(path, |w| matrix_market(w, scene, a, &entries, &totals))?
+                write_with(path, |w| matrix_market(w, scene, a, &matrix))?
             }
         }
     }
@@ -229,52 +230,24 @@ fn write_with(
     })
 }
 
-/// Every `(i, j, N_ij)` with `N_ij > 0`, both directions of each pair, sorted by `i` then `j`; a
-/// segment from a patch back to itself enters `N_ii` twice (as in the measures).
-fn ordered_entries(counts: &PairCounts) -> Vec<(u32, u32, u64)> {
-    let mut entries = Vec::with_capacity(2 * counts.distinct_pairs());
-    counts.for_each(|i, j, c| {
-        if i == j {
-            entries.push((i, i, 2 * c));
-        } else {
-            entries.push((i, j, c));
-            entries.push((j, i, c));
-        }
-    });
-    entries.par_sort_unstable_by_key(|&(i, j, _)| (i, j));
-    entries
-}
-
-/// `N_i`: each row's counts plus its escapes.
-fn row_totals(patches: usize, entries: &[(u32, u32, u64)], escapes: &[u64]) -> Vec<u64> {
-    let mut n = escapes.to_vec();
-    n.resize(patches, 0);
-    for &(i, _, c) in entries {
-        n[i as usize] += c;
-    }
-    n
-}
-
-/// `F_ij = N_ij / N_i` and its binomial standard error `sqrt(F (1 - F) / N_i)`.
-fn form_factor(count: u64, total: u64) -> (f64, f64) {
-    let n = total as f64;
-    let f = count as f64 / n;
-    (f, (f * (1.0 - f) / n).max(0.0).sqrt())
-}
-
 /// Entries formatted per chunk, in parallel: a fine mesh has millions of them, and formatting the
 /// numbers, not writing them, is what takes the time.
 const CHUNK: usize = 1 << 16;
 
-/// Writes `entries` in order, each chunk turned into bytes by `format` on the thread pool, a few
-/// chunks at a time (so that the whole file is never held in memory).
+/// Writes the entries `0..count` in order, each chunk turned into bytes by `format` on the thread
+/// pool, a few chunks at a time (so that the whole file is never held in memory).
 fn write_in_chunks(
     w: &mut dyn Write,
-    entries: &[(u32, u32, u64)],
-    format: impl Fn(&[(u32, u32, u64)]) -> std::io::Result<Vec<u8>> + Sync,
+    count: usize,
+    format: impl Fn(std::ops::Range<usize>) -> std::io::Result<Vec<u8>> + Sync,
 ) -> std::io::Result<()> {
-    for round in entries.chunks(16 * CHUNK) {
-        let parts: Vec<std::io::Result<Vec<u8>>> = round.par_chunks(CHUNK).map(&format).collect();
+    let chunks: Vec<std::ops::Range<usize>> = (0..count)
+        .step_by(CHUNK)
+        .map(|start| start..(start + CHUNK).min(count))
+        .collect();
+    for round in chunks.chunks(16) {
+        let parts: Vec<std::io::Result<Vec<u8>>> =
+            round.par_iter().map(|r| format(r.clone())).collect();
         for part in parts {
             w.write_all(&part?)?;
         }
@@ -282,23 +255,20 @@ fn write_in_chunks(
     Ok(())
 }
 
-fn matrix_csv(
-    w: &mut dyn Write,
-    entries: &[(u32, u32, u64)],
-    totals: &[u64],
-) -> std::io::Result<()> {
+fn matrix_csv(w: &mut dyn Write, matrix: &FormFactors) -> std::io::Result<()> {
     let mut header = csv::Writer::from_writer(&mut *w);
     header.write_record(["i", "j", "n_ij", "n_i", "f_ij", "f_ij_stderr"])?;
     header.flush()?;
     drop(header);
-    write_in_chunks(w, entries, |chunk| {
+    write_in_chunks(w, matrix.entries.len(), |chunk| {
         let mut out = csv::WriterBuilder::new()
             .has_headers(false)
             .from_writer(Vec::with_capacity(56 * chunk.len()));
         let mut fields: [String; 6] = Default::default();
-        for &(i, j, c) in chunk {
-            let n_i = totals[i as usize];
-            let (f, se) = form_factor(c, n_i);
+        for k in chunk {
+            let (i, j, c) = matrix.entries[k];
+            let n_i = matrix.row_totals[i as usize];
+            let (f, se) = matrix.value(k);
             fields.iter_mut().for_each(String::clear);
             let [fi, fj, fc, fn_, ff, fse] = &mut fields;
             let _ = (
@@ -319,10 +289,9 @@ fn matrix_market(
     w: &mut dyn Write,
     scene: &Scene,
     a: &Analysis,
-    entries: &[(u32, u32, u64)],
-    totals: &[u64],
+    matrix: &FormFactors,
 ) -> std::io::Result<()> {
-    let n = scene.patch_count();
+    let n = matrix.patches;
     writeln!(w, "%%MatrixMarket matrix coordinate real general")?;
     writeln!(
         w,
@@ -333,152 +302,24 @@ fn matrix_market(
         env!("CARGO_PKG_VERSION")
     )?;
     writeln!(w, "% row i, column j (1-based: patch index + 1)")?;
-    writeln!(w, "{n} {n} {}", entries.len())?;
-    write_in_chunks(w, entries, |chunk| {
+    writeln!(w, "{n} {n} {}", matrix.entries.len())?;
+    write_in_chunks(w, matrix.entries.len(), |chunk| {
         let mut out = Vec::with_capacity(32 * chunk.len());
-        for &(i, j, c) in chunk {
-            let (f, _) = form_factor(c, totals[i as usize]);
+        for k in chunk {
+            let (i, j, _) = matrix.entries[k];
+            let (f, _) = matrix.value(k);
             writeln!(out, "{} {} {f}", i + 1, j + 1)?;
         }
         Ok(out)
     })
 }
 
-/// The area-weighted centroid of a patch's triangles, in the scene's own units and frame.
-fn centroid(scene: &Scene, patch: usize) -> Point {
-    let p = &scene.patches[patch];
-    let first = p.first_triangle as usize;
-    let (mut sum, mut weight) = (Point::ZERO, 0.0);
-    for t in &scene.triangles[first..first + p.triangle_count as usize] {
-        let [a, b, c] = t.map(|v| scene.vertices[v as usize]);
-        let area = 0.5 * (b - a).cross(c - a).length();
-        sum += area * (a + b + c) / 3.0;
-        weight += area;
-    }
-    if weight > 0.0 {
-        sum / weight
-    } else {
-        scene.vertices[scene.triangles[first][0] as usize]
-    }
-}
-
-/// The columns of the per-patch catalogue, each value followed by its standard error.
-fn per_patch_columns() -> Vec<String> {
-    PatchMeasure::ALL
-        .iter()
-        .flat_map(|q| {
-            let name = q.info().column;
-            [name.to_string(), format!("{name}_stderr")]
-        })
-        .collect()
-}
-
-/// A number as the CSV files write it (`-0` as `0`), empty when there is none.
-fn csv_number(x: Option<f64>) -> String {
-    x.map(|v| format!("{}", v + 0.0)).unwrap_or_default()
-}
-
-fn patches_csv(w: &mut dyn Write, scene: &Scene, patches: &[PatchResult]) -> std::io::Result<()> {
+/// A table as CSV: its header, then one record per row.
+fn table_csv(w: &mut dyn Write, table: &Table) -> std::io::Result<()> {
     let mut out = csv::Writer::from_writer(w);
-    let mut header: Vec<String> = [
-        "id",
-        "object",
-        "material",
-        "area",
-        "centroid_x",
-        "centroid_y",
-        "centroid_z",
-        "normal_x",
-        "normal_y",
-        "normal_z",
-        "area_fraction",
-        "segments",
-        "escapes",
-        "absorbed",
-        "sampled",
-    ]
-    .map(String::from)
-    .to_vec();
-    header.extend(per_patch_columns());
-    out.write_record(&header)?;
-    let norm = scene.normalization;
-    let total_area = scene.total_area();
-    let num = csv_number;
-    for (i, (patch, p)) in scene.patches.iter().zip(patches).enumerate() {
-        let c = centroid(scene, i);
-        let n = patch.normal;
-        let material = &scene.materials[patch.material as usize].name;
-        let mut row = vec![
-            i.to_string(),
-            scene.objects[patch.object as usize].clone(),
-            material.clone(),
-            num(Some(patch.area * norm.scale * norm.scale)),
-            num(Some(c.x)),
-            num(Some(c.y)),
-            num(Some(c.z)),
-            num(Some(n.x)),
-            num(Some(n.y)),
-            num(Some(n.z)),
-            num(Some(patch.area / total_area)),
-            p.segments.to_string(),
-            p.escapes.to_string(),
-            p.absorbed.to_string(),
-            p.sampled().to_string(),
-        ];
-        for e in PatchMeasure::ALL.map(|q| p.get(q)) {
-            row.push(num(e.map(|e| e.value)));
-            row.push(num(e.and_then(|e| e.stderr)));
-        }
-        out.write_record(&row)?;
-    }
-    out.flush()
-}
-
-/// One row per object: what it is, how lines met it, and its value of each per-patch quantity.
-fn objects_csv(w: &mut dyn Write, a: &Analysis) -> std::io::Result<()> {
-    let mut out = csv::Writer::from_writer(w);
-    let mut header: Vec<String> = [
-        "object",
-        "patches",
-        "triangles",
-        "area",
-        "area_fraction",
-        "segments",
-        "escapes",
-        "escape_fraction",
-        "absorbed",
-        "front_sides_to_open_space",
-        "back_sides_seen_from_fronts",
-        "back_sides_from_open_space",
-        "back_sides_to_open_space",
-    ]
-    .map(String::from)
-    .to_vec();
-    header.extend(per_patch_columns());
-    out.write_record(&header)?;
-    let num = csv_number;
-    let int = |x: Option<u64>| x.map(|v| v.to_string()).unwrap_or_default();
-    for o in &a.objects {
-        let mut row = vec![
-            o.name.clone(),
-            o.patches.to_string(),
-            o.triangles.to_string(),
-            num(Some(o.area)),
-            num(Some(o.area_fraction)),
-            int(o.segments),
-            int(o.escapes),
-            num(o.escape_fraction()),
-            int(o.absorbed),
-            o.sides.front_open.to_string(),
-            o.sides.back_seen.to_string(),
-            o.sides.back_from_open.to_string(),
-            o.sides.back_to_open.to_string(),
-        ];
-        for e in PatchMeasure::ALL.map(|q| o.get(q)) {
-            row.push(num(e.map(|e| e.value)));
-            row.push(num(e.and_then(|e| e.stderr)));
-        }
-        out.write_record(&row)?;
+    out.write_record(table.header())?;
+    for row in 0..table.rows() {
+        out.write_record(table.row_text(row))?;
     }
     out.flush()
 }

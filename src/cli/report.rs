@@ -6,16 +6,16 @@ use std::fmt::Write;
 
 use clap::ValueEnum;
 
-use scene_complexity::LineSource;
+use scene_complexity::report::{
+    bundle, positive_zero, rows, skipped_reason, Context, Process, Row,
+};
 use scene_complexity::Scene;
 use scene_complexity::VerdictRule;
 use scene_complexity::{
-    Analysis, ObjectResult, PatchMeasure, RadiosityOutcome, Reliability, TargetOutcome, Verdict,
-    COVERAGE_OK,
+    Analysis, RadiosityOutcome, Reliability, TargetOutcome, Verdict, COVERAGE_OK,
 };
 use scene_complexity::{ErrorMethod, Shard, StopReason, Tracing};
-use scene_complexity::{Estimate, Family, Measure, Unit};
-use serde_json::{json, Value};
+use scene_complexity::{Estimate, Family, Measure};
 
 use super::table::{fixed, Align, Table};
 
@@ -39,11 +39,6 @@ pub fn render(format: Format, run: &RunInfo, a: &Analysis) -> String {
     }
 }
 
-/// JSON schema version of `analyze --format json` (2: units, reliability, sampling, target, command
-/// line, CPU; 3: segments to back sides counted in their rows (`absorbed`), and I_s^c of an open scene
-/// on the footing of the discrete measures, the lost segments counted).
-pub const SCHEMA_VERSION: u32 = 4;
-
 /// Facts about the run that the analysis itself does not hold: the scene, how it ran.
 pub struct RunInfo<'a> {
     pub scene: &'a Scene,
@@ -55,295 +50,19 @@ pub struct RunInfo<'a> {
     pub shard: Option<Shard>,
 }
 
-/// Lines per side of a bundle, 0 for independent lines.
-fn bundle(a: &Analysis) -> u32 {
-    match a.spec.source {
-        LineSource::Independent => 0,
-        LineSource::Bundles { grid } => grid,
-    }
-}
-
-/// One row of the report: JSON key, table label, unit, paper reference, plug-in and bias-corrected
-/// estimates, and their verdicts.
-pub struct Row<'a> {
-    pub key: &'static str,
-    pub label: &'static str,
-    pub unit: Unit,
-    pub reference: &'static str,
-    pub estimate: Option<Estimate>,
-    pub corrected: Option<Estimate>,
-    pub reliability: Option<&'a Reliability>,
-    pub corrected_reliability: Option<&'a Reliability>,
-}
-
-/// The rows of `family`'s measures, in the catalogue's order: one per plug-in reading, with its
-/// bias-corrected reading beside it.
-pub fn rows(a: &Analysis, family: Family) -> Vec<Row<'_>> {
-    Measure::of_family(family)
-        .filter(|m| m.info().corrects.is_none())
-        .map(|m| {
-            let info = m.info();
-            let corrected = m.corrected();
-            Row {
-                key: info.key,
-                label: info.label,
-                unit: info.unit,
-                reference: info.equation,
-                estimate: a.estimate(m),
-                corrected: corrected.and_then(|c| a.estimate(c)),
-                reliability: a.reliability.get(m),
-                corrected_reliability: corrected.and_then(|c| a.reliability.get(c)),
-            }
-        })
-        .collect()
-}
-
-/// `-0.0` as `0.0`, so that no report shows a negative zero.
-fn positive_zero(x: f64) -> f64 {
-    x + 0.0
-}
-
-/// A finite number for JSON (`null` otherwise).
-fn finite(x: f64) -> Option<f64> {
-    x.is_finite().then_some(positive_zero(x))
-}
-
-fn reliability_json(r: Option<&Reliability>) -> Value {
-    match r {
-        None => Value::Null,
-        Some(r) => json!({
-            "verdict": r.verdict.name(),
-            "estimated_bias": r.estimated_bias.and_then(finite),
-            "lines_needed": r.lines_needed,
-            "flags": r.flags,
-        }),
-    }
-}
-
-fn estimate_json(e: Estimate, unit: Unit, r: Option<&Reliability>, quantile: f64) -> Value {
-    let interval = e
-        .interval(quantile)
-        .filter(|(lo, hi)| lo.is_finite() && hi.is_finite());
-    json!({
-        "value": finite(e.value),
-        "stderr": e.stderr.and_then(finite),
-        "interval_95": interval.map(|(lo, hi)| [positive_zero(lo), positive_zero(hi)]),
-        "unit": unit.name(),
-        "reliability": reliability_json(r),
-    })
-}
-
-fn row_json(r: &Row, quantile: f64) -> Value {
-    let Some(e) = r.estimate else {
-        return Value::Null;
-    };
-    let mut v = estimate_json(e, r.unit, r.reliability, quantile);
-    if let (Value::Object(map), Some(c)) = (&mut v, r.corrected) {
-        map.insert(
-            "corrected".into(),
-            estimate_json(c, r.unit, r.corrected_reliability, quantile),
-        );
-    }
-    v
-}
-
-/// The CPU's model name (Linux), else its architecture.
-fn cpu() -> String {
-    std::fs::read_to_string("/proc/cpuinfo")
-        .ok()
-        .and_then(|text| {
-            text.lines()
-                .find(|l| l.starts_with("model name"))
-                .and_then(|l| l.split_once(':'))
-                .map(|(_, name)| name.trim().to_string())
-        })
-        .unwrap_or_else(|| std::env::consts::ARCH.to_string())
-}
-
-/// The command line as given.
-fn command_line() -> Vec<String> {
-    std::env::args().collect()
-}
-
-fn sampling_json(a: &Analysis) -> Value {
-    match &a.sampling {
-        None => Value::Null,
-        Some(s) => json!({
-            "rows": s.sampling.rows,
-            "sampled_rows": s.sampling.sampled_rows,
-            "segments_per_row": finite(s.sampling.segments_per_row),
-            "coverage": finite(s.sampling.coverage),
-            "singleton_share": finite(s.sampling.singleton_share),
-            "lines_for_coverage_0_99": s.lines_for_coverage,
-        }),
-    }
-}
-
-fn target_json(t: &Option<TargetOutcome>) -> Value {
-    match t {
-        None => Value::Null,
-        Some(t) => json!({
-            "measure": t.measure.key(),
-            "stderr_goal": t.stderr_goal,
-            "stderr": t.stderr.and_then(finite),
-            "verdict": t.verdict.map(Verdict::name),
-            "met": t.met(),
-        }),
-    }
-}
-
-/// The JSON document of `analyze --format json`.
+/// The JSON document of `analyze --format json`, with this process's fields.
 pub fn json(run: &RunInfo, a: &Analysis) -> String {
-    let mut visibility = serde_json::Map::new();
-    for r in rows(a, Family::Visibility) {
-        visibility.insert(r.key.into(), row_json(&r, a.interval_quantile()));
-    }
-    let doc = json!({
-        "schema_version": SCHEMA_VERSION,
-        "scx_version": env!("CARGO_PKG_VERSION"),
-        "command_line": command_line(),
-        "cpu": cpu(),
-        "unit": "bit",
-        "scene": run.scene.name,
-        "patches": run.scene.patch_count(),
-        "triangles": run.scene.triangles.len(),
-        "area": run.scene.total_area_scene_units(),
-        "tracer": run.tracing.backend.name(),
-        "query": run.tracing.query.to_string(),
-        "bundle": bundle(a),
-        "lines": a.lines,
-        "seed": a.spec.seed,
-        "threads": run.threads,
-        "groups": a.groups,
-        "intervals": json!({
-            "level": 0.95,
-            "quantile": finite(a.interval_quantile()),
-            "degrees_of_freedom": a.groups.saturating_sub(1),
-        }),
-        "seconds": a.seconds,
-        "build_seconds": run.build_seconds,
-        "stop_reason": a.stop_reason.name(),
-        "interrupted": a.stop_reason == StopReason::Interrupted,
-        "complete": a.is_complete(),
-        "covered_lines": a.covered_lines().iter().map(|r| [r.start, r.end]).collect::<Vec<_>>(),
-        "shard": run.shard.map(|s| json!({"index": s.index, "count": s.count})),
-        "target": target_json(&a.target),
-        "estimator": a.spec.estimator.name(),
-        "errors": a.errors.name(),
-        "hits": a.hits,
-        "pairs": a.pairs,
-        "escapes": a.escapes,
-        "unpaired": a.unpaired,
-        "escape_fraction": a.escape_fraction(),
-        "absorbed": a.absorbed,
-        "absorbed_fraction": a.absorbed_fraction(),
-        "degenerate_pairs": a.degenerate_pairs,
-        "coincident_crossings": a.tally.counters.coincident_crossings,
-        "environment_area": a.environment_area.map(|e| json!({
-            "value": finite(e.value), "stderr": e.stderr.and_then(finite), "unit": "scene units^2"
-        })),
-        "distinct_pairs": a.distinct_pairs,
-        "unsampled_patches": a.unsampled.map(|u| u.0),
-        "unsampled_area_fraction": a.unsampled.map(|u| u.1),
-        "sampling": sampling_json(a),
-        "visibility": Value::Object(visibility),
-        "radiosity": radiosity_json(a),
-        "radiosity_skipped": skipped_reason(&a.radiosity).map_or(Value::Null, Value::from),
-        "objects": objects_json(a),
-        "warnings": warnings_json(run.scene, a),
-    });
+    let context = Context {
+        scene: run.scene,
+        tracing: run.tracing,
+        build_seconds: run.build_seconds,
+        shard: run.shard,
+        process: Some(Process::current(run.threads)),
+    };
+    let doc = scene_complexity::report::json(&context, a);
     let mut s = serde_json::to_string_pretty(&doc).expect("a JSON value always serialises");
     s.push('\n');
     s
-}
-
-/// Each object's results: what it is, how its sides were met, its segments (when the pairs were
-/// counted) and, with per-patch results, its value of each per-patch quantity with its standard error.
-fn objects_json(a: &Analysis) -> Value {
-    let object = |o: &ObjectResult| {
-        let mut doc = json!({
-            "name": o.name,
-            "patches": o.patches,
-            "triangles": o.triangles,
-            "area": finite(o.area),
-            "area_fraction": finite(o.area_fraction),
-            "segments": o.segments,
-            "escapes": o.escapes,
-            "escape_fraction": o.escape_fraction(),
-            "absorbed": o.absorbed,
-            "front_sides_to_open_space": o.sides.front_open,
-            "back_sides_seen_from_fronts": o.sides.back_seen,
-            "back_sides_from_open_space": o.sides.back_from_open,
-            "back_sides_to_open_space": o.sides.back_to_open,
-        });
-        let map = doc.as_object_mut().expect("an object");
-        for q in PatchMeasure::ALL {
-            let value = o.get(q).map_or(
-                Value::Null,
-                |e| json!({"value": finite(e.value), "stderr": e.stderr.and_then(finite)}),
-            );
-            map.insert(q.info().column.to_string(), value);
-        }
-        doc
-    };
-    Value::Array(a.objects.iter().map(object).collect())
-}
-
-/// The warnings as data: how the scene was read, then the run's; each with its stable code, the
-/// objects it is about, the numbers it reports and its sentence.
-fn warnings_json(scene: &Scene, a: &Analysis) -> Value {
-    let entry =
-        |from: &str, code: &str, message: &str, objects: &[String], numbers: &[(&str, f64)]| {
-            let numbers: serde_json::Map<String, Value> = numbers
-                .iter()
-                .map(|&(k, v)| (k.to_string(), finite(v).map_or(Value::Null, Value::from)))
-                .collect();
-            json!({
-                "code": code,
-                "from": from,
-                "objects": objects,
-                "numbers": numbers,
-                "message": message,
-            })
-        };
-    let read = scene
-        .warnings
-        .iter()
-        .map(|w| entry("scene", w.kind.code(), &w.message, &w.objects, &w.numbers));
-    let run = a
-        .warnings
-        .iter()
-        .map(|w| entry("run", w.kind.code(), &w.message, &w.objects, &w.numbers));
-    Value::Array(read.chain(run).collect())
-}
-
-/// Why the radiosity measures were left out (`None` when computed).
-fn skipped_reason(outcome: &RadiosityOutcome) -> Option<&str> {
-    match outcome {
-        RadiosityOutcome::Computed(_) => None,
-        RadiosityOutcome::NotRequested => Some("not requested (--measures leaves radiosity out)"),
-        RadiosityOutcome::Skipped(reason) => Some(reason),
-    }
-}
-
-/// The `radiosity` object of the JSON report (`null` when skipped).
-fn radiosity_json(a: &Analysis) -> Value {
-    let RadiosityOutcome::Computed(r) = &a.radiosity else {
-        return Value::Null;
-    };
-    let mut m = serde_json::Map::new();
-    for row in rows(a, Family::Radiosity) {
-        m.insert(row.key.into(), row_json(&row, a.interval_quantile()));
-    }
-    m.insert("solver_residual".into(), json!(finite(r.solver_residual)));
-    m.insert("solver_tolerance".into(), json!(r.solver_tolerance));
-    m.insert("solver_iterations".into(), json!(r.solver_sweeps));
-    m.insert("excluded_patches".into(), json!(r.excluded_patches));
-    m.insert(
-        "excluded_area_fraction".into(),
-        json!(finite(r.excluded_area_fraction)),
-    );
-    Value::Object(m)
 }
 
 /// One CSV row per reading, with the run's scene, lines, seed and tracer, so that files combine.

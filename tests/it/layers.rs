@@ -24,7 +24,14 @@ const LAYERS: &[(&str, &[&str])] = &[
     ("analysis", &["analysis"]),
     (
         "applications",
-        &["reproduce", "refine", "crosscheck", "render", "calibrate"],
+        &[
+            "reproduce",
+            "refine",
+            "crosscheck",
+            "render",
+            "report",
+            "calibrate",
+        ],
     ),
     ("cli", &[]),
 ];

@@ -15,6 +15,7 @@ mod lines_and_tracers;
 mod patches;
 mod radiosity;
 mod render;
+mod report;
 mod rust_bvh;
 mod scene_files;
 mod stability;
