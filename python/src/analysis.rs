@@ -5,9 +5,11 @@ use pyo3::exceptions::{PyAttributeError, PyKeyError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
+use numpy::{IntoPyArray, PyArray1};
+use scene_complexity::report::{self, object_table, patch_table, Context, FormFactors, Table, Values};
 use scene_complexity::{
-    Estimate, Family, Measure, RadiosityOutcome, Reliability, RunIdentity, RunState, StopReason,
-    Tracing,
+    Estimate, Family, Measure, RadiosityOutcome, Reliability, RunIdentity, RunState, Shard,
+    StopReason, Tracing,
 };
 
 use crate::errors::{bad_argument, persist_error};
@@ -119,9 +121,13 @@ impl Reading {
 /// How a run ran, beside what it found: not part of its numbers.
 #[derive(Clone, Copy, Debug)]
 pub struct RunFacts {
+    /// The tracer the report names: the one that cast the lines (for a merge, the states' own, as
+    /// `scx merge` reports).
     pub tracing: Tracing,
     pub threads: usize,
     pub build_seconds: f64,
+    /// The shard the report names (`scx merge` names none).
+    pub shard: Option<Shard>,
 }
 
 /// The results of a run (:func:`scx.analyze`, :func:`scx.resume`, :func:`scx.merge`).
@@ -140,6 +146,27 @@ pub struct Analysis {
 }
 
 impl Analysis {
+    /// The per-patch table, or why there is none.
+    fn patch_table(&self) -> PyResult<Table> {
+        let patches = self.inner.patches.as_ref().ok_or_else(|| {
+            bad_argument(
+                "this analysis has no per-patch results: run it with per_patch=True (not with \
+                 enclose=True, and with the discrete measures)",
+            )
+        })?;
+        Ok(patch_table(&self.scene.get().inner, patches))
+    }
+
+    /// The form-factor matrix, or why there is none.
+    fn form_factor_entries_of(&self) -> PyResult<FormFactors> {
+        let n = self.scene.get().inner.patch_count();
+        FormFactors::of(&self.inner, n).ok_or_else(|| {
+            bad_argument(
+                "no form factors: the run counted no patch pairs (measures without discrete)",
+            )
+        })
+    }
+
     /// The reading of `measure`, with its corrected reading beside it.
     fn reading(&self, py: Python<'_>, measure: Measure) -> PyResult<Option<Reading>> {
         let Some(e) = self.inner.estimate(measure) else {
@@ -348,6 +375,113 @@ impl Analysis {
         py.import("json")?.call_method1("loads", (text,))
     }
 
+    /// The report as a dict: the document of ``scx analyze --format json`` (``scx merge`` for a merge)
+    /// for the same run, but for the fields of the process (``command_line``, ``cpu``, ``threads``),
+    /// which it leaves out; ``seconds`` and ``build_seconds`` are this run's. docs/results.md
+    /// describes the fields.
+    fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let scene = &self.scene.get().inner;
+        let context = Context {
+            scene,
+            tracing: self.facts.tracing,
+            build_seconds: self.facts.build_seconds,
+            shard: self.facts.shard,
+            process: None,
+        };
+        let text = serde_json::to_string(&report::json(&context, &self.inner))
+            .map_err(|e| crate::errors::runtime_error(e.to_string()))?;
+        py.import("json")?.call_method1("loads", (text,))
+    }
+
+    /// The per-patch results as a dict of numpy arrays, one per column of ``scx analyze --patches``
+    /// (the same names; docs/per-patch.md lists them with their units): ``id``, ``object``,
+    /// ``material``, ``area``, ``centroid_x``, ..., ``segments``, ``row_entropy``,
+    /// ``continuous_mutual_information_term``, ... each quantity followed by its ``_stderr``.
+    /// Numbers are float64 (NaN where there is none), counts int64, names str. Row ``k`` is the
+    /// scene's patch ``k``.
+    ///
+    /// Raises:
+    ///     ValueError: the run gathered no per-patch results (``analyze(..., per_patch=True)``).
+    fn patches<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        table_dict(py, &self.patch_table()?, false)
+    }
+
+    /// :meth:`patches` as a pandas DataFrame indexed by ``id`` (``object`` and ``material``
+    /// categorical). Needs pandas.
+    fn patches_frame<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let frame = table_frame(py, &self.patch_table()?)?;
+        frame.call_method1("set_index", ("id",))
+    }
+
+    /// Each object's results (``scx analyze --objects``) as a dict of numpy arrays: name, patches,
+    /// triangles, area, segments, how lines met its sides and, with per-patch results, its share of
+    /// each per-patch quantity.
+    fn objects<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        table_dict(py, &object_table(&self.inner), false)
+    }
+
+    /// :meth:`objects` as a pandas DataFrame indexed by object name. Needs pandas.
+    fn objects_frame<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let frame = table_frame(py, &object_table(&self.inner))?;
+        frame.call_method1("set_index", ("object",))
+    }
+
+    /// The form factors ``F_ij = N_ij / N_i`` (the share of patch i's segments that end on patch j)
+    /// and their standard errors ``sqrt(F (1 - F) / N_i)``, as two ``scipy.sparse.csr_matrix`` of
+    /// ``n_p x n_p`` with the same entries: the matrix of ``scx analyze --form-factors``. Rows sum to 1
+    /// in a closed scene (less what escapes in an open one). Needs scipy.
+    ///
+    /// Raises:
+    ///     ValueError: the run counted no patch pairs (``measures`` without ``discrete``).
+    fn form_factors<'py>(&self, py: Python<'py>) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
+        let ff = self.form_factor_entries_of()?;
+        let n = ff.patches;
+        let mut indptr = vec![0i64; n + 1];
+        for &(i, _, _) in &ff.entries {
+            indptr[i as usize + 1] += 1;
+        }
+        for k in 0..n {
+            indptr[k + 1] += indptr[k];
+        }
+        let indices: Vec<i64> = ff.entries.iter().map(|&(_, j, _)| i64::from(j)).collect();
+        let (values, errors): (Vec<f64>, Vec<f64>) =
+            (0..ff.entries.len()).map(|k| ff.value(k)).unzip();
+        let sparse = py.import("scipy.sparse").map_err(|e| {
+            pyo3::exceptions::PyImportError::new_err(format!(
+                "form_factors needs scipy (pip install scipy): {e}"
+            ))
+        })?;
+        let csr = sparse.getattr("csr_matrix")?;
+        let indptr = indptr.into_pyarray(py);
+        let indices = indices.into_pyarray(py);
+        let matrix = |data: Vec<f64>| {
+            csr.call1((
+                (data.into_pyarray(py), indices.clone(), indptr.clone()),
+                (n, n),
+            ))
+        };
+        Ok((matrix(values)?, matrix(errors)?))
+    }
+
+    /// The form factors' entries as numpy arrays, the columns of ``scx analyze --form-factors x.csv``:
+    /// ``i``, ``j``, ``n_ij``, ``n_i``, ``f_ij``, ``f_ij_stderr`` (sorted by i, then j).
+    fn form_factor_entries<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let ff = self.form_factor_entries_of()?;
+        let d = PyDict::new(py);
+        let column = |f: &dyn Fn(&(u32, u32, u64)) -> i64| -> Bound<'py, PyArray1<i64>> {
+            ff.entries.iter().map(f).collect::<Vec<i64>>().into_pyarray(py)
+        };
+        d.set_item("i", column(&|e| i64::from(e.0)))?;
+        d.set_item("j", column(&|e| i64::from(e.1)))?;
+        d.set_item("n_ij", column(&|e| e.2 as i64))?;
+        d.set_item("n_i", column(&|e| ff.row_totals[e.0 as usize] as i64))?;
+        let (values, errors): (Vec<f64>, Vec<f64>) =
+            (0..ff.entries.len()).map(|k| ff.value(k)).unzip();
+        d.set_item("f_ij", values.into_pyarray(py))?;
+        d.set_item("f_ij_stderr", errors.into_pyarray(py))?;
+        Ok(d)
+    }
+
     /// Saves the run's state to ``path`` (the command line's state file: ``scx merge`` reports it,
     /// :func:`scx.resume` and ``scx analyze --resume`` continue it). Written atomically.
     ///
@@ -394,4 +528,62 @@ impl Analysis {
             parts.join(", ")
         ))
     }
+}
+
+/// A column's values as a numpy array: float64 numbers (NaN for none), int64 counts (float64 with NaN
+/// when some are missing), bool flags, and names as str (or, for a frame, a pandas Categorical).
+fn column_array<'py>(py: Python<'py>, values: &Values, categorical: bool) -> PyResult<Bound<'py, PyAny>> {
+    Ok(match values {
+        Values::Numbers(v) => v
+            .iter()
+            .map(|x| x.unwrap_or(f64::NAN))
+            .collect::<Vec<f64>>()
+            .into_pyarray(py)
+            .into_any(),
+        Values::Integers(v) if v.iter().all(Option::is_some) => v
+            .iter()
+            .map(|x| x.unwrap_or_default() as i64)
+            .collect::<Vec<i64>>()
+            .into_pyarray(py)
+            .into_any(),
+        Values::Integers(v) => v
+            .iter()
+            .map(|x| x.map_or(f64::NAN, |n| n as f64))
+            .collect::<Vec<f64>>()
+            .into_pyarray(py)
+            .into_any(),
+        Values::Flags(v) => v.clone().into_pyarray(py).into_any(),
+        Values::Labels { names, codes } => {
+            let codes: Vec<i64> = codes.iter().map(|&c| i64::from(c)).collect();
+            let codes = codes.into_pyarray(py);
+            if categorical {
+                py.import("pandas")?
+                    .getattr("Categorical")?
+                    .call_method1("from_codes", (codes, names.clone()))?
+            } else {
+                let names = py.import("numpy")?.call_method1("array", (names.clone(),))?;
+                names.get_item(codes)?
+            }
+        }
+    })
+}
+
+/// A table as a dict of column name to numpy array.
+fn table_dict<'py>(py: Python<'py>, table: &Table, categorical: bool) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    for c in &table.columns {
+        d.set_item(&c.name, column_array(py, &c.values, categorical)?)?;
+    }
+    Ok(d)
+}
+
+/// A table as a pandas DataFrame (names as categoricals).
+fn table_frame<'py>(py: Python<'py>, table: &Table) -> PyResult<Bound<'py, PyAny>> {
+    let pandas = py.import("pandas").map_err(|e| {
+        pyo3::exceptions::PyImportError::new_err(format!(
+            "a DataFrame needs pandas (pip install pandas): {e}"
+        ))
+    })?;
+    let columns = table_dict(py, table, true)?;
+    pandas.getattr("DataFrame")?.call1((columns,))
 }

@@ -99,6 +99,9 @@ struct Session {
     threads: usize,
     save: Option<PathBuf>,
     keep_state: bool,
+    /// The tracer and shard its report names (`scx merge` names the states' tracer and no shard).
+    report_tracing: Tracing,
+    report_shard: Option<Shard>,
 }
 
 /// What the worker thread hands back.
@@ -235,9 +238,10 @@ fn run_session(
                 identity: s.identity,
                 state,
                 facts: RunFacts {
-                    tracing: TRACING,
+                    tracing: s.report_tracing,
                     threads: s.threads,
                     build_seconds,
+                    shard: s.report_shard,
                 },
             })
         }
@@ -388,6 +392,8 @@ pub fn analyze(
         threads,
         save,
         keep_state,
+        report_tracing: TRACING,
+        report_shard: shard,
     };
     run_session(py, session, state, progress)
 }
@@ -512,6 +518,7 @@ pub fn resume(
         ..identity.spec.clone()
     };
     let scope = Scope::of(identity.shard);
+    let report_shard = identity.shard;
     let session = Session {
         scene,
         identity,
@@ -522,6 +529,8 @@ pub fn resume(
         threads,
         save: Some(file),
         keep_state,
+        report_tracing: TRACING,
+        report_shard,
     };
     run_session(py, session, state, progress)
 }
@@ -639,6 +648,7 @@ pub fn merge(
         per_patch,
         ..identity.spec.clone()
     };
+    let report_tracing = identity.tracing;
     let session = Session {
         scene,
         identity,
@@ -649,6 +659,8 @@ pub fn merge(
         threads,
         save,
         keep_state,
+        report_tracing,
+        report_shard: None,
     };
     run_session(py, session, state, None)
 }
