@@ -6,7 +6,9 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use numpy::{IntoPyArray, PyArray1};
-use scene_complexity::report::{self, object_table, patch_table, Context, FormFactors, Table, Values};
+use scene_complexity::report::{
+    self, object_table, patch_table, Context, FormFactors, Table, Values,
+};
 use scene_complexity::{
     Estimate, Family, Measure, RadiosityOutcome, Reliability, RunIdentity, RunState, Shard,
     StopReason, Tracing,
@@ -173,10 +175,7 @@ impl Analysis {
             return Ok(None);
         };
         let corrected = match measure.corrected() {
-            Some(c) => self
-                .reading(py, c)?
-                .map(|r| Py::new(py, r))
-                .transpose()?,
+            Some(c) => self.reading(py, c)?.map(|r| Py::new(py, r)).transpose()?,
             None => None,
         };
         Ok(Some(reading_of(
@@ -229,9 +228,7 @@ impl Analysis {
     ///     KeyError: ``key`` is not a measure's.
     fn __getitem__(&self, py: Python<'_>, key: &str) -> PyResult<Option<Reading>> {
         let m = Analysis::visibility(key).ok_or_else(|| {
-            PyKeyError::new_err(format!(
-                "{key:?} is not a measure; scx.MEASURES lists them"
-            ))
+            PyKeyError::new_err(format!("{key:?} is not a measure; scx.MEASURES lists them"))
         })?;
         self.reading(py, m)
     }
@@ -358,7 +355,11 @@ impl Analysis {
     /// What the user must know about these numbers (an open scene, unsampled patches, ...).
     #[getter]
     fn warnings(&self) -> Vec<String> {
-        self.inner.warnings.iter().map(|w| w.message.clone()).collect()
+        self.inner
+            .warnings
+            .iter()
+            .map(|w| w.message.clone())
+            .collect()
     }
 
     /// Whether the run gathered the per-patch results (``analyze(..., per_patch=True)``).
@@ -433,7 +434,10 @@ impl Analysis {
     ///
     /// Raises:
     ///     ValueError: the run counted no patch pairs (``measures`` without ``discrete``).
-    fn form_factors<'py>(&self, py: Python<'py>) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
+    fn form_factors<'py>(
+        &self,
+        py: Python<'py>,
+    ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
         let ff = self.form_factor_entries_of()?;
         let n = ff.patches;
         let mut indptr = vec![0i64; n + 1];
@@ -469,7 +473,11 @@ impl Analysis {
         let ff = self.form_factor_entries_of()?;
         let d = PyDict::new(py);
         let column = |f: &dyn Fn(&(u32, u32, u64)) -> i64| -> Bound<'py, PyArray1<i64>> {
-            ff.entries.iter().map(f).collect::<Vec<i64>>().into_pyarray(py)
+            ff.entries
+                .iter()
+                .map(f)
+                .collect::<Vec<i64>>()
+                .into_pyarray(py)
         };
         d.set_item("i", column(&|e| i64::from(e.0)))?;
         d.set_item("j", column(&|e| i64::from(e.1)))?;
@@ -532,7 +540,11 @@ impl Analysis {
 
 /// A column's values as a numpy array: float64 numbers (NaN for none), int64 counts (float64 with NaN
 /// when some are missing), bool flags, and names as str (or, for a frame, a pandas Categorical).
-fn column_array<'py>(py: Python<'py>, values: &Values, categorical: bool) -> PyResult<Bound<'py, PyAny>> {
+fn column_array<'py>(
+    py: Python<'py>,
+    values: &Values,
+    categorical: bool,
+) -> PyResult<Bound<'py, PyAny>> {
     Ok(match values {
         Values::Numbers(v) => v
             .iter()
@@ -561,7 +573,9 @@ fn column_array<'py>(py: Python<'py>, values: &Values, categorical: bool) -> PyR
                     .getattr("Categorical")?
                     .call_method1("from_codes", (codes, names.clone()))?
             } else {
-                let names = py.import("numpy")?.call_method1("array", (names.clone(),))?;
+                let names = py
+                    .import("numpy")?
+                    .call_method1("array", (names.clone(),))?;
                 names.get_item(codes)?
             }
         }
@@ -569,7 +583,11 @@ fn column_array<'py>(py: Python<'py>, values: &Values, categorical: bool) -> PyR
 }
 
 /// A table as a dict of column name to numpy array.
-fn table_dict<'py>(py: Python<'py>, table: &Table, categorical: bool) -> PyResult<Bound<'py, PyDict>> {
+fn table_dict<'py>(
+    py: Python<'py>,
+    table: &Table,
+    categorical: bool,
+) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
     for c in &table.columns {
         d.set_item(&c.name, column_array(py, &c.values, categorical)?)?;

@@ -203,7 +203,10 @@ pub fn estimator(name: &str) -> PyResult<EntropyEstimator> {
 pub fn errors(name: &str) -> PyResult<ErrorMethod> {
     ErrorMethod::from_name(name).ok_or_else(|| {
         let names: Vec<&str> = ErrorMethod::NAMES.iter().map(|(n, _)| *n).collect();
-        bad_argument(format!("errors: `{name}` is not one of {}", names.join(", ")))
+        bad_argument(format!(
+            "errors: `{name}` is not one of {}",
+            names.join(", ")
+        ))
     })
 }
 

@@ -8,7 +8,11 @@ use crate::args::repr;
 use crate::errors::scene_error;
 
 /// `obj` as a numpy array (a view when it is one already), or a `SceneError` naming `what`.
-fn as_array<'py>(py: Python<'py>, obj: &Bound<'py, PyAny>, what: &str) -> PyResult<Bound<'py, PyAny>> {
+fn as_array<'py>(
+    py: Python<'py>,
+    obj: &Bound<'py, PyAny>,
+    what: &str,
+) -> PyResult<Bound<'py, PyAny>> {
     py.import("numpy")?
         .call_method1("asarray", (obj,))
         .map_err(|e| scene_error(format!("{what} is not an array of numbers ({e})")))
@@ -39,7 +43,13 @@ fn contiguous<'py>(
 }
 
 /// Checks an array's number of dimensions and, for a matrix, its number of columns.
-fn check_shape(array: &Bound<'_, PyAny>, what: &str, expected: &str, ndim: usize, columns: Option<usize>) -> PyResult<()> {
+fn check_shape(
+    array: &Bound<'_, PyAny>,
+    what: &str,
+    expected: &str,
+    ndim: usize,
+    columns: Option<usize>,
+) -> PyResult<()> {
     let shape: Vec<usize> = array.getattr("shape")?.extract()?;
     let ok = shape.len() == ndim && columns.is_none_or(|c| shape.get(1) == Some(&c));
     if !ok {
@@ -170,9 +180,20 @@ pub fn per_triangle(
         ))
     };
     let values: Vec<f64> = match shape.as_slice() {
-        [] => vec![a.call_method1("astype", ("float64",))?.call_method0("item")?.extract::<f64>()?],
-        [n] if *n == m => c.downcast::<PyArray1<f64>>()?.readonly().as_slice()?.to_vec(),
-        [n, 3] if *n == m => c.downcast::<PyArray2<f64>>()?.readonly().as_slice()?.to_vec(),
+        [] => vec![a
+            .call_method1("astype", ("float64",))?
+            .call_method0("item")?
+            .extract::<f64>()?],
+        [n] if *n == m => c
+            .downcast::<PyArray1<f64>>()?
+            .readonly()
+            .as_slice()?
+            .to_vec(),
+        [n, 3] if *n == m => c
+            .downcast::<PyArray2<f64>>()?
+            .readonly()
+            .as_slice()?
+            .to_vec(),
         _ => return Err(expected()),
     };
     if let Some(k) = values.iter().position(|x| !x.is_finite()) {

@@ -32,7 +32,10 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(run::resume, m)?)?;
     m.add_function(wrap_pyfunction!(run::merge, m)?)?;
     m.add_function(wrap_pyfunction!(picture::render, m)?)?;
-    m.add("MEASURES", analysis::catalogue(py, scene_complexity::Family::Visibility)?)?;
+    m.add(
+        "MEASURES",
+        analysis::catalogue(py, scene_complexity::Family::Visibility)?,
+    )?;
     m.add(
         "RADIOSITY_MEASURES",
         analysis::catalogue(py, scene_complexity::Family::Radiosity)?,

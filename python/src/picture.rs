@@ -75,7 +75,9 @@ fn camera_of(py: Python<'_>, value: &Bound<'_, PyAny>) -> PyResult<Camera> {
         up: Vector::new(v[6], v[7], v[8]),
         fov_degrees: v[9],
     };
-    camera.validate().map_err(|e| bad_argument(format!("camera: {e}")))?;
+    camera
+        .validate()
+        .map_err(|e| bad_argument(format!("camera: {e}")))?;
     Ok(camera)
 }
 
@@ -88,12 +90,20 @@ fn size_of(value: &Bound<'_, PyAny>) -> PyResult<(usize, usize)> {
         ))
     })?;
     let dim = |d: &Bound<'_, PyAny>, what: &str| args::whole(d, what, 16, 8192);
-    Ok((dim(&w, "the width")? as usize, dim(&h, "the height")? as usize))
+    Ok((
+        dim(&w, "the width")? as usize,
+        dim(&h, "the height")? as usize,
+    ))
 }
 
 /// Each patch's value of `q`, per unit area fraction when `per_area` (the library's per-patch results;
 /// `scx render`'s `patch_values`).
-fn values_of(a: &Analysis, scene: &scene_complexity::Scene, q: Quantity, per_area: bool) -> PyResult<Vec<Option<f64>>> {
+fn values_of(
+    a: &Analysis,
+    scene: &scene_complexity::Scene,
+    q: Quantity,
+    per_area: bool,
+) -> PyResult<Vec<Option<f64>>> {
     let patches = a.inner.patches.as_ref().ok_or_else(|| {
         bad_argument(
             "this analysis has no per-patch results to colour by: run it with per_patch=True (or \
@@ -151,7 +161,8 @@ fn scale_of(
 
 /// Writes RGB pixels as a PNG.
 fn write_png(path: &Path, w: usize, h: usize, pixels: &[u8]) -> Result<(), String> {
-    let file = std::fs::File::create(path).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+    let file =
+        std::fs::File::create(path).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
     let mut encoder = png::Encoder::new(BufWriter::new(file), w as u32, h as u32);
     encoder.set_color(png::ColorType::Rgb);
     encoder.set_depth(png::BitDepth::Eight);
@@ -198,7 +209,10 @@ pub fn render<'py>(
         .map(|p| path_text(p, "path"))
         .transpose()?;
     if let Some(p) = &path {
-        let ext = Path::new(p).extension().and_then(|e| e.to_str()).unwrap_or("");
+        let ext = Path::new(p)
+            .extension()
+            .and_then(|e| e.to_str())
+            .unwrap_or("");
         if !ext.eq_ignore_ascii_case("png") {
             return Err(bad_argument(format!("{p}: path must name a .png file")));
         }
@@ -248,34 +262,35 @@ pub fn render<'py>(
         Some(t) => args::threads(t)?,
         None => args::threads(&0u8.into_pyobject(py)?.into_any())?,
     };
-    let (pw, ph, pixels) = py.allow_threads(|| -> Result<_, String> {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .map_err(|e| format!("cannot start {threads} threads: {e}"))?;
-        let tracer =
-            make_tracer(Backend::Rust, &scene, Query::Single).map_err(|e| e.to_string())?;
-        let camera = match camera {
-            Some(c) => c,
-            None => default_camera(&scene, tracer.as_ref()).map_err(|e| e.to_string())?,
-        };
-        let image = pool
-            .install(|| {
-                trace_view(
-                    &scene,
-                    tracer.as_ref(),
-                    &camera,
-                    w * SUPERSAMPLING,
-                    h * SUPERSAMPLING,
-                )
-            })
-            .map_err(|e| e.to_string())?;
-        let picture = image.to_rgb(&colours, SUPERSAMPLING);
-        if let Some(p) = &path {
-            write_png(Path::new(p), picture.0, picture.1, &picture.2)?;
-        }
-        Ok(picture)
-    })
-    .map_err(runtime_error)?;
-    Ok(pixels.into_pyarray(py).reshape([ph, pw, 3])?)
+    let (pw, ph, pixels) = py
+        .allow_threads(|| -> Result<_, String> {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .map_err(|e| format!("cannot start {threads} threads: {e}"))?;
+            let tracer =
+                make_tracer(Backend::Rust, &scene, Query::Single).map_err(|e| e.to_string())?;
+            let camera = match camera {
+                Some(c) => c,
+                None => default_camera(&scene, tracer.as_ref()).map_err(|e| e.to_string())?,
+            };
+            let image = pool
+                .install(|| {
+                    trace_view(
+                        &scene,
+                        tracer.as_ref(),
+                        &camera,
+                        w * SUPERSAMPLING,
+                        h * SUPERSAMPLING,
+                    )
+                })
+                .map_err(|e| e.to_string())?;
+            let picture = image.to_rgb(&colours, SUPERSAMPLING);
+            if let Some(p) = &path {
+                write_png(Path::new(p), picture.0, picture.1, &picture.2)?;
+            }
+            Ok(picture)
+        })
+        .map_err(runtime_error)?;
+    pixels.into_pyarray(py).reshape([ph, pw, 3])
 }

@@ -106,14 +106,19 @@ struct Session {
 
 /// What the worker thread hands back.
 enum Outcome {
-    Done {
-        analysis: scene_complexity::Analysis,
-        state: Option<RunState>,
-        build_seconds: f64,
+    Done(Box<Finished>),
+    /// Stopped for a Python exception before its analysis (the state saved when asked).
+    Stopped {
         saved: Option<PyErr>,
     },
-    /// Stopped for a Python exception before its analysis (the state saved when asked).
-    Stopped { saved: Option<PyErr> },
+}
+
+/// A run finished: its analysis, its state when kept, and how its save went.
+struct Finished {
+    analysis: scene_complexity::Analysis,
+    state: Option<RunState>,
+    build_seconds: f64,
+    saved: Option<PyErr>,
 }
 
 /// Saves `bytes` to `path`, as a Python error when it fails.
@@ -183,12 +188,12 @@ fn work(
         (Some(path), Some(bytes)) => save_bytes(path, bytes),
         _ => None,
     };
-    Ok(Outcome::Done {
+    Ok(Outcome::Done(Box::new(Finished {
         analysis,
         state: kept,
         build_seconds,
         saved,
-    })
+    })))
 }
 
 /// Runs a session to its analysis, raising the Python exception that stopped it, or a failed save.
@@ -204,30 +209,37 @@ fn run_session(
     }
     let scene = Arc::clone(&s.scene.get().inner);
     let control = RunControl::default();
-    let total = (s.casts && !s.cfg.budget.is_open_ended())
-        .then(|| remaining_lines(&state, s.scope));
-    let progress = progress.filter(|p| !p.is_none()).map(|p| p.clone().unbind());
+    let total =
+        (s.casts && !s.cfg.budget.is_open_ended()).then(|| remaining_lines(&state, s.scope));
+    let progress = progress
+        .filter(|p| !p.is_none())
+        .map(|p| p.clone().unbind());
     let (outcome, pending) = watched(py, &control, total, progress.as_ref(), || {
         work(&s, state, &scene, &control)
     })?;
     if let Some(e) = pending {
-        if let Ok(Outcome::Stopped { saved: Some(failed) } | Outcome::Done { saved: Some(failed), .. }) =
-            &outcome
-        {
+        let failed = match &outcome {
+            Ok(Outcome::Stopped { saved }) => saved.as_ref(),
+            Ok(Outcome::Done(f)) => f.saved.as_ref(),
+            Err(_) => None,
+        };
+        if let Some(failed) = failed {
             // The exception is what the caller sees; the failed save goes beside it as a warning.
             warn_all(py, std::iter::once(failed.to_string().as_str()))?;
         }
         return Err(e);
     }
     match outcome? {
-        Outcome::Stopped { saved } => Err(saved
-            .unwrap_or_else(|| runtime_error("scx: the run stopped without a reason"))),
-        Outcome::Done {
-            analysis,
-            state,
-            build_seconds,
-            saved,
-        } => {
+        Outcome::Stopped { saved } => {
+            Err(saved.unwrap_or_else(|| runtime_error("scx: the run stopped without a reason")))
+        }
+        Outcome::Done(finished) => {
+            let Finished {
+                analysis,
+                state,
+                build_seconds,
+                saved,
+            } = *finished;
             warn_all(py, analysis.warnings.iter().map(|w| w.message.as_str()))?;
             if let Some(e) = saved {
                 return Err(e);
@@ -331,7 +343,10 @@ pub fn analyze(
         None if budget.is_open_ended() => 1_000_000_000_000,
         None => 1_000_000,
     };
-    let seed = given(seed).map(|s| args::seed(&s)).transpose()?.unwrap_or(1);
+    let seed = given(seed)
+        .map(|s| args::seed(&s))
+        .transpose()?
+        .unwrap_or(1);
     let threads = match given(threads) {
         Some(t) => args::threads(&t)?,
         None => args::threads(&0u8.into_pyobject(py)?.into_any())?,
@@ -589,7 +604,9 @@ pub fn merge(
         .map(|p| path_text(&p?, "paths").map(PathBuf::from))
         .collect::<PyResult<_>>()?;
     if paths.is_empty() {
-        return Err(bad_argument("paths is empty: give the state files to merge"));
+        return Err(bad_argument(
+            "paths is empty: give the state files to merge",
+        ));
     }
     check_distinct(&paths)?;
     let policy = args::read_policy(read_anywhere, max_file_size)?;

@@ -210,8 +210,11 @@ fn objects_of(
             let mut seen: Vec<i64> = ids.to_vec();
             seen.sort_unstable();
             seen.dedup();
-            let index: HashMap<i64, i64> =
-                seen.iter().enumerate().map(|(k, &id)| (id, k as i64)).collect();
+            let index: HashMap<i64, i64> = seen
+                .iter()
+                .enumerate()
+                .map(|(k, &id)| (id, k as i64))
+                .collect();
             (
                 seen.iter().map(|id| format!("object {id}")).collect(),
                 ids.iter().map(|id| index[id]).collect(),
@@ -225,8 +228,11 @@ fn objects_of(
             let mut seen = names.clone();
             seen.sort_unstable();
             seen.dedup();
-            let index: HashMap<&str, i64> =
-                seen.iter().enumerate().map(|(k, n)| (n.as_str(), k as i64)).collect();
+            let index: HashMap<&str, i64> = seen
+                .iter()
+                .enumerate()
+                .map(|(k, n)| (n.as_str(), k as i64))
+                .collect();
             let codes = names.iter().map(|n| index[n.as_str()]).collect();
             (seen, codes)
         }
@@ -389,7 +395,9 @@ impl Scene {
         let (v, t) = (v.as_slice()?, t.as_slice()?);
         let (n, m) = (v.len() / 3, t.len() / 3);
         if m == 0 {
-            return Err(scene_error("triangles is empty: a scene needs at least one triangle"));
+            return Err(scene_error(
+                "triangles is empty: a scene needs at least one triangle",
+            ));
         }
         if let Some(k) = v.iter().position(|x| !x.is_finite()) {
             let i = k / 3;
@@ -448,9 +456,8 @@ impl Scene {
                     current_object = Some(o);
                 }
             }
-            let material = default_material.unwrap_or_else(|| {
-                materials.index(b, reflectance.get(first), emission.get(first))
-            });
+            let material = default_material
+                .unwrap_or_else(|| materials.index(b, reflectance.get(first), emission.get(first)));
             b.polygon(polygon, material, origin);
         };
         match &groups {
@@ -462,7 +469,12 @@ impl Scene {
             Some((groups, ids)) => {
                 for group in groups {
                     let id = ids[group[0]];
-                    shared(group, |t| reflectance.get(t).map(f64::to_bits), "reflectance", id)?;
+                    shared(
+                        group,
+                        |t| reflectance.get(t).map(f64::to_bits),
+                        "reflectance",
+                        id,
+                    )?;
                     shared(group, |t| emission.get(t).map(f64::to_bits), "emission", id)?;
                     if let Some((_, codes)) = &objects {
                         shared(group, |t| codes[t], "objects", id)?;
@@ -556,8 +568,14 @@ impl Scene {
     /// one, unused ones dropped).
     #[getter]
     fn vertices<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
-        let flat: Vec<f64> = self.inner.vertices.iter().flat_map(|p| p.to_array()).collect();
-        Ok(flat.into_pyarray(py).reshape([self.inner.vertices.len(), 3])?)
+        let flat: Vec<f64> = self
+            .inner
+            .vertices
+            .iter()
+            .flat_map(|p| p.to_array())
+            .collect();
+        flat.into_pyarray(py)
+            .reshape([self.inner.vertices.len(), 3])
     }
 
     /// The scene's triangles as indices into :attr:`vertices`, ``(t, 3)`` int64, each patch's
@@ -570,13 +588,19 @@ impl Scene {
             .iter()
             .flat_map(|t| t.map(i64::from))
             .collect();
-        Ok(flat.into_pyarray(py).reshape([self.inner.triangles.len(), 3])?)
+        flat.into_pyarray(py)
+            .reshape([self.inner.triangles.len(), 3])
     }
 
     /// The patch of each of :attr:`triangles`, ``(t,)`` int64.
     #[getter]
     fn triangle_patch<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<i64>> {
-        let v: Vec<i64> = self.inner.triangle_patch.iter().map(|&p| i64::from(p)).collect();
+        let v: Vec<i64> = self
+            .inner
+            .triangle_patch
+            .iter()
+            .map(|&p| i64::from(p))
+            .collect();
         v.into_pyarray(py)
     }
 
@@ -589,14 +613,23 @@ impl Scene {
     /// The object of each patch, as an index into :attr:`objects`, ``(n_p,)`` int64.
     #[getter]
     fn patch_object<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<i64>> {
-        let v: Vec<i64> = self.inner.patches.iter().map(|p| i64::from(p.object)).collect();
+        let v: Vec<i64> = self
+            .inner
+            .patches
+            .iter()
+            .map(|p| i64::from(p.object))
+            .collect();
         v.into_pyarray(py)
     }
 
     /// What loading found wrong but not fatal (dropped zero-area triangles, split polygons, ...).
     #[getter]
     fn warnings(&self) -> Vec<String> {
-        self.inner.warnings.iter().map(|w| w.message.clone()).collect()
+        self.inner
+            .warnings
+            .iter()
+            .map(|w| w.message.clone())
+            .collect()
     }
 
     /// A SHA-256 fingerprint of the geometry and materials (hex): saved runs carry it, and a resume or
