@@ -21,7 +21,7 @@ from __future__ import annotations
 import os
 import sys
 from contextlib import contextmanager
-from typing import Any, Callable, Iterator, Optional, Sequence, Tuple, Union
+from typing import Any, Callable, Dict, Iterator, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
@@ -70,7 +70,7 @@ class ScxWarning(UserWarning):
     same sentences on standard error."""
 
 
-def builtins() -> dict:
+def builtins() -> Dict[str, str]:
     """The built-in scenes: each usage (``"@cube[:N]"``) and what it is, as ``scx scenes`` lists them."""
     return dict(_native.builtins())
 
@@ -108,7 +108,7 @@ class _Tqdm:
     """A tqdm bar fed with the lines started."""
 
     def __init__(self) -> None:
-        from tqdm.auto import tqdm
+        from tqdm.auto import tqdm  # type: ignore[import-untyped,unused-ignore]
 
         self.bar = tqdm(unit=" lines", unit_scale=True, dynamic_ncols=True)
 

@@ -3,7 +3,7 @@ re-exports what is here; the functions it wraps (``analyze``, ``resume``, ``merg
 documented there."""
 
 import os
-from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple, Union
+from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple, Union, final
 
 import numpy as np
 import numpy.typing as npt
@@ -13,6 +13,24 @@ _Objects = Union[bool, str, Sequence[str], None]
 _Number = Union[int, float]
 _Progress = Optional[Callable[[int, Optional[int]], Any]]
 
+__all__ = [
+    "Analysis",
+    "COLORS",
+    "MEASURES",
+    "MeasureInfo",
+    "RADIOSITY_MEASURES",
+    "Reading",
+    "Scene",
+    "SceneError",
+    "TRACER",
+    "__version__",
+    "analyze",
+    "builtins",
+    "load",
+    "merge",
+    "render",
+    "resume",
+]
 __version__: str
 TRACER: str
 """The tracer this wheel casts lines with: ``"rust"`` (scx's pure-Rust tracer; no Embree)."""
@@ -27,6 +45,7 @@ class SceneError(ValueError):
     """A scene that cannot be read or built: a bad file, a bad built-in name, bad arrays (shapes,
     non-finite coordinates, indices out of range). Its message is the library's."""
 
+@final
 class MeasureInfo:
     """One entry of the catalogue of measures."""
 
@@ -55,6 +74,7 @@ class MeasureInfo:
     def target(self) -> bool:
         """Whether ``target_stderr`` can watch it."""
 
+@final
 class Reading:
     """A measure's reading: value, standard error, verdict. ``float(reading)`` is its value."""
 
@@ -96,6 +116,7 @@ class Reading:
         """The bias-corrected reading of the same measure, where the catalogue has one."""
     def __float__(self) -> float: ...
 
+@final
 class Scene:
     """A triangle scene ready to analyse: patches (the unit of the discretisation), each one or more
     coplanar triangles with an area, a normal, a material and an object. Immutable."""
@@ -181,13 +202,19 @@ class Scene:
         """Writes the scene as its extension says: ``.obj``, ``.ply``, ``.stl``, ``.gltf``, ``.glb``."""
     def __len__(self) -> int: ...
 
+@final
 class Analysis:
     """The results of a run: each measure of :data:`MEASURES` by key or attribute, a :class:`Reading`
     (``None`` when not computed)."""
 
-    def __getitem__(self, key: str) -> Optional[Reading]: ...
-    def __getattr__(self, name: str) -> Optional[Reading]: ...
-    def __contains__(self, key: str) -> bool: ...
+    def __getitem__(self, key: str, /) -> Optional[Reading]:
+        """The reading of the visibility measure ``key``, or ``None`` when not computed.
+
+        Raises:
+            KeyError: ``key`` is not a measure's.
+        """
+    def __getattr__(self, name: str, /) -> Optional[Reading]: ...
+    def __contains__(self, key: str, /) -> bool: ...
     def keys(self) -> List[str]:
         """The keys of the visibility measures the run computed."""
     def readings(self) -> Dict[str, Reading]:
@@ -237,8 +264,26 @@ class Analysis:
     @property
     def spec(self) -> Dict[str, Any]:
         """The run's settings, as its saved state keeps them."""
+    def to_dict(self) -> Dict[str, Any]:
+        """The document of ``scx analyze --format json`` for the same run, without the fields of the
+        process (``command_line``, ``cpu``, ``threads``)."""
+    def patches(self) -> Dict[str, npt.NDArray[Any]]:
+        """The per-patch results, one numpy array per column of ``scx analyze --patches`` (same
+        names). Needs ``per_patch=True``."""
+    def patches_frame(self) -> Any:
+        """:meth:`patches` as a pandas DataFrame indexed by ``id``. Needs pandas."""
+    def objects(self) -> Dict[str, npt.NDArray[Any]]:
+        """Each object's results (``scx analyze --objects``), one numpy array per column."""
+    def objects_frame(self) -> Any:
+        """:meth:`objects` as a pandas DataFrame indexed by object name. Needs pandas."""
+    def form_factors(self) -> Tuple[Any, Any]:
+        """``(F, F_stderr)``: two ``scipy.sparse.csr_matrix`` of ``n_p x n_p``, ``F_ij = N_ij / N_i``
+        and ``sqrt(F_ij (1 - F_ij) / N_i)``. Needs scipy and the discrete measures."""
+    def form_factor_entries(self) -> Dict[str, npt.NDArray[Any]]:
+        """The entries of F as arrays ``i``, ``j``, ``n_ij``, ``n_i``, ``f_ij``, ``f_ij_stderr``."""
     def save(self, path: _Path) -> None:
-        """Saves the run's state (the command line's state file), atomically."""
+        """Saves the run's state (the command line's state file), atomically. Needs
+        ``keep_state=True`` (the default)."""
 
 def load(
     path: _Path,
