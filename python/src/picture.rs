@@ -83,16 +83,23 @@ fn camera_of(py: Python<'_>, value: &Bound<'_, PyAny>) -> PyResult<Camera> {
 
 /// The picture's size: two whole numbers from 16 to 8192.
 fn size_of(value: &Bound<'_, PyAny>) -> PyResult<(usize, usize)> {
-    let (w, h): (Bound<'_, PyAny>, Bound<'_, PyAny>) = value.extract().map_err(|_| {
+    let bad = || {
         bad_argument(format!(
             "size must be (width, height) in pixels, not {}",
             repr(value)
         ))
-    })?;
+    };
+    if value.is_instance_of::<pyo3::types::PyString>() {
+        return Err(bad());
+    }
+    let pair: Vec<Bound<'_, PyAny>> = value.extract().map_err(|_| bad())?;
+    let [w, h] = pair.as_slice() else {
+        return Err(bad());
+    };
     let dim = |d: &Bound<'_, PyAny>, what: &str| args::whole(d, what, 16, 8192);
     Ok((
-        dim(&w, "the width")? as usize,
-        dim(&h, "the height")? as usize,
+        dim(w, "the width")? as usize,
+        dim(h, "the height")? as usize,
     ))
 }
 

@@ -170,19 +170,20 @@ pub fn builtins() -> Vec<(String, String)> {
         .collect()
 }
 
-/// The vertex indices of one triangle, each checked against the vertex count.
-fn triangle_at(triangles: &[i64], t: usize, n: usize) -> PyResult<[usize; 3]> {
-    let mut out = [0usize; 3];
-    for (k, &v) in triangles[3 * t..3 * t + 3].iter().enumerate() {
-        if v < 0 || v as u64 >= n as u64 {
-            return Err(scene_error(format!(
-                "triangles[{t}] names vertex {v}, but the vertices are numbered from 0 to {}",
-                n.saturating_sub(1)
-            )));
-        }
-        out[k] = v as usize;
+/// Checks every vertex index of `triangles` (flat, 3 per triangle) against the vertex count `n`.
+fn check_indices(triangles: &[i64], n: usize) -> PyResult<()> {
+    match triangles
+        .iter()
+        .position(|&v| v < 0 || v as u64 >= n as u64)
+    {
+        None => Ok(()),
+        Some(k) => Err(scene_error(format!(
+            "triangles[{}] names vertex {}, but the vertices are numbered from 0 to {}",
+            k / 3,
+            triangles[k],
+            n.saturating_sub(1)
+        ))),
     }
-    Ok(out)
 }
 
 /// The objects of the triangles: names and each triangle's object, from an integer array (objects
@@ -306,20 +307,12 @@ fn outline(tris: &[[u32; 3]]) -> Option<Vec<u32>> {
     (corners.len() == next.len()).then_some(corners)
 }
 
-/// The triangles grouped by patch id (ascending ids), each group in the triangles' order.
-fn groups_by_patch(ids: &[i64]) -> Vec<Vec<usize>> {
+/// The triangles in order of their patch id (ascending, each patch's in the triangles' order): the
+/// patches are the runs of equal ids.
+fn by_patch(ids: &[i64]) -> Vec<usize> {
     let mut order: Vec<usize> = (0..ids.len()).collect();
     order.sort_by_key(|&t| ids[t]);
-    let mut groups: Vec<Vec<usize>> = Vec::new();
-    let mut last = None;
-    for t in order {
-        if last != Some(ids[t]) {
-            groups.push(Vec::new());
-            last = Some(ids[t]);
-        }
-        groups.last_mut().expect("a group was pushed").push(t);
-    }
-    groups
+    order
 }
 
 /// What a patch's triangles share: the material and the object of its first triangle, which every
@@ -408,9 +401,7 @@ impl Scene {
                 v[3 * i + 2]
             )));
         }
-        let tris: Vec<[usize; 3]> = (0..m)
-            .map(|k| triangle_at(t, k, n))
-            .collect::<PyResult<_>>()?;
+        check_indices(t, n)?;
         let grey = |x: f64| PerTriangle::All([x; 3]);
         let shade = |obj: Option<&Bound<'_, PyAny>>, what: &str, default: f64| match obj {
             Some(o) if !o.is_none() => arrays::per_triangle(py, o, what, m),
@@ -422,26 +413,23 @@ impl Scene {
             Some(o) => Some(objects_of(py, o, m)?),
             None => None,
         };
-        let groups = match patches.filter(|p| !p.is_none()) {
-            Some(p) => {
-                let ids = arrays::ints1(py, p, "patches", &format!("({m},)"))?;
-                let ids = ids.as_slice()?;
-                if ids.len() != m {
-                    return Err(scene_error(format!(
-                        "patches must have shape ({m},) (one patch id per triangle), not ({},)",
-                        ids.len()
-                    )));
-                }
-                Some((groups_by_patch(ids), ids.to_vec()))
-            }
-            None => None,
-        };
+        let ids = patches
+            .filter(|p| !p.is_none())
+            .map(|p| arrays::ints1(py, p, "patches", &format!("({m},)")))
+            .transpose()?;
+        let ids = ids.as_ref().map(|a| a.as_slice()).transpose()?;
+        if let Some(ids) = ids.filter(|ids| ids.len() != m) {
+            return Err(scene_error(format!(
+                "patches must have shape ({m},) (one patch id per triangle), not ({},)",
+                ids.len()
+            )));
+        }
 
         let mut b = SceneBuilder::new(name);
         let index: Vec<u32> = (0..n)
             .map(|i| b.vertex([v[3 * i], v[3 * i + 1], v[3 * i + 2]]))
             .collect();
-        let corners = |k: usize| tris[k].map(|c| index[c]);
+        let corners = |k: usize| [0, 1, 2].map(|c| index[t[3 * k + c] as usize]);
         let mut materials = Materials {
             by_value: HashMap::new(),
         };
@@ -460,14 +448,15 @@ impl Scene {
                 .unwrap_or_else(|| materials.index(b, reflectance.get(first), emission.get(first)));
             b.polygon(polygon, material, origin);
         };
-        match &groups {
+        match ids {
             None => {
                 for k in 0..m {
                     add(&mut b, k, &corners(k), format!("triangle {k}"));
                 }
             }
-            Some((groups, ids)) => {
-                for group in groups {
+            Some(ids) => {
+                let order = by_patch(ids);
+                for group in order.chunk_by(|&a, &b| ids[a] == ids[b]) {
                     let id = ids[group[0]];
                     shared(
                         group,
@@ -491,7 +480,6 @@ impl Scene {
                 }
             }
         }
-        drop(groups);
         let scene = py
             .allow_threads(|| quietly(name, || b.build_with(&options)))
             .map_err(scene_error)?;

@@ -79,7 +79,7 @@ def test_render_gives_an_rgb_array_and_a_png(cube4, tmp_path):
     assert png_size(tmp_path / "a.png") == (96, 64)
     # The view from inside the cube sees patches of several colours.
     assert len(np.unique(picture.reshape(-1, 3), axis=0)) > 10
-    plain = scx.render(cube4, None, size=(32, 32))
+    plain = scx.render(cube4, None, size=[32, 32])
     assert plain.shape == (32, 32, 3)
     # The same per-patch column, by its name in the per-patch results.
     same = scx.render(a, "continuous_mutual_information_term", size=(96, 64))
