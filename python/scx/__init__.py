@@ -309,6 +309,8 @@ def merge(
     """
     if scene is not None and not isinstance(scene, Scene):
         scene = os.fspath(scene)
+    if isinstance(paths, (str, bytes, os.PathLike)):
+        raise ValueError(f"paths must be a list of state files, not one path: {paths!r}")
     return _native.merge(
         list(paths),
         scene=scene,

@@ -292,12 +292,12 @@ pub fn render<'py>(
                     )
                 })
                 .map_err(|e| e.to_string())?;
-            let picture = image.to_rgb(&colours, SUPERSAMPLING);
-            if let Some(p) = &path {
-                write_png(Path::new(p), picture.0, picture.1, &picture.2)?;
-            }
-            Ok(picture)
+            Ok(image.to_rgb(&colours, SUPERSAMPLING))
         })
         .map_err(runtime_error)?;
+    if let Some(p) = &path {
+        py.allow_threads(|| write_png(Path::new(p), pw, ph, &pixels))
+            .map_err(pyo3::exceptions::PyOSError::new_err)?;
+    }
     pixels.into_pyarray(py).reshape([ph, pw, 3])
 }

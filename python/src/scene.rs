@@ -172,6 +172,11 @@ pub fn builtins() -> Vec<(String, String)> {
 
 /// Checks every vertex index of `triangles` (flat, 3 per triangle) against the vertex count `n`.
 fn check_indices(triangles: &[i64], n: usize) -> PyResult<()> {
+    if n == 0 {
+        return Err(scene_error(
+            "vertices is empty: the triangles name vertices that are not there",
+        ));
+    }
     match triangles
         .iter()
         .position(|&v| v < 0 || v as u64 >= n as u64)

@@ -36,6 +36,7 @@ def test_scene_error_is_a_value_error():
         (V, T[:0], "triangles is empty"),
         ([[0, 0, 0], [1, 0], [0, 1, 0]], [[0, 1, 2]], "vertices is not an array of numbers"),
         (np.zeros((3, 3)), [[0, 1, 2]], "the scene has no"),
+        (np.zeros((0, 3)), [[0, 1, 2]], "vertices is empty"),
     ],
 )
 def test_bad_arrays(vertices, triangles, words):

@@ -50,6 +50,8 @@ def test_shards_merged_are_the_whole_run(cube4, full, tmp_path):
     assert not partial.complete
     with pytest.raises(ValueError, match="is given twice"):
         scx.merge([parts[0], parts[0]])
+    with pytest.raises(ValueError, match="a list of state files"):
+        scx.merge(parts[0])
 
 
 def test_an_interrupted_run_saved_and_resumed_is_the_whole_run(cube4, full, tmp_path):

@@ -101,3 +101,5 @@ def test_render_refuses_what_it_cannot_draw(cube4, tmp_path):
         scx.render(b, "segments", camera=(0, 0, 0))
     with pytest.raises(ValueError, match=".png"):
         scx.render(b, "segments", path=tmp_path / "x.jpg")
+    with pytest.raises(OSError):
+        scx.render(b, "segments", size=(32, 32), path=tmp_path / "missing" / "x.png")
