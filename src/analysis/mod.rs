@@ -19,7 +19,10 @@ use std::time::Instant;
 pub use object_results::{ObjectResult, ENVIRONMENT};
 pub use patch_results::{PatchLight, PatchResult};
 pub use radiosity::{RadiosityOutcome, RadiositySolve, SolveFailure, NOTHING_EMITS};
-pub use reliability::{Reliability, SamplingReport, Verdict, COVERAGE_OK, COVERAGE_UNUSABLE};
+pub use reliability::{
+    HalfRun, LinesAdvice, Reliability, SamplingReport, Verdict, ADVICE_SETTLED_GROWTH, COVERAGE_OK,
+    COVERAGE_UNUSABLE,
+};
 pub use warnings::{RunWarning, RunWarningKind};
 
 use patch_results as per_patch;

@@ -1121,7 +1121,10 @@ fn enclosing_leaves_the_sampling_of_the_scenes_rows_alone() {
         )
         .unwrap();
         let report = a.sampling.expect("pairs were counted");
-        (report.sampling, report.lines_for_coverage)
+        (
+            report.sampling,
+            (report.lines_for_coverage, report.from_half),
+        )
     };
     let ((plain, plain_lines), (enclosed, enclosed_lines)) = (sampling(false), sampling(true));
     assert_eq!(enclosed.rows, scene.patch_count());
