@@ -417,8 +417,11 @@ impl Tally {
         areas.push(a_env);
 
         let c = &self.counters;
-        let mut t = self.clone();
-        t.counts = self.enclosed_counts(n);
+        // The counts are rebuilt, not cloned: a large scene's are most of the tally.
+        let mut t = Tally {
+            counts: self.enclosed_counts(n),
+            ..self.without_counts()
+        };
         t.escapes_by_patch = if self.counts.is_some() {
             PatchCounts::zeros(n + 1)
         } else {
@@ -455,12 +458,28 @@ impl Tally {
         let counts = self.counts.as_ref()?;
         let env = n as u32;
         let mut entries: Vec<(u64, u64)> = Vec::with_capacity(counts.distinct_pairs() + n + 1);
-        counts.for_each(|i, j, k| entries.push((pair_key(i, j), k)));
-        self.escapes_by_patch
-            .for_each_counted(|i, e| entries.push((pair_key(i, env), e)));
+        // In pair-key order (the smaller patch first, then the larger), so that the counts are built
+        // without sorting: (i, env) follows every pair (i, j) of the scene.
+        let mut next_row = 0u32;
+        let escapes = self.escapes_by_patch.dense();
+        let mut escapes_up_to = |row: u32, entries: &mut Vec<(u64, u64)>| {
+            for i in next_row..row {
+                let e = escapes.get(i as usize).copied().unwrap_or(0);
+                if e > 0 {
+                    entries.push((pair_key(i, env), e));
+                }
+            }
+            next_row = next_row.max(row);
+        };
+        counts.for_each(|i, j, k| {
+            escapes_up_to(i, &mut entries);
+            entries.push((pair_key(i, j), k));
+        });
+        escapes_up_to(env, &mut entries);
         if self.counters.misses > 0 {
             entries.push((pair_key(env, env), self.counters.misses));
         }
+        debug_assert!(entries.windows(2).all(|w| w[0].0 < w[1].0));
         Some(PairCounts::from_entries(n + 1, entries))
     }
 
