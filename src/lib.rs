@@ -87,7 +87,9 @@ pub use scene::{
     SceneOptions, DEFAULT_PLANARITY,
 };
 pub use scene::{Reach, ReadPolicy, SceneWarning, SceneWarningKind, Warning};
-pub use scenes::{load, load_with, load_with_policy, Builtin, CATALOGUE, MAX_BUILTIN_PATCHES};
+pub use scenes::{
+    load, load_with, load_with_policy, read_guarded, Builtin, CATALOGUE, MAX_BUILTIN_PATCHES,
+};
 
 // Tracing.
 pub use trace::{make_tracer, Backend, Query, QueryError, TraceError, Tracer};
@@ -103,8 +105,8 @@ pub use run::persist::{
 };
 pub use run::{
     remaining_lines, start, Budget, CastOptions, ErrorMethod, ExtendError, Measures, MergeError,
-    PersistError, RunControl, RunIdentity, RunSpec, RunState, SavedRun, SceneRef, Scope, Shard,
-    SpecDifference, StopReason, Target, Tracing, DEFAULT_ESTIMATOR, DEFAULT_GROUPS,
+    MissingLines, PersistError, RunControl, RunIdentity, RunSpec, RunState, SavedRun, SceneRef,
+    Scope, Shard, SpecDifference, StopReason, Target, Tracing, DEFAULT_ESTIMATOR, DEFAULT_GROUPS,
 };
 pub use sample::counts::PairCounts;
 pub use sample::lines::{BundleError, LineSource, MAX_BUNDLE_GRID};

@@ -690,32 +690,10 @@ fn check_missing(
     identity: &RunIdentity,
     partial: bool,
 ) -> PyResult<()> {
-    let plan = state.plan();
-    let missing = state.done().missing(plan.batches());
-    if missing.is_empty() {
+    let Some(missing) = state.missing_lines() else {
         return Ok(());
-    }
-    let lines: Vec<String> = missing
-        .ranges()
-        .iter()
-        .map(|r| {
-            format!(
-                "{}..{}",
-                plan.first_line(r.start),
-                plan.first_line(r.end - 1) + plan.batch_len(r.end - 1) as u64
-            )
-        })
-        .collect();
-    let message = format!(
-        "the states cover {} of the run's {} batches; lines {} are missing{}",
-        state.done().len(),
-        plan.batches(),
-        lines.join(", "),
-        identity
-            .shard
-            .map(|s| format!(" (the run was cut into {} shards)", s.count))
-            .unwrap_or_default()
-    );
+    };
+    let message = missing.message(identity.shard.map(|s| s.count));
     if !partial {
         return Err(bad_argument(format!(
             "{message}; merge every shard, or pass partial=True for an analysis of these lines only"

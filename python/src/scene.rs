@@ -58,27 +58,6 @@ pub fn warn_all<'a>(py: Python<'_>, messages: impl Iterator<Item = &'a str>) -> 
     Ok(())
 }
 
-/// Runs a scene reader with Rust's panic message switched off and any panic turned into an error (as
-/// the command line does, src/cli/input.rs): a scene file is untrusted input, and a panic in a reader
-/// must never reach Python as anything but a `SceneError`.
-fn quietly(
-    spec: &str,
-    read: impl FnOnce() -> Result<scene_complexity::Scene, LibSceneError>,
-) -> Result<scene_complexity::Scene, LibSceneError> {
-    let previous = std::panic::take_hook();
-    std::panic::set_hook(Box::new(|_| {}));
-    let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(read));
-    std::panic::set_hook(previous);
-    result.unwrap_or_else(|_| {
-        Err(LibSceneError::Geometry {
-            scene: spec.to_string(),
-            message: "scx failed to read it (an internal error in a scene reader); please report \
-                      the file"
-                .into(),
-        })
-    })
-}
-
 /// Reads the scene `spec` (a file or a built-in) as `options` ask, under `policy`, with the GIL
 /// released; its warnings are emitted.
 pub fn read_scene(
@@ -88,7 +67,9 @@ pub fn read_scene(
     policy: &ReadPolicy,
 ) -> PyResult<Scene> {
     let scene = py
-        .allow_threads(|| quietly(spec, || load_with_policy(spec, options, policy)))
+        .allow_threads(|| {
+            scene_complexity::read_guarded(spec, || load_with_policy(spec, options, policy))
+        })
         .map_err(scene_error)?;
     let scene = Scene::new(scene, options.clone());
     scene.warn(py)?;
@@ -486,7 +467,7 @@ impl Scene {
             }
         }
         let scene = py
-            .allow_threads(|| quietly(name, || b.build_with(&options)))
+            .allow_threads(|| scene_complexity::read_guarded(name, || b.build_with(&options)))
             .map_err(scene_error)?;
         let scene = Scene::new(scene, options);
         scene.warn(py)?;

@@ -3,7 +3,7 @@
 use std::path::Path;
 
 use scene_complexity::{
-    load_stream, load_with_policy, ReadPolicy, Scene, SceneError, SceneOptions,
+    load_stream, load_with_policy, read_guarded, ReadPolicy, Scene, SceneError, SceneOptions,
 };
 
 use super::exit::Failure;
@@ -16,7 +16,7 @@ pub fn load_scene(
     options: &SceneOptions,
     policy: &ReadPolicy,
 ) -> Result<Scene, Failure> {
-    let scene = quietly(spec, || {
+    let scene = read_guarded(spec, || {
         if spec == "-" {
             // A scene on standard input names its files relative to the current folder.
             let stdin = std::io::stdin().lock();
@@ -30,26 +30,4 @@ pub fn load_scene(
         warn(&w.message);
     }
     Ok(scene)
-}
-
-/// Runs a scene reader with Rust's panic message switched off: the readers turn a panic in a dependency
-/// into an error of their own (the glTF reader) and this catches any other, so that the user sees one
-/// clear message and never a panic's text or backtrace. Reading happens before any other thread of the
-/// run starts, so the process-wide hook is this reading's alone while it is swapped.
-fn quietly(
-    spec: &str,
-    read: impl FnOnce() -> Result<Scene, SceneError>,
-) -> Result<Scene, SceneError> {
-    let previous = std::panic::take_hook();
-    std::panic::set_hook(Box::new(|_| {}));
-    let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(read));
-    std::panic::set_hook(previous);
-    result.unwrap_or_else(|_| {
-        Err(SceneError::Geometry {
-            scene: spec.to_string(),
-            message: "scx failed to read it (an internal error in a scene reader); please report \
-                      the file"
-                .into(),
-        })
-    })
 }

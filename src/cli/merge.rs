@@ -190,30 +190,8 @@ pub fn run(args: &MergeArgs) -> Result<Exit, Failure> {
         first,
         without_sums,
     } = merged(files, &runner.scene)?;
-    let plan = state.plan();
-    let missing = state.done().missing(plan.batches());
-    if !missing.is_empty() {
-        let lines: Vec<String> = missing
-            .ranges()
-            .iter()
-            .map(|r| {
-                format!(
-                    "{}..{}",
-                    plan.first_line(r.start),
-                    plan.first_line(r.end - 1) + plan.batch_len(r.end - 1) as u64
-                )
-            })
-            .collect();
-        let message = format!(
-            "the states cover {} of the run's {} batches; lines {} are missing{}",
-            state.done().len(),
-            plan.batches(),
-            lines.join(", "),
-            identity
-                .shard
-                .map(|s| format!(" (the run was cut into {} shards)", s.count))
-                .unwrap_or_default()
-        );
+    if let Some(missing) = state.missing_lines() {
+        let message = missing.message(identity.shard.map(|s| s.count));
         if !args.partial {
             return Err(Failure::bad_input(format!(
                 "{message}; merge every shard, or add --partial for a report of these lines only"

@@ -35,4 +35,4 @@ pub use errors::{ErrorMethod, Spread};
 pub use persist::{PersistError, RunIdentity, SavedRun, SceneRef, Tracing};
 pub use plan::{BatchPlan, BatchSet};
 pub use spec::{ExtendError, Measures, RunSpec, SpecDifference, DEFAULT_ESTIMATOR, DEFAULT_GROUPS};
-pub use state::{FinishedRun, MergeError, RunState, StateParts, TracedBatches};
+pub use state::{FinishedRun, MergeError, MissingLines, RunState, StateParts, TracedBatches};

@@ -98,6 +98,37 @@ pub struct FinishedRun {
     pub groups: Vec<Tally>,
 }
 
+/// The batches a state lacks of its run ([`RunState::missing_lines`]).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct MissingLines {
+    /// The batches done.
+    pub done: u64,
+    /// The run's batches.
+    pub batches: u64,
+    /// The missing lines, as ranges of line indices (a line's index fixes its stream).
+    pub lines: Vec<std::ops::Range<u64>>,
+}
+
+impl MissingLines {
+    /// What is missing, in words; `shards`: how many shards the run was cut into, if it was.
+    pub fn message(&self, shards: Option<u32>) -> String {
+        let lines: Vec<String> = self
+            .lines
+            .iter()
+            .map(|r| format!("{}..{}", r.start, r.end))
+            .collect();
+        format!(
+            "the states cover {} of the run's {} batches; lines {} are missing{}",
+            self.done,
+            self.batches,
+            lines.join(", "),
+            shards
+                .map(|m| format!(" (the run was cut into {m} shards)"))
+                .unwrap_or_default()
+        )
+    }
+}
+
 /// Why two states cannot be merged.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 pub enum MergeError {
@@ -167,6 +198,29 @@ impl RunState {
     /// The batches done.
     pub fn done(&self) -> &BatchSet {
         &self.done
+    }
+
+    /// The lines of the run's batches that are not done (a merge of some of a run's shards, or a
+    /// run stopped early); `None` when every batch is done.
+    pub fn missing_lines(&self) -> Option<MissingLines> {
+        let plan = self.plan;
+        let missing = self.done.missing(plan.batches());
+        if missing.is_empty() {
+            return None;
+        }
+        let lines = missing
+            .ranges()
+            .iter()
+            .map(|r| {
+                plan.first_line(r.start)
+                    ..plan.first_line(r.end - 1) + plan.batch_len(r.end - 1) as u64
+            })
+            .collect();
+        Some(MissingLines {
+            done: self.done.len(),
+            batches: plan.batches(),
+            lines,
+        })
     }
 
     /// Batches done so far.

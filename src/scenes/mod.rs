@@ -170,6 +170,29 @@ pub fn load_with_policy(
     format::load_file_with_policy(std::path::Path::new(spec), options, policy)
 }
 
+/// Runs a scene reader with Rust's panic message switched off and any panic turned into an error
+/// naming `spec`: a scene file is untrusted input, and a panic in a reader (or a dependency of one)
+/// must reach the user as one clear message, never as a panic's text or backtrace, nor cross into a
+/// host language (the Python binding). The panic hook is process-wide: call it while no other thread
+/// of the program may panic (before a run starts).
+pub fn read_guarded(
+    spec: &str,
+    read: impl FnOnce() -> Result<Scene, SceneError>,
+) -> Result<Scene, SceneError> {
+    let previous = std::panic::take_hook();
+    std::panic::set_hook(Box::new(|_| {}));
+    let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(read));
+    std::panic::set_hook(previous);
+    result.unwrap_or_else(|_| {
+        Err(SceneError::Geometry {
+            scene: spec.to_string(),
+            message: "scx failed to read it (an internal error in a scene reader); please report \
+                      the file"
+                .into(),
+        })
+    })
+}
+
 /// A built scene built again with options: its patches as polygons (they are planar, so the planarity
 /// rule changes nothing), its objects and materials.
 fn rebuild(scene: &Scene, options: &SceneOptions) -> Result<Scene, SceneError> {
