@@ -30,7 +30,7 @@ use crate::measure::radiosity::{MaterialError, PatchMaterials};
 use crate::measure::{student_t_975, ByMeasure, Estimate, Measure};
 use crate::run::{
     BatchPlan, BatchSet, CastHooks, CastOptions, ErrorMethod, FinishedRun, RunControl, RunSpec,
-    RunState, StopReason, TargetReading,
+    RunState, SpecError, StartError, StopReason, TargetReading,
 };
 use crate::sample::tally::{ObjectSides, Tally, Wanted};
 use crate::scene::Scene;
@@ -42,12 +42,24 @@ pub enum AnalysisError {
     /// A material outside the physical range (bad input), found before any line is cast.
     #[error(transparent)]
     Material(#[from] MaterialError),
+    /// Settings of the run that contradict each other (bad input), found before any line is cast.
+    #[error(transparent)]
+    Spec(#[from] SpecError),
     /// The radiosity system has no solution, or the solver gave up (bad input: the materials).
     #[error(transparent)]
     Solve(#[from] SolveFailure),
     /// Tracing failed.
     #[error(transparent)]
     Trace(#[from] TraceError),
+}
+
+impl From<StartError> for AnalysisError {
+    fn from(e: StartError) -> Self {
+        match e {
+            StartError::Material(e) => AnalysisError::Material(e),
+            StartError::Spec(e) => AnalysisError::Spec(e),
+        }
+    }
 }
 
 impl AnalysisError {

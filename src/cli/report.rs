@@ -14,7 +14,7 @@ use scene_complexity::VerdictRule;
 use scene_complexity::{
     Analysis, RadiosityOutcome, Reliability, TargetOutcome, Verdict, COVERAGE_OK,
 };
-use scene_complexity::{ErrorMethod, Shard, StopReason, Tracing};
+use scene_complexity::{ErrorMethod, Sampler, Shard, StopReason, Tracing};
 use scene_complexity::{Estimate, Family, Measure};
 
 use super::table::{fixed, Align, Table};
@@ -193,10 +193,10 @@ pub fn table(run: &RunInfo, a: &Analysis) -> String {
         s,
         "lines    {}{}  seed {}  tracer {} ({})  threads {}  {:.3} s  ({:.2} M lines/s)",
         a.lines,
-        if bundle(a) > 0 {
-            format!(" in bundles of {0} x {0}", bundle(a))
-        } else {
-            String::new()
+        match (bundle(a), a.spec.sampler) {
+            (0, Sampler::Sobol) => " (sobol: randomised quasi-Monte Carlo)".to_string(),
+            (0, Sampler::Independent) => String::new(),
+            (grid, _) => format!(" in bundles of {grid} x {grid}"),
         },
         a.spec.seed,
         run.tracing.backend.name(),

@@ -15,5 +15,6 @@ pub mod kernel_sums;
 pub mod lines;
 mod order;
 pub mod pairs;
+pub mod sobol;
 pub mod sparse;
 pub mod tally;
