@@ -16,7 +16,7 @@
 //! The randomisation: a nested uniform scramble in the manner of Laine and Karras (2011) and Burley
 //! ("Practical hash-based Owen scrambling", JCGT 2020), on 64-bit digits. Written with the digits
 //! reversed (the most significant first digit becomes bit 0), a nested scramble flips digit `k` by a
-//! random function of digits `0..k`; every step of [`Scramble::apply`] (adding a random word, multiplying
+//! random function of digits `0..k`; every step of the scramble (adding a random word, multiplying
 //! by a random odd word, XOR with the product by an even constant) changes bit `k` only by a function of
 //! the bits below it, so their composition is such a scramble. Two consequences hold whatever the hash's
 //! quality: the net properties above survive exactly, and every scrambled point is exactly uniform over
