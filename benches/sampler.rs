@@ -34,7 +34,8 @@ use scene_complexity::internals::scenes;
 use scene_complexity::internals::trace::{make_tracer, Backend, Query};
 use scene_complexity::report::FormFactors;
 
-/// The measures followed: name, and the measure.
+/// The readings followed: name and measure. With the Sobol' sampler the readings on corrected rows
+/// are the delete-a-group jackknife's debiased ones (see `Spread::debiased`).
 const FOLLOWED: [(&str, Measure); 7] = [
     ("I_s^c", Measure::ContinuousMutualInformation),
     ("H_s", Measure::Entropy),
@@ -75,7 +76,10 @@ fn compare(spec: &str, lines: u64, seeds: u64) -> anyhow::Result<()> {
     let tracer = make_tracer(Backend::Embree, &scene, Query::Single)
         .or_else(|_| make_tracer(Backend::Rust, &scene, Query::Single))?;
     let exact = exact_values(spec);
-    let exact_f = exact_form_factors(&scene);
+    let exact_f = match CalibrationScene::parse(spec) {
+        Ok(CalibrationScene::Cube(_)) => exact_form_factors(&scene),
+        _ => None,
+    };
     let mut runs: Vec<Runs> = SAMPLERS
         .iter()
         .map(|_| Runs {
@@ -95,8 +99,8 @@ fn compare(spec: &str, lines: u64, seeds: u64) -> anyhow::Result<()> {
             let r = &mut runs[s];
             r.wall += w0.elapsed().as_secs_f64();
             r.cpu += common::cpu_seconds() - c0;
-            for (m, (_, measure)) in FOLLOWED.iter().enumerate() {
-                let e = a.estimate(*measure);
+            for (m, &(_, measure)) in FOLLOWED.iter().enumerate() {
+                let e = a.estimate(measure);
                 r.values[m].push(e.map_or(f64::NAN, |e| e.value));
                 r.stderrs[m].push(e.and_then(|e| e.stderr).unwrap_or(f64::NAN));
             }
@@ -124,8 +128,8 @@ fn exact_values(spec: &str) -> Vec<Option<f64>> {
         .collect()
 }
 
-/// The exact form factors when every patch is an axis-aligned rectangle of a box (`@cube:N`, up to
-/// 2000 patches): rows of F.
+/// The exact form factors of `@cube:N` (up to 2000 patches; every patch an axis-aligned rectangle of
+/// the box, which no other patch hides): rows of F.
 fn exact_form_factors(scene: &Scene) -> Option<Vec<Vec<f64>>> {
     let n = scene.patch_count();
     if n > 2000 {
@@ -170,7 +174,7 @@ fn print_table(spec: &str, runs: &[Runs], exact: &[Option<f64>], seeds: u64) {
         "z(mean)",
         "ind/sob"
     );
-    for (m, (name, _)) in FOLLOWED.iter().enumerate() {
+    for (m, (name, ..)) in FOLLOWED.iter().enumerate() {
         let base = sample_sd(&runs[0].values[m]);
         for (s, sampler) in SAMPLERS.iter().enumerate() {
             let r = &runs[s];

@@ -23,7 +23,7 @@ pub use reliability::{Reliability, SamplingReport, Verdict, COVERAGE_OK, COVERAG
 pub use warnings::{RunWarning, RunWarningKind};
 
 use patch_results as per_patch;
-use values::{visibility_estimates, VisibilityOfRun};
+use values::{visibility_estimates, Replication, VisibilityOfRun};
 
 use crate::measure::estimators::EntropyEstimator;
 use crate::measure::radiosity::{MaterialError, PatchMaterials};
@@ -32,6 +32,7 @@ use crate::run::{
     BatchPlan, BatchSet, CastHooks, CastOptions, ErrorMethod, FinishedRun, RunControl, RunSpec,
     RunState, SpecError, StartError, StopReason, TargetReading,
 };
+use crate::sample::lines::Sampler;
 use crate::sample::tally::{ObjectSides, Tally, Wanted};
 use crate::scene::Scene;
 use crate::trace::{TraceError, Tracer};
@@ -318,7 +319,7 @@ pub fn finish(
             &run,
             &cfg.solve,
             cfg.estimator,
-            visibility.jackknifed,
+            (visibility.jackknifed, visibility.debiased),
             visibility
                 .sampling
                 .as_ref()
@@ -359,7 +360,11 @@ pub fn finish(
         for (m, e) in r.estimates.iter() {
             estimates.set(m, Some(*e));
         }
-        for (m, v) in r.reliability.iter() {
+        let mut verdicts = r.reliability.clone();
+        if cfg.sampler == Sampler::Sobol && !visibility.debiased {
+            reliability::flag_dependent_lines(&mut verdicts);
+        }
+        for (m, v) in verdicts.iter() {
             reliability.set(m, Some(v.clone()));
         }
     }
@@ -413,16 +418,17 @@ fn judged_visibility(
 }
 
 /// Whether a run's delete-a-group replicates can be computed (for the bias estimates behind the
-/// verdicts), and whether they also give the standard errors (`--errors jackknife`). Not with
-/// `--enclose` nor Chao–Shen (its second pass needs every count of the replicate), and not with fewer
-/// than 2 groups.
-fn replication(cfg: &RunSpec, run: &FinishedRun, enclose: bool) -> (bool, bool) {
+/// verdicts), whether they also give the standard errors (`--errors jackknife`), and whether they
+/// debias the readings on corrected rows (the Sobol' sampler). Not with `--enclose` nor Chao–Shen (its
+/// second pass needs every count of the replicate), and not with fewer than 2 groups.
+fn replication(cfg: &RunSpec, run: &FinishedRun, enclose: bool) -> Replication {
     let replicable =
         !enclose && cfg.estimator != EntropyEstimator::ChaoShen && run.groups.len() >= 2;
-    (
+    Replication {
         replicable,
-        replicable && cfg.errors == ErrorMethod::Jackknife,
-    )
+        jackknife: replicable && cfg.errors == ErrorMethod::Jackknife,
+        debias: cfg.sampler == Sampler::Sobol,
+    }
 }
 
 /// The standard error of `measure` and the verdict on its reading, from the run so far, judged as the
