@@ -317,7 +317,12 @@ fn verdict(
         }
         VerdictRule::Unbiased => {
             let (report, _) = evidence.discrete(info.family)?;
-            let bias = report.sampling.mse_bias;
+            // The rows' multinomial estimate of the plug-in's bias, unless the jackknife gives one (Sobol'
+            // lines, whose rows are no multinomial samples).
+            let bias = evidence
+                .bias
+                .and_then(|b| b.of(m))
+                .unwrap_or(report.sampling.mse_bias);
             let mut r = Reliability::new(if bias.abs() <= stderr(e) {
                 Verdict::Ok
             } else {

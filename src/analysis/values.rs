@@ -202,14 +202,18 @@ pub(super) fn visibility_estimates(
         replicates: replicates.as_deref().filter(|_| jackknife),
         ..with_replicates
     };
-    // A debiased reading has had its jackknife bias taken out: the rows' coverage alone judges it.
+    // A debiased reading has had its jackknife bias taken out: the rows' coverage alone judges it. With
+    // Sobol' lines the jackknife also estimates E(MSE)'s bias, which the multinomial formula overstates.
     let bias = ByMeasure::from_fn(|m| {
         let info = m.info();
-        (info.family == Family::Visibility
-            && info.verdict == VerdictRule::Corrected
-            && !debiased(m))
-        .then(|| with_replicates.jackknife_bias(|g| value_of(m, g)))
-        .flatten()
+        let wanted = match info.verdict {
+            VerdictRule::Corrected => !debiased(m),
+            VerdictRule::Unbiased => debias,
+            _ => false,
+        };
+        (info.family == Family::Visibility && wanted)
+            .then(|| with_replicates.jackknife_bias(|g| value_of(m, g)))
+            .flatten()
     });
     let mut estimates = if run.total.counters.lines == 0 {
         exact_only(&areas)
