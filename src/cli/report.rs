@@ -341,6 +341,15 @@ pub fn table(run: &RunInfo, a: &Analysis) -> String {
              values, I_s^c and E(MSE) stay unbiased)."
         );
     }
+    if a.spec.sampler == Sampler::Sobol && a.estimate(Measure::MutualInformationCorrected).is_some()
+    {
+        let _ = writeln!(
+            s,
+            "sobol: the estimator's corrections assume independent lines; the corrected readings are its \
+             values less the delete-a-group jackknife's estimate of their bias, with the jackknife's \
+             standard errors, or flagged where there is no jackknife (docs/sampling.md)."
+        );
+    }
     if let Some(t) = &a.target {
         let _ = writeln!(s, "{}", target_text(t));
     }
