@@ -202,18 +202,26 @@ pub(super) fn visibility_estimates(
         replicates: replicates.as_deref().filter(|_| jackknife),
         ..with_replicates
     };
-    // A debiased reading has had its jackknife bias taken out: the rows' coverage alone judges it. With
-    // Sobol' lines the jackknife also estimates E(MSE)'s bias, which the multinomial formula overstates.
+    // The bias estimate behind a corrected reading's verdict: the jackknife's estimate of its bias; for a
+    // debiased reading, whose first-order bias is gone, its distance to the debiased plug-in reading
+    // (both free of the 1 / lines term, they part where the higher terms are not small: rows sampled too
+    // thinly for either to be trusted). With Sobol' lines the jackknife also estimates E(MSE)'s bias,
+    // which the multinomial formula overstates.
     let bias = ByMeasure::from_fn(|m| {
         let info = m.info();
-        let wanted = match info.verdict {
-            VerdictRule::Corrected => !debiased(m),
-            VerdictRule::Unbiased => debias,
-            _ => false,
-        };
-        (info.family == Family::Visibility && wanted)
-            .then(|| with_replicates.jackknife_bias(|g| value_of(m, g)))
-            .flatten()
+        if info.family != Family::Visibility {
+            return None;
+        }
+        let jackknife = |m: Measure| with_replicates.jackknife_bias(|g| value_of(m, g));
+        match info.verdict {
+            VerdictRule::Corrected if debiased(m) => {
+                let debiased_value = |m: Measure| with_replicates.debiased(|g| value_of(m, g));
+                Some(debiased_value(m)?.value - debiased_value(plug_in_of(m)?)?.value)
+            }
+            VerdictRule::Corrected => jackknife(m),
+            VerdictRule::Unbiased if debias => jackknife(m),
+            _ => None,
+        }
     });
     let mut estimates = if run.total.counters.lines == 0 {
         exact_only(&areas)
@@ -262,6 +270,15 @@ pub(super) fn visibility_estimates(
         environment_area,
         jackknifed: spread.replicates.is_some(),
         debiased: debias && replicates.is_some(),
+    }
+}
+
+/// The plug-in reading a corrected visibility reading corrects.
+fn plug_in_of(m: Measure) -> Option<Measure> {
+    match m {
+        Measure::EntropyCorrected => Some(Measure::Entropy),
+        Measure::MutualInformationCorrected => Some(Measure::MutualInformation),
+        _ => None,
     }
 }
 
