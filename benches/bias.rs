@@ -56,8 +56,8 @@ fn main() {
                     n, lines, exact, a.seconds
                 );
                 for e in EntropyEstimator::ALL {
-                    let v =
-                        corrected(&areas, counts, &a.tally.escapes_by_patch, e).mutual_information;
+                    let v = corrected(&areas, counts, &a.tally.escapes_by_patch.dense(), e)
+                        .mutual_information;
                     print!(" {:>8.4} {:>+6.1}%", v, 100.0 * (v - exact) / exact);
                 }
                 println!();

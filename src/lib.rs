@@ -113,9 +113,10 @@ pub use sample::tally::{Tally, Wanted};
 
 // What is computed from a run.
 pub use analysis::{
-    analyze, cast, finish, Analysis, AnalysisError, ObjectResult, PatchResult, RadiosityOutcome,
-    RadiositySolve, Reliability, RunWarning, RunWarningKind, SamplingReport, SolveFailure,
-    TargetOutcome, Verdict, COVERAGE_OK, COVERAGE_UNUSABLE,
+    analyze, cast, finish, Analysis, AnalysisError, HalfRun, LinesAdvice, ObjectResult,
+    PatchResult, RadiosityOutcome, RadiositySolve, Reliability, RunWarning, RunWarningKind,
+    SamplingReport, SolveFailure, TargetOutcome, Verdict, ADVICE_SETTLED_GROWTH, COVERAGE_OK,
+    COVERAGE_UNUSABLE, ENVIRONMENT,
 };
 pub use measure::catalogue::{
     Bound, ByMeasure, Family, Measure, MeasureInfo, Needs, PatchMeasure, PatchMeasureInfo, Unit,

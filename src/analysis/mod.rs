@@ -16,10 +16,13 @@ pub mod warnings;
 
 use std::time::Instant;
 
-pub use object_results::ObjectResult;
+pub use object_results::{ObjectResult, ENVIRONMENT};
 pub use patch_results::{PatchLight, PatchResult};
 pub use radiosity::{RadiosityOutcome, RadiositySolve, SolveFailure, NOTHING_EMITS};
-pub use reliability::{Reliability, SamplingReport, Verdict, COVERAGE_OK, COVERAGE_UNUSABLE};
+pub use reliability::{
+    HalfRun, LinesAdvice, Reliability, SamplingReport, Verdict, ADVICE_SETTLED_GROWTH, COVERAGE_OK,
+    COVERAGE_UNUSABLE,
+};
 pub use warnings::{RunWarning, RunWarningKind};
 
 use patch_results as per_patch;
@@ -110,6 +113,10 @@ pub struct Analysis {
     /// With `--enclose` when something escaped: the environment patch's area in scene units (see
     /// [`crate::sample::environment`]); `None` otherwise.
     pub environment_area: Option<Estimate>,
+    /// Whether the measures are those of the enclosed scene (`--enclose` on a scene lines escaped):
+    /// the environment is then patch `patches` of the per-patch results and of the form factors
+    /// ([`Tally::enclosed`]).
+    pub enclosed: bool,
     /// Every reading with its standard error, by measure ([`Measure`]): the visibility measures and,
     /// when computed, the radiosity measures; `None` for a measure not computed.
     pub estimates: ByMeasure<Estimate>,
@@ -127,11 +134,13 @@ pub struct Analysis {
     pub orientation: Vec<ObjectSides>,
     /// The full-run counts, for form factors (when counted).
     pub tally: Tally,
-    /// Each patch's results, with standard errors, when [`RunSpec::per_patch`] asked for them
-    /// (`None` as well for an enclosed open scene).
+    /// Each patch's results, with standard errors, when [`RunSpec::per_patch`] asked for them; for an
+    /// enclosed open scene those of the enclosed scene, the environment's after the scene's patches
+    /// ([`patch_results`]).
     pub patches: Option<Vec<PatchResult>>,
     /// Each object's results ([`ObjectResult`]): what it is and how its sides were met always, its
-    /// segments when the pairs were counted, and its share of the measures with per-patch results.
+    /// segments when the pairs were counted, and its share of the measures with per-patch results
+    /// (with the environment's object last when those are an enclosed scene's).
     pub objects: Vec<ObjectResult>,
 }
 
@@ -326,18 +335,21 @@ pub fn finish(
                 .expect("radiosity counts the pairs"),
         )?,
     };
-    let patches = (cfg.per_patch && !enclose)
+    let patches = cfg
+        .per_patch
         .then(|| {
             let light = materials.as_ref().filter(|_| lit).map(|m| PatchLight {
                 materials: m,
                 solve: &cfg.solve,
             });
-            per_patch::estimates(scene, &run, cfg.estimator, light)
+            per_patch::estimates(scene, &run, cfg.estimator, light, enclose)
         })
         .flatten();
     let (patches, object_values) = patches.unzip();
     let FinishedRun { total, .. } = run;
-    let objects = object_results::of_run(scene, &total, object_values);
+    // The environment is an object of its own beside the enclosed scene's per-patch results.
+    let environment = (enclose && patches.is_some()).then(|| total.environment_area(scene));
+    let objects = object_results::of_run(scene, &total, object_values, environment);
     let mut warnings = warnings::of_run(
         &scene.name,
         &total.counters,
@@ -388,6 +400,7 @@ pub fn finish(
         absorbed: total.counters.absorbed,
         degenerate_pairs: total.counters.degenerate_pairs,
         environment_area: visibility.environment_area,
+        enclosed: enclose,
         distinct_pairs: total.counts.as_ref().map(|c| c.distinct_pairs()),
         unsampled: visibility.unsampled,
         estimates,

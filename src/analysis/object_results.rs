@@ -2,10 +2,19 @@
 //! how lines met its sides, and, when the run has per-patch results, the sums of its patches' terms,
 //! each with the batch-means standard error of the group sums (a sum's error is not the sum of its
 //! terms' errors: the terms of one group move together).
+//!
+//! The per-patch results of an enclosed open scene (`--enclose`) have a row for the environment
+//! ([`super::patch_results`]); the objects then have one too, last, named [`ENVIRONMENT`], and every
+//! object's area fraction is its share of the enclosed scene's area, so that the objects' values add up
+//! to the enclosed scene's measures.
 
 use crate::measure::{Estimate, PatchMeasure};
 use crate::sample::tally::{ObjectSides, Tally};
 use crate::scene::Scene;
+
+/// The name of the environment's object (and material) in the per-object and per-patch results of an
+/// enclosed open scene.
+pub const ENVIRONMENT: &str = "environment";
 
 /// An object's value of each quantity of the per-patch catalogue, by [`PatchMeasure`].
 pub type ObjectValues = [Option<Estimate>; PatchMeasure::COUNT];
@@ -21,7 +30,8 @@ pub struct ObjectResult {
     pub triangles: usize,
     /// Its area, in the scene's units squared.
     pub area: f64,
-    /// Its share of the scene's area.
+    /// Its share of the scene's area (of the enclosed scene's, the environment's included, when the
+    /// results have the environment's row).
     pub area_fraction: f64,
     /// How lines met its sides: front sides escaping, back sides seen from front sides and from open
     /// space ([`ObjectSides`]).
@@ -84,14 +94,16 @@ pub fn patches_by_object(scene: &Scene) -> Vec<Vec<usize>> {
 
 /// Every object's results from the run's total tally: what it is, how its sides were met, and its
 /// segments and escapes when the pair counts were kept; `values` holds the sums of its patches' terms
-/// when the run has per-patch results.
+/// when the run has per-patch results, and the environment's last when they are an enclosed scene's
+/// (`environment`: its area in tracing space); the environment is then the last object.
 pub(crate) fn of_run(
     scene: &Scene,
     total: &Tally,
     values: Option<Vec<ObjectValues>>,
+    environment: Option<f64>,
 ) -> Vec<ObjectResult> {
     let members = patches_by_object(scene);
-    let total_area = scene.total_area();
+    let total_area = scene.total_area() + environment.unwrap_or(0.0);
     let scale2 = scene.normalization.scale * scene.normalization.scale;
     let lost = total.lost_by_patch();
     let segments = total
@@ -99,6 +111,10 @@ pub(crate) fn of_run(
         .as_ref()
         .map(|counts| crate::measure::channel::row_totals(scene.patch_count(), counts, &lost));
     let mut values = values.map(Vec::into_iter);
+    let (escapes, absorbed) = (
+        total.escapes_by_patch.dense(),
+        total.absorbed_by_patch.dense(),
+    );
     members
         .iter()
         .enumerate()
@@ -124,13 +140,33 @@ pub(crate) fn of_run(
                 segments: segments
                     .as_ref()
                     .map(|s| patches.iter().map(|&i| s[i].round() as u64).sum()),
-                escapes: counted.then(|| sum(&total.escapes_by_patch)),
-                absorbed: counted.then(|| sum(&total.absorbed_by_patch)),
+                escapes: counted.then(|| sum(&escapes)),
+                absorbed: counted.then(|| sum(&absorbed)),
                 values: values
                     .as_mut()
                     .and_then(Iterator::next)
                     .unwrap_or([None; PatchMeasure::COUNT]),
             }
         })
+        .collect::<Vec<_>>()
+        .into_iter()
+        .chain(environment.map(|area| {
+            let c = &total.counters;
+            ObjectResult {
+                name: ENVIRONMENT.into(),
+                patches: 1,
+                triangles: 0,
+                area: area * scale2,
+                area_fraction: area / total_area,
+                sides: ObjectSides::default(),
+                segments: total.counts.as_ref().map(|_| c.escapes + 2 * c.misses),
+                escapes: total.counts.as_ref().map(|_| 0),
+                absorbed: total.counts.as_ref().map(|_| 0),
+                values: values
+                    .as_mut()
+                    .and_then(Iterator::next)
+                    .unwrap_or([None; PatchMeasure::COUNT]),
+            }
+        }))
         .collect()
 }

@@ -89,6 +89,100 @@ pub struct SamplingReport {
     pub sampling: Sampling,
     /// The lines in all for a coverage of [`COVERAGE_OK`] (`None`: beyond reach of the extrapolation).
     pub lines_for_coverage: Option<u64>,
+    /// The same extrapolation from the first half of the run's groups alone, a run of about half the
+    /// lines; computed only when the coverage falls short of [`COVERAGE_OK`].
+    pub from_half: HalfRun,
+    /// What [`SamplingReport::lines_for_coverage`] is worth.
+    pub advice: LinesAdvice,
+}
+
+/// The extrapolation of the lines for a coverage of [`COVERAGE_OK`] from half a run's groups.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum HalfRun {
+    /// Not computed: the coverage is reached (or beyond reach) with all the lines, or the run has fewer
+    /// than 2 groups.
+    NotComputed,
+    /// The lines in all it advises.
+    Lines(u64),
+    /// The coverage was beyond reach of the extrapolation from half the lines.
+    BeyondReach,
+}
+
+/// The growth of the lines advice from half a run's lines to all of them above which the advice is a
+/// lower bound ([`LinesAdvice::LowerBound`]). Where the extrapolation holds it does not grow (1.0 on the
+/// icosphere `@sphere:3` at 10^6 and 3 x 10^6 lines).
+pub const ADVICE_SETTLED_GROWTH: f64 = 1.25;
+
+/// What the lines advice for a coverage of [`COVERAGE_OK`] ([`SamplingReport::lines_for_coverage`]) is
+/// worth. Chao and Jost's extrapolation of a row's coverage is fitted to the outcomes seen once and
+/// twice; rows with a long tail of rare outcomes (an object seen from outside: each patch sees a few
+/// others often and many rarely) keep revealing new ones as the lines grow, and the advice grows with
+/// them. The same extrapolation from half the run's groups (independent replicates: a run of half the
+/// lines) shows whether it has settled.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LinesAdvice {
+    /// The coverage is reached: no advice.
+    Reached,
+    /// An estimate: it did not grow by more than [`ADVICE_SETTLED_GROWTH`] from half the lines (or the
+    /// run has too few groups to tell).
+    Estimate,
+    /// A lower bound: it grew by more than [`ADVICE_SETTLED_GROWTH`] from half the lines, or from half the
+    /// lines the coverage was beyond reach; more lines may be needed.
+    LowerBound,
+    /// The coverage is beyond reach of the extrapolation: no advice.
+    BeyondReach,
+}
+
+impl LinesAdvice {
+    /// The stable code in the JSON report (`lower-bound`).
+    pub fn code(self) -> &'static str {
+        match self {
+            LinesAdvice::Reached => "reached",
+            LinesAdvice::Estimate => "estimate",
+            LinesAdvice::LowerBound => "lower-bound",
+            LinesAdvice::BeyondReach => "beyond-reach",
+        }
+    }
+}
+
+impl SamplingReport {
+    /// The report of a run of `lines` lines whose rows' sampling is `sampling`, with the lines advised
+    /// for a coverage of [`COVERAGE_OK`] from all the lines and from half of them.
+    pub fn new(
+        sampling: Sampling,
+        lines: u64,
+        lines_for_coverage: Option<u64>,
+        from_half: HalfRun,
+    ) -> Self {
+        let mut report = SamplingReport {
+            sampling,
+            lines_for_coverage,
+            from_half,
+            advice: LinesAdvice::Estimate,
+        };
+        report.advice = match (lines_for_coverage, from_half) {
+            (None, _) => LinesAdvice::BeyondReach,
+            (Some(n), _) if n <= lines => LinesAdvice::Reached,
+            (Some(_), HalfRun::BeyondReach) => LinesAdvice::LowerBound,
+            _ if report
+                .advice_growth()
+                .is_some_and(|g| g > ADVICE_SETTLED_GROWTH) =>
+            {
+                LinesAdvice::LowerBound
+            }
+            _ => LinesAdvice::Estimate,
+        };
+        report
+    }
+
+    /// How many times the lines advice grew from half the run's lines to all of them, when both were
+    /// extrapolated.
+    pub fn advice_growth(&self) -> Option<f64> {
+        match (self.lines_for_coverage, self.from_half) {
+            (Some(all), HalfRun::Lines(half)) if half > 0 => Some(all as f64 / half as f64),
+            _ => None,
+        }
+    }
 }
 
 /// Whether `a` exceeds `b` by more than twice their combined standard error.
@@ -384,6 +478,8 @@ mod tests {
                 mse_bias: -0.001,
             },
             lines_for_coverage: Some(5_000_000),
+            from_half: HalfRun::NotComputed,
+            advice: LinesAdvice::Estimate,
         }
     }
 
@@ -566,5 +662,47 @@ mod tests {
             .flags
             .iter()
             .any(|f| f.contains("Proposition 2")));
+    }
+
+    /// The advice is what its two extrapolations say: none when the coverage is reached or beyond reach,
+    /// a lower bound when it grew past 1.25 times from half the lines or the half could not reach the
+    /// coverage, an estimate otherwise (and when there was no half to compare with).
+    #[test]
+    fn lines_advice_from_all_and_half_the_lines() {
+        let advice = |all: Option<u64>, half: HalfRun| {
+            let r = SamplingReport::new(report(0.95).sampling, 1_000_000, all, half);
+            (r.advice, r.advice_growth())
+        };
+        let m = 1_000_000u64;
+        assert_eq!(
+            advice(Some(m), HalfRun::NotComputed),
+            (LinesAdvice::Reached, None)
+        );
+        assert_eq!(
+            advice(None, HalfRun::BeyondReach),
+            (LinesAdvice::BeyondReach, None)
+        );
+        assert_eq!(
+            advice(Some(4 * m), HalfRun::BeyondReach),
+            (LinesAdvice::LowerBound, None)
+        );
+        assert_eq!(
+            advice(Some(4 * m), HalfRun::NotComputed),
+            (LinesAdvice::Estimate, None)
+        );
+        assert_eq!(
+            advice(Some(4 * m), HalfRun::Lines(2 * m)),
+            (LinesAdvice::LowerBound, Some(2.0))
+        );
+        assert_eq!(
+            advice(Some(6 * m), HalfRun::Lines(5 * m)),
+            (LinesAdvice::Estimate, Some(1.2))
+        );
+        // Shrinking from half the lines (a far extrapolation from a low coverage) is no sign of a bound.
+        assert_eq!(
+            advice(Some(4 * m), HalfRun::Lines(5 * m)),
+            (LinesAdvice::Estimate, Some(0.8))
+        );
+        assert_eq!(LinesAdvice::LowerBound.code(), "lower-bound");
     }
 }

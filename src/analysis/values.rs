@@ -3,7 +3,7 @@
 
 use rayon::prelude::*;
 
-use super::reliability::{self, Reliability, RunFacts, SamplingReport, COVERAGE_OK};
+use super::reliability::{self, HalfRun, Reliability, RunFacts, SamplingReport, COVERAGE_OK};
 use crate::measure::bias::{self, CorrectedValues};
 use crate::measure::catalogue::VerdictRule;
 use crate::measure::channel;
@@ -244,9 +244,16 @@ pub(super) fn visibility_estimates(
         environment_area = spread.batch_means(|g| Some(g.environment_area? * scale2));
     }
     let lines = run.total.counters.lines;
-    let sampling = all.sampling.map(|sampling| SamplingReport {
-        sampling,
-        lines_for_coverage: all.lines_factor.map(|k| (k * lines as f64).ceil() as u64),
+    let sampling = all.sampling.map(|sampling| {
+        let lines_for_coverage = all.lines_factor.map(|k| lines_for(k, lines));
+        // From half the lines only when there is advice to check.
+        let half = match all.lines_factor {
+            Some(k) if k > 1.0 => {
+                half_run_lines_for_coverage(scene, &run.groups, estimator, enclose)
+            }
+            _ => HalfRun::NotComputed,
+        };
+        SamplingReport::new(sampling, lines, lines_for_coverage, half)
     });
     let c = &run.total.counters;
     let facts = RunFacts {
@@ -279,6 +286,45 @@ fn plug_in_of(m: Measure) -> Option<Measure> {
         Measure::EntropyCorrected => Some(Measure::Entropy),
         Measure::MutualInformationCorrected => Some(Measure::MutualInformation),
         _ => None,
+    }
+}
+
+/// The lines in all for a factor `k` on a run of `lines` lines.
+fn lines_for(k: f64, lines: u64) -> u64 {
+    (k * lines as f64).ceil() as u64
+}
+
+/// The lines for a coverage of [`COVERAGE_OK`] extrapolated from the first half of the groups alone (a
+/// run of about half the lines: the groups are independent replicates, and the first half of them is
+/// the same whatever the threads, shards or resumes), to see whether the whole run's extrapolation has
+/// settled ([`SamplingReport::advice`]). Not computed with fewer than 2 groups or without pair counts.
+fn half_run_lines_for_coverage(
+    scene: &Scene,
+    groups: &[Tally],
+    estimator: EntropyEstimator,
+    enclose: bool,
+) -> HalfRun {
+    let Some((first, rest)) = groups[..groups.len() / 2].split_first() else {
+        return HalfRun::NotComputed;
+    };
+    if first.counts.is_none() {
+        return HalfRun::NotComputed;
+    }
+    // The per-patch sums of eq. (27) play no part in the coverage.
+    let mut half = Tally {
+        counters: first.counters,
+        orientation: first.orientation.clone(),
+        escapes_by_patch: first.escapes_by_patch.clone(),
+        absorbed_by_patch: first.absorbed_by_patch.clone(),
+        counts: first.counts.clone(),
+        kernel_by_patch: None,
+    };
+    for g in rest {
+        half.merge(g);
+    }
+    match GroupValues::of(scene, &half, estimator, enclose, true).lines_factor {
+        Some(k) => HalfRun::Lines(lines_for(k, half.counters.lines)),
+        None => HalfRun::BeyondReach,
     }
 }
 

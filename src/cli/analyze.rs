@@ -64,6 +64,8 @@ pub struct AnalyzeArgs {
     /// inwards): escaping segments become pairs with it, rows of F sum to 1, and every visibility measure
     /// is that of the enclosed scene. Its area is counted: the part of the sphere that sees the scene's
     /// front sides or itself (4 pi R^2 for objects in open space). Changes nothing in a closed scene.
+    /// With --patches, --form-factors and --objects, the environment is a row (and object) of its own,
+    /// after the scene's patches.
     #[arg(long)]
     enclose: bool,
     /// Output format: `table` (for people), `json` (one document with every field, units and verdicts),
@@ -135,11 +137,6 @@ fn check_patch_files(args: &AnalyzeArgs) -> Result<(), Failure> {
         return Ok(());
     }
     f.check()?;
-    if args.enclose {
-        return Err(Failure::bad_input(
-            "--patches and --form-factors describe the scene's own patches; they do not take --enclose",
-        ));
-    }
     if !f.form_factors.is_empty()
         && args.measures.as_ref().is_some_and(|m| {
             !m.contains(&MeasureArg::Discrete) && !m.contains(&MeasureArg::Radiosity)

@@ -84,7 +84,7 @@ impl PatchFiles {
 
     /// Checks, before any line is cast or any measure computed, that a saved run (read from `file`, or
     /// the merge of states whose first is `file`) can give these files: it must have counted patch
-    /// pairs and not closed the scene. `wanted` is what the run gathers, and `without_sums` the state
+    /// pairs. `wanted` is what the run gathers, and `without_sums` the state
     /// files that keep no per-patch sums of eq. (27) although their run computes I_s^c (their run was
     /// not asked for `--patches`): then the I_s^c columns are left empty, and a warning names them,
     /// rather than sharing out sums of only some of the lines.
@@ -98,12 +98,6 @@ impl PatchFiles {
         if self.is_empty() {
             return Ok(());
         }
-        if identity.spec.enclose {
-            return Err(Failure::bad_input(format!(
-                "{file}: the run closed the scene with --enclose; --patches and --form-factors \
-                 describe the scene's own patches"
-            )));
-        }
         if !wanted.discrete {
             return Err(Failure::bad_input(format!(
                 "{file}: the run counted no patch pairs (--measures without discrete): it has no \
@@ -113,9 +107,14 @@ impl PatchFiles {
         if !self.patches.is_empty() && wanted.continuous && !without_sums.is_empty() {
             warn(&format!(
                 "{}: saved without the per-patch sums of eq. (27) (the run was not asked for \
-                 --patches), so the {} and {} columns of --patches stay empty; give --patches to the \
+                 --patches{}), so the {} and {} columns of --patches stay empty; give --patches to the \
                  first run (to every shard) to have them",
                 without_sums.join(", "),
+                if identity.spec.enclose {
+                    ", or was enclosed by an scx from before the environment had a row of its own"
+                } else {
+                    ""
+                },
                 PatchMeasure::ContinuousTerm.info().column,
                 PatchMeasure::LostInformation.info().column
             ));
@@ -187,7 +186,7 @@ fn write_patches(paths: &[PathBuf], scene: &Scene, a: &Analysis) -> Result<(), F
     }
     let Some(patches) = &a.patches else {
         return Err(Failure::bad_input(
-            "no per-patch results: the run counted no patch pairs, or closed the scene with --enclose",
+            "no per-patch results: the run counted no patch pairs",
         ));
     };
     let table = patch_table(scene, patches);
@@ -302,6 +301,12 @@ fn matrix_market(
         env!("CARGO_PKG_VERSION")
     )?;
     writeln!(w, "% row i, column j (1-based: patch index + 1)")?;
+    if a.enclosed {
+        writeln!(
+            w,
+            "% row and column {n}: the environment of the enclosed scene (--enclose)"
+        )?;
+    }
     writeln!(w, "{n} {n} {}", matrix.entries.len())?;
     write_in_chunks(w, matrix.entries.len(), |chunk| {
         let mut out = Vec::with_capacity(32 * chunk.len());

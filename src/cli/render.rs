@@ -35,7 +35,7 @@ pub struct RenderArgs {
     #[arg(short, long, value_name = "FILE.png")]
     output: PathBuf,
     /// Also write the mesh with a colour per patch (PLY, for MeshLab or Blender; binary unless
-    /// --patches-mesh-format ascii).
+    /// --patches-mesh-format ascii), each face's number in `value` (`valued` 0 where a patch has none).
     #[arg(long, value_name = "FILE.ply")]
     patches_mesh: Option<PathBuf>,
     /// How --patches-mesh stores its numbers: `binary` (binary little-endian PLY: exact, and about a
@@ -272,7 +272,9 @@ pub fn run(args: &RenderArgs) -> Result<Exit, Failure> {
     output::wrote(&args.output);
     if let Some(ply) = &args.patches_mesh {
         let comment = format!(
-            "{} coloured by {} ({}) from {} lines, viridis from {} to {}\nwritten by scx {}",
+            "{} coloured by {} ({}) from {} lines, viridis from {} to {}\n\
+             value: the patch's number; valued 0: the patch has none (its value written as 0)\n\
+             written by scx {}",
             scene.name,
             args.color.label(),
             args.color.unit(args.per_area),

@@ -12,7 +12,8 @@ use scene_complexity::report::{
 use scene_complexity::Scene;
 use scene_complexity::VerdictRule;
 use scene_complexity::{
-    Analysis, RadiosityOutcome, Reliability, TargetOutcome, Verdict, COVERAGE_OK,
+    Analysis, LinesAdvice, RadiosityOutcome, Reliability, SamplingReport, TargetOutcome, Verdict,
+    COVERAGE_OK,
 };
 use scene_complexity::{ErrorMethod, Sampler, Shard, StopReason, Tracing};
 use scene_complexity::{Estimate, Family, Measure};
@@ -419,10 +420,32 @@ fn corrected_needs(a: &Analysis) -> String {
         }
         Some(n) => format!(
             "; the corrected readings need a coverage of 0.99 and a remaining bias (the jackknife's \
-             estimate) within their standard error, at least about {n:.1e} lines (an extrapolation, good \
-             to about twice the lines cast)"
+             estimate) within their standard error, at least about {n:.1e} lines ({})",
+            extrapolation_note(a.sampling.as_ref().filter(|_| coverage_short), n)
         ),
         None => String::new(),
+    }
+}
+
+/// What the advice of `n` lines is worth, from the coverage's extrapolation when the coverage is short.
+fn extrapolation_note(sampling: Option<&SamplingReport>, n: u64) -> String {
+    let Some(s) = sampling.filter(|s| s.advice == LinesAdvice::LowerBound) else {
+        return "an extrapolation, good to about twice the lines cast".into();
+    };
+    // The advice may be the bias's rather than the coverage's: then name the coverage's.
+    let what = if s.lines_for_coverage == Some(n) {
+        "it"
+    } else {
+        "the coverage's"
+    };
+    match s.advice_growth() {
+        Some(g) => format!(
+            "an extrapolation that has not settled: {what} grew {g:.1}x from half the lines, so more \
+             may be needed"
+        ),
+        None => "an extrapolation that has not settled: from half the lines a coverage of 0.99 was \
+                 beyond the extrapolation's reach, so more may be needed"
+            .into(),
     }
 }
 

@@ -119,6 +119,9 @@ const FRAMING: f64 = 0.88;
 /// How much more another view must score to replace the classic view.
 const KEEP_CLASSIC: f64 = 1.1;
 
+/// The thinnest side of the box the views are framed on, as a share of the longest.
+const THINNEST: f64 = 0.05;
+
 /// The default view of a scene (module documentation).
 pub fn default_camera(scene: &Scene, tracer: &dyn Tracer) -> Result<Camera, TraceError> {
     let bounds = Bounds::of(scene);
@@ -141,9 +144,13 @@ fn best_view(
     tracer: &dyn Tracer,
     candidates: &[Camera],
 ) -> Result<Camera, TraceError> {
+    // A candidate that cannot form a picture (on a degenerate scene) is never chosen.
     let scores = candidates
         .iter()
-        .map(|c| view_score(scene, tracer, c).map(|s| s.score()))
+        .map(|c| match c.validate() {
+            Ok(()) => view_score(scene, tracer, c).map(|s| s.score()),
+            Err(_) => Ok(f64::NEG_INFINITY),
+        })
         .collect::<Result<Vec<f64>, _>>()?;
     let (best, top) =
         scores.iter().enumerate().fold(
@@ -278,11 +285,21 @@ struct Bounds {
 }
 
 impl Bounds {
+    /// The bounds of the scene's vertices, each side at least [`THINNEST`] of the longest: a flat
+    /// scene (one triangle, a height field) still has a box to stand in and look across.
     fn of(scene: &Scene) -> Self {
-        let (lo, hi) = scene.vertices.iter().fold(
+        let (mut lo, mut hi) = scene.vertices.iter().fold(
             (Point::splat(f64::INFINITY), Point::splat(f64::NEG_INFINITY)),
             |(lo, hi), v| (lo.min(*v), hi.max(*v)),
         );
+        let thinnest = THINNEST * (hi - lo).max_element();
+        for axis in 0..3 {
+            let missing = thinnest - (hi[axis] - lo[axis]);
+            if missing > 0.0 {
+                lo[axis] -= 0.5 * missing;
+                hi[axis] += 0.5 * missing;
+            }
+        }
         Bounds { lo, hi }
     }
 

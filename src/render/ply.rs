@@ -3,8 +3,10 @@
 //! Each face has its own copies of its vertices, so that the colours can be given both per face
 //! (`red green blue` on the face: MeshLab) and per vertex (Blender's importer reads vertex colours
 //! only) without blending across patches. Coordinates are in the scene's own units and frame; faces
-//! are in patch order (the order of `scx export`), with the value shown as a `value` property (NaN when
-//! the patch has none).
+//! are in patch order (the order of `scx export`), with the value shown as a `value` property and a
+//! `valued` flag before it: 1 when the patch has a value, 0 when it has none (no line left it, say), its
+//! `value` then written as 0. PLY has no missing value that every reader accepts (ASCII readers,
+//! scx's among them, refuse `NaN`), so the flag says it and both formats hold the same numbers.
 //!
 //! Binary little-endian by default: a fine mesh's vertices in ASCII are written with up to 17 digits
 //! each, three times the bytes of their doubles. ASCII on request, for reading or diffing by eye.
@@ -74,6 +76,7 @@ fn write_header(
     for c in ["red", "green", "blue"] {
         writeln!(out, "property uchar {c}")?;
     }
+    writeln!(out, "property uchar valued")?;
     writeln!(out, "property double value")?;
     writeln!(out, "end_header")
 }
@@ -99,8 +102,8 @@ fn write_ascii_body(
             write!(out, " {next}")?;
             next += 1;
         }
-        let value = values[p].unwrap_or(f64::NAN);
-        writeln!(out, " {r} {g} {b} {value}")?;
+        let (valued, value) = flag_and_value(values[p]);
+        writeln!(out, " {r} {g} {b} {valued} {value}")?;
     }
     Ok(())
 }
@@ -128,9 +131,17 @@ fn write_binary_body(
             next = next.checked_add(1).ok_or_else(too_many_corners)?;
         }
         out.write_all(&colours[p])?;
-        out.write_all(&values[p].unwrap_or(f64::NAN).to_le_bytes())?;
+        let (valued, value) = flag_and_value(values[p]);
+        out.write_all(&[valued])?;
+        out.write_all(&value.to_le_bytes())?;
     }
     Ok(())
+}
+
+/// The `valued` flag and the `value` written for a patch's value: `(1, v)`, or `(0, 0.0)` without one
+/// (a value that is not finite counts as none: ASCII readers refuse `NaN` and `inf`).
+fn flag_and_value(value: Option<f64>) -> (u8, f64) {
+    value.filter(|v| v.is_finite()).map_or((0, 0.0), |v| (1, v))
 }
 
 /// A face's corner count as the `uchar` the list is declared with.

@@ -5,7 +5,7 @@ use serde_json::{json, Value};
 
 use super::rows::{finite, positive_zero, rows, Row};
 use crate::analysis::{
-    Analysis, ObjectResult, RadiosityOutcome, Reliability, TargetOutcome, Verdict,
+    Analysis, HalfRun, ObjectResult, RadiosityOutcome, Reliability, TargetOutcome, Verdict,
 };
 use crate::measure::catalogue::{Family, PatchMeasure, Unit};
 use crate::measure::Estimate;
@@ -127,6 +127,11 @@ fn sampling_json(a: &Analysis) -> Value {
             "coverage": finite(s.sampling.coverage),
             "singleton_share": finite(s.sampling.singleton_share),
             "lines_for_coverage_0_99": s.lines_for_coverage,
+            "lines_for_coverage_0_99_from_half": match s.from_half {
+                HalfRun::Lines(n) => Some(n),
+                HalfRun::NotComputed | HalfRun::BeyondReach => None,
+            },
+            "lines_advice": s.advice.code(),
         }),
     }
 }

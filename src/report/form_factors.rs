@@ -1,5 +1,9 @@
 //! The sparse form-factor matrix of a run (`--form-factors`): `F_ij = N_ij / N_i`, the share of patch
 //! i's segments that end on patch j (the Monte Carlo estimate of eq. 2 by global lines, sec. 2.3).
+//!
+//! An enclosed open scene (`--enclose`) has the environment as row and column `patches`: `F_i,env =
+//! escapes_i / N_i`, `F_env,j = escapes_j / N_env` and `F_env,env = 2 misses / N_env`, so that every
+//! row sums to 1 ([`crate::sample::environment`]).
 
 use rayon::prelude::*;
 
@@ -9,7 +13,8 @@ use crate::sample::counts::PairCounts;
 /// The non-zero entries of F with their counts, and each row's total.
 #[derive(Clone, Debug)]
 pub struct FormFactors {
-    /// The matrix is `patches x patches`.
+    /// The matrix is `patches x patches` (the scene's patches, and the environment after them when the
+    /// run's measures are those of the enclosed scene).
     pub patches: usize,
     /// Every `(i, j, N_ij)` with `N_ij > 0`, both directions of each pair, sorted by `i` then `j`; a
     /// segment from a patch back to itself enters `N_ii` twice (as in the measures).
@@ -20,17 +25,34 @@ pub struct FormFactors {
 }
 
 impl FormFactors {
-    /// The matrix of a run that counted patch pairs (`None` when it did not: `--measures` without
-    /// `discrete`).
+    /// The matrix of a run of a scene of `patches` patches that counted patch pairs (`None` when it did
+    /// not: `--measures` without `discrete`); of the enclosed scene, `patches + 1` square, when the run's
+    /// measures are ([`Analysis::enclosed`]).
     pub fn of(a: &Analysis, patches: usize) -> Option<FormFactors> {
+        if a.enclosed {
+            let counts = a.tally.enclosed_counts(patches)?;
+            return Some(FormFactors::of_counts(
+                patches + 1,
+                &counts,
+                &a.tally.enclosed_lost(patches),
+            ));
+        }
         let counts = a.tally.counts.as_ref()?;
+        Some(FormFactors::of_counts(
+            patches,
+            counts,
+            &a.tally.lost_by_patch(),
+        ))
+    }
+
+    fn of_counts(patches: usize, counts: &PairCounts, lost: &[u64]) -> FormFactors {
         let entries = ordered_entries(counts);
-        let row_totals = row_totals(patches, &entries, &a.tally.lost_by_patch());
-        Some(FormFactors {
+        let row_totals = row_totals(patches, &entries, lost);
+        FormFactors {
             patches,
             entries,
             row_totals,
-        })
+        }
     }
 
     /// Entry `k`'s `F_ij` and standard error ([`form_factor`]).

@@ -1,6 +1,7 @@
 //! The per-patch and per-object tables (`--patches FILE.csv`, `--objects FILE.csv`): named columns, one
 //! row per patch or object, each quantity of the per-patch catalogue followed by its standard error.
 
+use crate::analysis::object_results::ENVIRONMENT;
 use crate::analysis::{Analysis, PatchResult};
 use crate::geom::{Normal, Point};
 use crate::measure::catalogue::PatchMeasure;
@@ -120,47 +121,55 @@ impl Table {
 /// area, centroid and normal in the scene's units and frame, area fraction, segments `N_i`, escapes,
 /// absorbed segments, whether sampled, then each per-patch quantity (the patch's row entropy and its
 /// terms of I_s (eq. 21) and I_s^c (eq. 27), the information it loses, radiosities) with its standard
-/// error.
+/// error. The per-patch results of an enclosed scene have one row more, the environment's, last: id
+/// `patches`, object and material [`ENVIRONMENT`], its counted area, no centroid nor normal.
 pub fn patch_table(scene: &Scene, patches: &[PatchResult]) -> Table {
-    let n = scene.patch_count().min(patches.len());
-    let norm = scene.normalization;
-    let total_area = scene.total_area();
-    let centroids: Vec<Point> = (0..n).map(|i| centroid(scene, i)).collect();
-    let normals: Vec<Normal> = scene.patches[..n].iter().map(|p| p.normal).collect();
-    let number = |f: &dyn Fn(usize) -> f64| Values::Numbers((0..n).map(|i| Some(f(i))).collect());
+    let own = scene.patch_count().min(patches.len());
+    // The environment's row, after the scene's patches.
+    let n = patches.len().min(own + 1);
+    let centroids: Vec<Point> = (0..own).map(|i| centroid(scene, i)).collect();
+    let normals: Vec<Normal> = scene.patches[..own].iter().map(|p| p.normal).collect();
+    let geometry = |f: &dyn Fn(usize) -> f64| {
+        Values::Numbers((0..n).map(|i| (i < own).then(|| f(i))).collect())
+    };
+    let number = |f: &dyn Fn(&PatchResult) -> f64| {
+        Values::Numbers(patches[..n].iter().map(|p| Some(f(p))).collect())
+    };
     let count = |f: &dyn Fn(&PatchResult) -> u64| {
         Values::Integers(patches[..n].iter().map(|p| Some(f(p))).collect())
+    };
+    let labels = |names: Vec<String>, code: &dyn Fn(usize) -> u32| {
+        let mut names = names;
+        let environment = names.len() as u32;
+        if n > own {
+            names.push(ENVIRONMENT.to_string());
+        }
+        let codes = (0..n)
+            .map(|i| if i < own { code(i) } else { environment })
+            .collect();
+        Values::Labels { names, codes }
     };
     let mut t = Table::default();
     t.push("id", Values::Integers((0..n as u64).map(Some).collect()));
     t.push(
         "object",
-        Values::Labels {
-            names: scene.objects.clone(),
-            codes: scene.patches[..n].iter().map(|p| p.object).collect(),
-        },
+        labels(scene.objects.clone(), &|i| scene.patches[i].object),
     );
     t.push(
         "material",
-        Values::Labels {
-            names: scene.materials.iter().map(|m| m.name.clone()).collect(),
-            codes: scene.patches[..n].iter().map(|p| p.material).collect(),
-        },
+        labels(
+            scene.materials.iter().map(|m| m.name.clone()).collect(),
+            &|i| scene.patches[i].material,
+        ),
     );
-    t.push(
-        "area",
-        number(&|i| scene.patches[i].area * norm.scale * norm.scale),
-    );
-    t.push("centroid_x", number(&|i| centroids[i].x));
-    t.push("centroid_y", number(&|i| centroids[i].y));
-    t.push("centroid_z", number(&|i| centroids[i].z));
-    t.push("normal_x", number(&|i| normals[i].x));
-    t.push("normal_y", number(&|i| normals[i].y));
-    t.push("normal_z", number(&|i| normals[i].z));
-    t.push(
-        "area_fraction",
-        number(&|i| scene.patches[i].area / total_area),
-    );
+    t.push("area", number(&|p| p.area));
+    t.push("centroid_x", geometry(&|i| centroids[i].x));
+    t.push("centroid_y", geometry(&|i| centroids[i].y));
+    t.push("centroid_z", geometry(&|i| centroids[i].z));
+    t.push("normal_x", geometry(&|i| normals[i].x));
+    t.push("normal_y", geometry(&|i| normals[i].y));
+    t.push("normal_z", geometry(&|i| normals[i].z));
+    t.push("area_fraction", number(&|p| p.area_fraction));
     t.push("segments", count(&|p| p.segments));
     t.push("escapes", count(&|p| p.escapes));
     t.push("absorbed", count(&|p| p.absorbed));

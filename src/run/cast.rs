@@ -40,7 +40,8 @@ pub struct CastHooks<'a> {
 }
 
 /// Which measures a run of `cfg` gathers on `scene`: the pair counts also for the radiosity measures
-/// when something emits. Checks the materials first when radiosity is asked for.
+/// when something emits, and the escapes' per-patch sums of eq. (27) for the per-patch results of an
+/// enclosed scene. Checks the materials first when radiosity is asked for.
 fn gathered(scene: &Scene, cfg: &RunSpec) -> Result<Wanted, MaterialError> {
     let lit = if cfg.measures.radiosity {
         PatchMaterials::of_scene(scene)?.any_emission()
@@ -51,6 +52,7 @@ fn gathered(scene: &Scene, cfg: &RunSpec) -> Result<Wanted, MaterialError> {
         discrete: cfg.measures.discrete || lit || cfg.per_patch,
         continuous: cfg.measures.continuous,
         per_patch: cfg.per_patch && cfg.measures.continuous,
+        environment: cfg.per_patch && cfg.measures.continuous && cfg.enclose,
     })
 }
 

@@ -5,6 +5,7 @@
 //! a forged count can neither wrap around nor send an estimator into a loop as long as the count.
 
 use super::plan::{BatchPlan, BatchSet};
+use crate::sample::exact::ExactSum;
 use crate::sample::tally::Counters;
 
 /// The batches a state says are done, refused by name when its ranges are empty, overlap or reach
@@ -104,6 +105,28 @@ pub(super) fn check_counters(c: &Counters, lines: u64, triangles: u64) -> Result
     }
 }
 
+/// Checks that per-patch sums of eq. (27)'s log kernel are ones their counts of terms can give: each
+/// term is the `log2` of a normal f64 ([`crate::sample::kernel::kernel_without_pi`]), within
+/// (-1075, 1024), so a sum beyond that many times its count is forged (and could overflow a merge).
+pub(super) fn check_kernel_sums(sums: &[ExactSum], ends: &[u64], what: &str) -> Result<(), String> {
+    let most = |e: u64| MOST_LOG2_KERNEL * e as f64;
+    match sums
+        .iter()
+        .zip(ends)
+        .position(|(s, &e)| s.value().abs() > most(e))
+    {
+        Some(i) => Err(format!(
+            "{what}: patch {i}'s sum {} is beyond what its {} terms can add up to",
+            sums[i].value(),
+            ends[i]
+        )),
+        None => Ok(()),
+    }
+}
+
+/// The largest |log2| of a normal f64.
+const MOST_LOG2_KERNEL: f64 = 1075.0;
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -173,5 +196,15 @@ mod tests {
         assert!(check_counters(&wrapped, 100, 12)
             .unwrap_err()
             .contains("crossings than its lines"));
+    }
+
+    /// Per-patch sums of the log kernel beyond 1075 bits a term are refused, naming the patch.
+    #[test]
+    fn kernel_sums_beyond_their_terms_are_refused() {
+        let sums = [ExactSum::of(-2000.0), ExactSum::of(5000.0)];
+        assert_eq!(check_kernel_sums(&sums, &[2, 5], "sums"), Ok(()));
+        let message = check_kernel_sums(&sums, &[1, 5], "sums").unwrap_err();
+        assert!(message.contains("patch 0"), "{message}");
+        assert!(check_kernel_sums(&sums, &[2, 4], "sums").is_err());
     }
 }

@@ -9,8 +9,9 @@
 //! counters, and its escapes and pair counts as sparse lists whose sorted keys are stored as differences
 //! (mostly one or two bytes each); and, when the run was asked for per-patch results (`--patches`), its
 //! per-patch sums of eq. (27) ([`PatchKernelSums`]), without which a resumed or merged run could not
-//! share I_s^c out among the patches. States written before those sums were kept load as states without
-//! them.
+//! share I_s^c out among the patches, and with `--enclose` the sums of each patch's escapes, without
+//! which the enclosed scene's I_s^c could not be. States written before those sums were kept load as
+//! states without them (an enclosed one without the escapes' sums as one without any per-patch sums).
 //!
 //! Files are written atomically (a temporary file beside the target, synced, then renamed over it), so a
 //! run killed while saving leaves the previous state intact ([`super::files`]). A state goes only to a
@@ -30,6 +31,7 @@ use super::state::RunState;
 use crate::sample::counts::{pair_key, split_key, PairCounts};
 use crate::sample::exact::ExactSum;
 use crate::sample::kernel_sums::PatchKernelSums;
+use crate::sample::patch_counts::PatchCounts;
 use crate::sample::tally::{Counters, ObjectSides, Tally, Wanted};
 use crate::scene::read as scene_read;
 use crate::scene::{Scene, SceneOptions};
@@ -231,6 +233,11 @@ struct Wire {
     /// they were kept: those have none).
     #[serde(default)]
     per_patch: bool,
+    /// Whether the per-patch sums hold the escapes' terms too (`--enclose`; absent, and then false,
+    /// from the states of scx before they were kept and from the states of runs not enclosed, which
+    /// are written as before).
+    #[serde(default, skip_serializing_if = "is_false")]
+    per_patch_environment: bool,
     done: Vec<[u64; 2]>,
     groups: Vec<Option<TallyWire>>,
     tail: Option<(u64, TallyWire)>,
@@ -259,11 +266,19 @@ struct TallyWire {
 
 /// [`PatchKernelSums`] as stored: one entry per patch in each list. Dense, not sparse: in any run
 /// long enough to be worth a per-patch table every patch of a group has pair ends, and a patch without
-/// any costs two bytes.
+/// any costs two bytes. The escapes' lists are absent when not gathered.
 #[derive(Serialize, Deserialize)]
 struct KernelWire {
     log2_kernel: Vec<ExactSum>,
     ends: Vec<u64>,
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    environment_log2_kernel: Vec<ExactSum>,
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    environment_ends: Vec<u64>,
+}
+
+fn is_false(b: &bool) -> bool {
+    !*b
 }
 
 /// Sorted `(key, value)` entries as key differences and values.
@@ -274,15 +289,11 @@ struct Sparse {
 }
 
 impl Sparse {
-    /// The non-zero entries of a dense per-patch list.
-    fn of_dense(per_patch: &[u64]) -> Self {
-        Sparse::of(
-            per_patch
-                .iter()
-                .enumerate()
-                .filter(|(_, &e)| e > 0)
-                .map(|(i, &e)| (i as u64, e)),
-        )
+    /// The non-zero entries of counts per patch.
+    fn of_counts(per_patch: &PatchCounts) -> Self {
+        let mut entries = Vec::new();
+        per_patch.for_each_counted(|i, e| entries.push((u64::from(i), e)));
+        Sparse::of(entries)
     }
 
     fn of(entries: impl IntoIterator<Item = (u64, u64)>) -> Self {
@@ -320,8 +331,8 @@ impl Sparse {
 fn tally_wire(t: &Tally) -> TallyWire {
     TallyWire {
         counters: t.counters,
-        escapes: Sparse::of_dense(&t.escapes_by_patch),
-        absorbed: Sparse::of_dense(&t.absorbed_by_patch),
+        escapes: Sparse::of_counts(&t.escapes_by_patch),
+        absorbed: Sparse::of_counts(&t.absorbed_by_patch),
         counts: t.counts.as_ref().map(|c| {
             let mut entries = Vec::with_capacity(c.distinct_pairs());
             c.for_each(|i, j, n| entries.push((pair_key(i, j), n)));
@@ -335,28 +346,22 @@ fn tally_wire(t: &Tally) -> TallyWire {
         kernel_by_patch: t.kernel_by_patch.as_ref().map(|k| KernelWire {
             log2_kernel: k.log2_kernel.clone(),
             ends: k.ends.clone(),
+            environment_log2_kernel: k.environment_log2_kernel.clone(),
+            environment_ends: k.environment_ends.clone(),
         }),
     }
 }
 
-/// `n` zeros, or none when that much memory cannot be had.
-fn zeros(n: usize) -> Option<Vec<u64>> {
-    let mut v = Vec::new();
-    v.try_reserve_exact(n).ok()?;
-    v.resize(n, 0);
-    Some(v)
-}
-
-/// A dense per-patch list from sparse entries, each within the scene's patches.
-fn dense(entries: &[(u64, u64)], patches: usize, what: &str) -> Result<Vec<u64>, String> {
-    let mut list = zeros(patches).ok_or_else(|| format!("no memory for {patches} patches"))?;
-    for &(i, e) in entries {
-        let slot = usize::try_from(i).ok().and_then(|i| list.get_mut(i));
-        *slot.ok_or_else(|| {
-            format!("{what} of patch {i}, beyond the scene's {patches} patches")
-        })? = e;
+/// Counts per patch from sparse entries (sorted, distinct), each within the scene's patches.
+fn per_patch(entries: &[(u64, u64)], patches: usize, what: &str) -> Result<PatchCounts, String> {
+    if let Some(&(i, _)) = entries.iter().find(|&&(i, _)| i >= patches as u64) {
+        return Err(format!(
+            "{what} of patch {i}, beyond the scene's {patches} patches"
+        ));
     }
-    Ok(list)
+    // Below the patch count, which fits a u32 (a scene's patches are numbered by u32).
+    let entries = entries.iter().map(|&(i, e)| (i as u32, e));
+    Ok(PatchCounts::of_entries(patches, entries))
 }
 
 /// The sorted, unique entries of a sparse list, refused by name when they are not.
@@ -386,21 +391,21 @@ fn tally_of(w: &TallyWire, scene: &SceneSize, wanted: Wanted, lines: u64) -> Res
     let absorbed = entries_of(&w.absorbed, "absorbed segments")?;
     let escapes_by_patch = if wanted.discrete {
         check_sum(&escapes, w.counters.escapes, "escapes per patch")?;
-        dense(&escapes, patches, "escapes")?
+        per_patch(&escapes, patches, "escapes")?
     } else if escapes.is_empty() {
-        Vec::new()
+        PatchCounts::default()
     } else {
         return Err("it lists escapes per patch for a run that keeps none".into());
     };
     let absorbed_by_patch = if absorbed.is_empty() {
-        Vec::new()
+        PatchCounts::default()
     } else {
         check_sum(
             &absorbed,
             w.counters.absorbed,
             "absorbed segments per patch",
         )?;
-        dense(&absorbed, patches, "absorbed segments")?
+        per_patch(&absorbed, patches, "absorbed segments")?
     };
     if wanted.discrete && absorbed.is_empty() && w.counters.absorbed > 0 {
         return Err(format!(
@@ -463,10 +468,15 @@ fn tally_of(w: &TallyWire, scene: &SceneSize, wanted: Wanted, lines: u64) -> Res
                     w.counters.pairs
                 ));
             }
-            Some(PatchKernelSums {
+            consistency::check_kernel_sums(&k.log2_kernel, &k.ends, "per-patch sums of eq. (27)")?;
+            let sums = PatchKernelSums {
                 log2_kernel: k.log2_kernel.clone(),
                 ends: k.ends.clone(),
-            })
+                environment_log2_kernel: k.environment_log2_kernel.clone(),
+                environment_ends: k.environment_ends.clone(),
+            };
+            check_environment_sums(&sums, w, &escapes_by_patch.dense(), wanted)?;
+            Some(sums)
         }
         (None, false) => None,
         (None, true) => {
@@ -484,6 +494,60 @@ fn tally_of(w: &TallyWire, scene: &SceneSize, wanted: Wanted, lines: u64) -> Res
         counts,
         kernel_by_patch,
     })
+}
+
+/// The escapes' per-patch sums of a tally ([`PatchKernelSums::environment_log2_kernel`]): present, one
+/// entry per patch, exactly when the run gathers them; no patch with more of them than its escapes; and
+/// as many in all as the escapes that entered the environment's sum of eq. (27) (every segment to the
+/// environment that is no miss).
+fn check_environment_sums(
+    k: &PatchKernelSums,
+    w: &TallyWire,
+    escapes_by_patch: &[u64],
+    wanted: Wanted,
+) -> Result<(), String> {
+    let listed = !k.environment_log2_kernel.is_empty() || !k.environment_ends.is_empty();
+    if !wanted.environment {
+        return match listed {
+            true => Err("per-patch sums of escapes in a run that keeps none".into()),
+            false => Ok(()),
+        };
+    }
+    let patches = escapes_by_patch.len();
+    if k.environment_log2_kernel.len() != patches || k.environment_ends.len() != patches {
+        return Err(format!(
+            "per-patch sums of escapes for {} patches, the scene has {patches}",
+            k.environment_log2_kernel
+                .len()
+                .max(k.environment_ends.len())
+        ));
+    }
+    if let Some(i) = (0..patches).find(|&i| k.environment_ends[i] > escapes_by_patch[i]) {
+        return Err(format!(
+            "per-patch sums of escapes over {} escapes of patch {i}, which has {}",
+            k.environment_ends[i], escapes_by_patch[i]
+        ));
+    }
+    let ends = k
+        .environment_ends
+        .iter()
+        .map(|&e| u128::from(e))
+        .sum::<u128>();
+    let c = &w.counters;
+    if ends + u128::from(c.misses) != u128::from(c.env_pairs) {
+        return Err(format!(
+            "per-patch sums of escapes over {ends} escapes, where {} segments to the environment \
+             and {} misses leave {} escapes",
+            c.env_pairs,
+            c.misses,
+            i128::from(c.env_pairs) - i128::from(c.misses)
+        ));
+    }
+    consistency::check_kernel_sums(
+        &k.environment_log2_kernel,
+        &k.environment_ends,
+        "per-patch sums of escapes",
+    )
 }
 
 /// What a state is checked against in its scene.
@@ -513,6 +577,7 @@ pub fn encode(identity: &RunIdentity, state: &RunState, seconds: f64) -> Vec<u8>
         discrete: parts.wanted.discrete,
         continuous: parts.wanted.continuous,
         per_patch: parts.wanted.per_patch,
+        per_patch_environment: parts.wanted.environment,
         done: parts
             .done
             .ranges()
@@ -680,11 +745,20 @@ fn state_of(w: Wire, scene: &SceneSize) -> Result<SavedRun, String> {
             w.identity.scene.patches, scene.patches
         ));
     }
+    if w.per_patch_environment && !(w.per_patch && spec.enclose) {
+        return Err(
+            "per-patch sums of escapes in a run without per-patch sums or --enclose".into(),
+        );
+    }
     let wanted = Wanted {
         discrete: w.discrete,
         continuous: w.continuous,
         per_patch: w.per_patch,
+        environment: w.per_patch_environment,
     };
+    // An enclosed run's state written before the escapes' sums were kept: its per-patch sums cannot
+    // give the enclosed scene's per-patch I_s^c, so it is read as a state without any.
+    let lacks_environment = spec.enclose && w.per_patch && !w.per_patch_environment;
     let done = consistency::done_batches(&w.done, plan)?;
     let lines = consistency::group_lines(plan, &done, w.groups.len());
     let groups = w
@@ -718,9 +792,13 @@ fn state_of(w: Wire, scene: &SceneSize) -> Result<SavedRun, String> {
         }
         (None, Some(b)) => return Err(format!("its partial last batch {b} is done but not kept")),
     };
+    let mut state = RunState::from_parts(plan, wanted, groups, done, tail);
+    if lacks_environment {
+        state.drop_per_patch();
+    }
     Ok(SavedRun {
         identity: w.identity,
-        state: RunState::from_parts(plan, wanted, groups, done, tail),
+        state,
         seconds: w.seconds,
     })
 }
@@ -926,12 +1004,16 @@ mod tests {
             values: vec![5, 6],
         };
         assert_eq!(repeated.entries(), None);
-        assert!(zeros(usize::MAX).is_none());
     }
 
     /// A run of `cfg` on `@cube:3`, cast at once, its scene and state.
     fn cube_run(cfg: &RunSpec) -> (Scene, RunState) {
-        let scene = crate::scenes::load("@cube:3").unwrap();
+        run_of("@cube:3", cfg)
+    }
+
+    /// A run of `cfg` on the built-in scene `spec`, cast at once, its scene and state.
+    fn run_of(spec: &str, cfg: &RunSpec) -> (Scene, RunState) {
+        let scene = crate::scenes::load(spec).unwrap();
         let tracer = make_tracer(Backend::Rust, &scene, Query::Single).unwrap();
         let mut state = start(&scene, cfg).unwrap();
         cast(
@@ -1112,5 +1194,171 @@ mod tests {
         let identity = RunIdentity::new(scene_ref, sobol.clone(), None, tracing);
         let read = decode("s.scx", &encode(&identity, &state, 1.0)).unwrap();
         assert_eq!(read.identity().spec, sobol);
+    }
+
+    /// The state of an enclosed run of the open `@cornell-open:2` with per-patch sums, its scene, its
+    /// identity and its CBOR document.
+    fn enclosed_state() -> (Scene, RunState, RunIdentity, ciborium::Value) {
+        let cfg = RunSpec {
+            per_patch: true,
+            enclose: true,
+            ..RunSpec::new(30_000, 4)
+        };
+        let (scene, state) = run_of("@cornell-open:2", &cfg);
+        let identity = RunIdentity::new(
+            SceneRef::of("@cornell-open:2", &SceneOptions::default(), &scene),
+            cfg,
+            None,
+            Tracing {
+                backend: Backend::Rust,
+                query: Query::Single,
+            },
+        );
+        let bytes = encode(&identity, &state, 1.0);
+        let doc = ciborium::from_reader(&bytes[HEADER..]).unwrap();
+        (scene, state, identity, doc)
+    }
+
+    /// The tallies of a state's CBOR document (the groups' and the partial last batch's), as maps.
+    fn wire_tallies(
+        doc: &mut ciborium::Value,
+    ) -> Vec<&mut Vec<(ciborium::Value, ciborium::Value)>> {
+        let mut out = Vec::new();
+        for (k, v) in doc.as_map_mut().unwrap().iter_mut() {
+            let tallies = match k.as_text() {
+                Some("groups") => v.as_array_mut().unwrap(),
+                Some("tail") => match v.as_array_mut() {
+                    Some(pair) => &mut pair[1..],
+                    None => continue,
+                },
+                _ => continue,
+            };
+            out.extend(tallies.iter_mut().filter_map(|t| t.as_map_mut()));
+        }
+        out
+    }
+
+    /// A tally's stored per-patch sums (`kernel_by_patch`), as a map.
+    fn kernel_map(
+        tally: &mut [(ciborium::Value, ciborium::Value)],
+    ) -> &mut Vec<(ciborium::Value, ciborium::Value)> {
+        let (_, v) = tally
+            .iter_mut()
+            .find(|(k, _)| k.as_text() == Some("kernel_by_patch"))
+            .unwrap();
+        v.as_map_mut().unwrap()
+    }
+
+    fn decode_doc(doc: &ciborium::Value, scene: &Scene) -> Result<SavedRun, PersistError> {
+        let mut payload = Vec::new();
+        ciborium::into_writer(doc, &mut payload).unwrap();
+        decode("e.scx", &framed(&payload))?.into_run(scene)
+    }
+
+    /// The escapes' per-patch sums of an enclosed run (`--enclose`) survive a save to the last bit; a
+    /// run not enclosed writes none, nor the flag saying it has them (its state is written as before).
+    #[test]
+    fn enclosed_per_patch_sums_round_trip() {
+        let (scene, state, identity, doc) = enclosed_state();
+        assert!(state.wanted().environment);
+        let back = decode("e.scx", &encode(&identity, &state, 1.0))
+            .unwrap()
+            .into_run(&scene)
+            .unwrap()
+            .state;
+        assert_eq!(back.wanted(), state.wanted());
+        let (a, b) = (state.finish(&scene), back.finish(&scene));
+        let k = a.total.kernel_by_patch.as_ref().unwrap();
+        assert!(k.has_environment() && k.environment_ends.iter().sum::<u64>() > 0);
+        assert_eq!(a.total.kernel_by_patch, b.total.kernel_by_patch);
+        let keys = |doc: &ciborium::Value| -> Vec<String> {
+            let map = doc.as_map().unwrap();
+            map.iter()
+                .filter_map(|(k, _)| k.as_text().map(String::from))
+                .collect()
+        };
+        assert!(keys(&doc).contains(&"per_patch_environment".to_string()));
+
+        let cfg = RunSpec {
+            per_patch: true,
+            ..RunSpec::new(30_000, 4)
+        };
+        let (plain_scene, plain) = run_of("@cornell-open:2", &cfg);
+        assert!(!plain.wanted().environment);
+        let identity = RunIdentity {
+            spec: cfg,
+            ..identity
+        };
+        let bytes = encode(&identity, &plain, 1.0);
+        let mut doc: ciborium::Value = ciborium::from_reader(&bytes[HEADER..]).unwrap();
+        assert!(!keys(&doc).contains(&"per_patch_environment".to_string()));
+        for t in wire_tallies(&mut doc) {
+            let stored: Vec<String> = kernel_map(t)
+                .iter()
+                .filter_map(|(k, _)| k.as_text().map(String::from))
+                .collect();
+            assert_eq!(stored, ["log2_kernel", "ends"]);
+        }
+        let back = decode_doc(&doc, &plain_scene).unwrap();
+        assert_eq!(back.state.wanted(), plain.wanted());
+    }
+
+    /// An enclosed run's state written before the escapes' sums were kept (no flag, no lists) loads as a
+    /// state without per-patch sums; escapes' sums that their counters cannot give, or that a run
+    /// without them holds, are refused.
+    #[test]
+    fn enclosed_states_without_or_with_wrong_escape_sums() {
+        let (scene, state, _, doc) = enclosed_state();
+        let strip_lists = |doc: &mut ciborium::Value| {
+            for t in wire_tallies(doc) {
+                kernel_map(t)
+                    .retain(|(k, _)| !k.as_text().is_some_and(|k| k.starts_with("environment_")));
+            }
+        };
+        let mut old = doc.clone();
+        old.as_map_mut()
+            .unwrap()
+            .retain(|(k, _)| k.as_text() != Some("per_patch_environment"));
+        strip_lists(&mut old);
+        let read = decode_doc(&old, &scene).unwrap();
+        assert!(!read.state.wanted().per_patch && !read.state.wanted().environment);
+        let (a, b) = (state.finish(&scene), read.state.finish(&scene));
+        assert_eq!(a.total.counters, b.total.counters);
+        assert!(b.total.kernel_by_patch.is_none());
+
+        // The flag without the lists, and the lists without the flag.
+        let mut no_lists = doc.clone();
+        strip_lists(&mut no_lists);
+        let message = decode_doc(&no_lists, &scene).unwrap_err().to_string();
+        assert!(
+            message.contains("sums of escapes for 0 patches"),
+            "{message}"
+        );
+        let mut no_flag = doc.clone();
+        no_flag
+            .as_map_mut()
+            .unwrap()
+            .retain(|(k, _)| k.as_text() != Some("per_patch_environment"));
+        let message = decode_doc(&no_flag, &scene).unwrap_err().to_string();
+        assert!(
+            message.contains("escapes in a run that keeps none"),
+            "{message}"
+        );
+
+        // One more escape summed for a patch than the run's counters give.
+        let mut forged = doc.clone();
+        let tally = wire_tallies(&mut forged).into_iter().next().unwrap();
+        let ends = kernel_map(tally)
+            .iter_mut()
+            .find(|(k, _)| k.as_text() == Some("environment_ends"))
+            .unwrap();
+        let first = &mut ends.1.as_array_mut().unwrap()[0];
+        let n = u64::try_from(first.as_integer().unwrap()).unwrap();
+        *first = ciborium::Value::Integer((n + 1).into());
+        let message = decode_doc(&forged, &scene).unwrap_err().to_string();
+        assert!(
+            message.contains("inconsistent") && message.contains("escapes"),
+            "{message}"
+        );
     }
 }

@@ -87,8 +87,9 @@ pub struct RunSpec {
     /// How the radiosity system is solved.
     pub solve: SolveOptions,
     /// Also share the measures out among the patches (the per-patch results); gathers eq. (27)'s terms
-    /// per patch, which costs nothing when left off. Not with `enclose` on an open scene. Parts of one
-    /// run may differ: their merge keeps the per-patch sums only when every part has them.
+    /// per patch, which costs nothing when left off. With `enclose` on an open scene, the enclosed
+    /// scene's, the environment's row among them (gathering the terms of each patch's escapes too).
+    /// Parts of one run may differ: their merge keeps the per-patch sums only when every part has them.
     pub per_patch: bool,
 }
 

@@ -206,7 +206,8 @@ impl RunState {
     }
 
     /// Adds the state of another part of the same run (a shard): the groups' tallies and the batches.
-    /// The result keeps the per-patch sums of eq. (27) only when both parts have them.
+    /// The result keeps the per-patch sums of eq. (27), and the escapes' among them, only when both
+    /// parts have them.
     pub fn absorb(&mut self, other: RunState) -> Result<(), MergeError> {
         if other.plan != self.plan || other.groups.len() != self.groups.len() {
             return Err(MergeError::Mismatch(format!(
@@ -248,17 +249,36 @@ impl RunState {
         // leaves the whole without them: sums over only some of the lines would be silently wrong.
         if !(self.wanted.per_patch && other.wanted.per_patch) {
             self.drop_per_patch();
+        } else if !(self.wanted.environment && other.wanted.environment) {
+            self.drop_environment();
         }
         Ok(())
     }
 
     /// Forgets the per-patch sums of eq. (27), in every group and the partial last batch.
-    fn drop_per_patch(&mut self) {
+    pub(super) fn drop_per_patch(&mut self) {
         self.wanted.per_patch = false;
-        let tail = self.tail.as_mut().map(|(_, t)| t);
-        for t in self.groups.iter_mut().flatten().chain(tail) {
+        self.wanted.environment = false;
+        for t in self.tallies_mut() {
             t.kernel_by_patch = None;
         }
+    }
+
+    /// Forgets the escapes' per-patch sums of eq. (27) (`--enclose`), keeping the pairs'.
+    fn drop_environment(&mut self) {
+        self.wanted.environment = false;
+        for t in self.tallies_mut() {
+            if let Some(k) = &mut t.kernel_by_patch {
+                k.environment_log2_kernel.clear();
+                k.environment_ends.clear();
+            }
+        }
+    }
+
+    /// Every tally of the state: the groups' and the partial last batch's.
+    fn tallies_mut(&mut self) -> impl Iterator<Item = &mut Tally> {
+        let tail = self.tail.as_mut().map(|(_, t)| t);
+        self.groups.iter_mut().flatten().chain(tail)
     }
 
     /// The state of the same run extended to the longer plan `plan` (resuming to more lines): the
@@ -287,9 +307,17 @@ impl RunState {
             }
         }
         let groups: Vec<Tally> = self.groups.into_iter().flatten().collect();
-        // The counts are integers and the sums exact: added in any order.
-        let sums = groups.iter().map(Tally::without_counts).collect();
-        let mut total = merge_tree(sums).unwrap_or_else(|| Tally::empty(scene, self.wanted));
+        // The counts are integers and the sums exact: added in any order. Each thread adds copies of its
+        // groups (without their pair counts) into one, rather than all of them copied at once: on a
+        // large mesh each copy holds a list per patch.
+        let mut total = groups
+            .par_iter()
+            .map(Tally::without_counts)
+            .reduce_with(|mut a, b| {
+                a.merge(&b);
+                a
+            })
+            .unwrap_or_else(|| Tally::empty(scene, self.wanted));
         let counts: Vec<&PairCounts> = groups.iter().filter_map(|t| t.counts.as_ref()).collect();
         total.counts = PairCounts::sum_of(&counts);
         FinishedRun { total, groups }
@@ -309,17 +337,4 @@ pub struct StateParts<'a> {
     pub done: &'a BatchSet,
     /// The partial last batch's tally, kept apart.
     pub tail: Option<&'a (u64, Tally)>,
-}
-
-/// Merges tallies pairwise in a balanced binary tree, the two halves in parallel; every count is merged
-/// O(log G) times.
-fn merge_tree(mut tallies: Vec<Tally>) -> Option<Tally> {
-    if tallies.len() <= 1 {
-        return tallies.pop();
-    }
-    let right = tallies.split_off(tallies.len() / 2);
-    let (left, right) = rayon::join(|| merge_tree(tallies), || merge_tree(right));
-    let (mut left, right) = (left?, right?);
-    left.merge(&right);
-    Some(left)
 }

@@ -40,6 +40,13 @@ pub(crate) fn escape(scene: &Scene, line: &Line, patch: u32, at_start: bool) -> 
     (cos.abs() * cos_sphere, distance)
 }
 
+/// `(cos cos, d)` of a line that met nothing, a chord of the environment sphere of radius `radius` seen
+/// as a pair of the environment with itself: whatever the chord, cos cos / d^2 = 1 / (4 R^2) (module
+/// documentation), so it is taken as the diameter's.
+pub(crate) fn miss(radius: f64) -> (f64, f64) {
+    (1.0, 2.0 * radius)
+}
+
 /// Where the line enters and leaves the sphere of radius `r` about the origin, and the cosine between
 /// the line and the sphere's normal there (the same at both ends).
 fn sphere_chord(l: &LineF64, r: f64) -> (f64, f64, f64) {

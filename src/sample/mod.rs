@@ -15,6 +15,7 @@ pub mod kernel_sums;
 pub mod lines;
 mod order;
 pub mod pairs;
+pub mod patch_counts;
 pub mod sobol;
 pub mod sparse;
 pub mod tally;

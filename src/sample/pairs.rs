@@ -154,32 +154,30 @@ impl PatchPlanes {
     /// (256 KiB, `CACHED_BYTES`) and at most a quarter of them are distinct. Otherwise the index
     /// would only add a dependent read to every crossing.
     pub fn of(scene: &Scene) -> Self {
-        let every: Vec<[f64; 4]> = scene
-            .patches
-            .iter()
-            .map(|p| [p.normal.x, p.normal.y, p.normal.z, p.offset])
-            .collect();
-        if std::mem::size_of_val(every.as_slice()) <= Self::CACHED_BYTES {
-            return PatchPlanes {
-                planes: every,
-                index: Vec::new(),
-            };
+        let plane = |p: &crate::scene::Patch| [p.normal.x, p.normal.y, p.normal.z, p.offset];
+        let every = || PatchPlanes {
+            planes: scene.patches.iter().map(plane).collect(),
+            index: Vec::new(),
+        };
+        let n = scene.patch_count();
+        if n * std::mem::size_of::<[f64; 4]>() <= Self::CACHED_BYTES {
+            return every();
         }
+        // The distinct planes are looked for before the full table is made, which is made only when they
+        // are too many: a large mesh never holds both (its table alone is 32 bytes a patch).
         let mut seen: std::collections::HashMap<[u64; 4], u32> = std::collections::HashMap::new();
         let mut planes = Vec::new();
-        let mut index = Vec::with_capacity(every.len());
-        for plane in &every {
+        let mut index = Vec::with_capacity(n);
+        for p in &scene.patches {
             let next = planes.len() as u32;
-            let at = *seen.entry(plane.map(f64::to_bits)).or_insert(next);
+            let at = *seen.entry(plane(p).map(f64::to_bits)).or_insert(next);
             if at == next {
-                planes.push(*plane);
+                planes.push(plane(p));
             }
             index.push(at);
-            if planes.len() > every.len() / 4 {
-                return PatchPlanes {
-                    planes: every,
-                    index: Vec::new(),
-                };
+            if planes.len() > n / 4 {
+                drop((seen, planes, index));
+                return every();
             }
         }
         PatchPlanes { planes, index }

@@ -13,6 +13,7 @@ use super::exact::ExactSum;
 use super::kernel::Log2Sum;
 use super::kernel_sums::PatchKernelSums;
 use super::pairs::{PatchPlanes, Segment};
+use super::patch_counts::PatchCounts;
 use crate::scene::Scene;
 use crate::trace::{Line, LineHits};
 
@@ -26,6 +27,21 @@ pub struct Wanted {
     /// Eq. (27)'s terms summed per patch ([`PatchKernelSums`]) for the per-patch results; needs
     /// `discrete` (the pair keys say which patches a term belongs to).
     pub per_patch: bool,
+    /// With `per_patch`, the terms of each patch's escapes summed too
+    /// ([`PatchKernelSums::environment_log2_kernel`]), for the per-patch results of an enclosed scene
+    /// (`--enclose`, [`super::environment`]).
+    pub environment: bool,
+}
+
+impl Wanted {
+    /// Empty per-patch sums for `patches` patches, when they are wanted.
+    fn kernel_sums(self, patches: usize) -> Option<PatchKernelSums> {
+        match (self.per_patch, self.environment) {
+            (false, _) => None,
+            (true, false) => Some(PatchKernelSums::new(patches)),
+            (true, true) => Some(PatchKernelSums::with_environment(patches)),
+        }
+    }
 }
 
 /// The counters and sums of a set of lines: every number a run adds up but the pair counts and the
@@ -205,11 +221,11 @@ pub struct Tally {
     pub counters: Counters,
     /// Per object of the scene ([`crate::scene::Scene::objects`]): how its sides were met.
     pub orientation: Vec<ObjectSides>,
-    /// Escapes per patch (empty unless the discrete measures are wanted).
-    pub escapes_by_patch: Vec<u64>,
+    /// Escapes per patch (none kept unless the discrete measures are wanted).
+    pub escapes_by_patch: PatchCounts,
     /// Segments from each patch's front side to a back side (absorbed), when the discrete measures are
-    /// wanted; empty as long as there are none (most scenes have none).
-    pub absorbed_by_patch: Vec<u64>,
+    /// wanted; none kept as long as there are none (most scenes have none).
+    pub absorbed_by_patch: PatchCounts,
     /// Pair counts (only when the discrete measures are wanted).
     pub counts: Option<PairCounts>,
     /// Eq. (27)'s terms summed per patch (only when [`Wanted::per_patch`]).
@@ -223,17 +239,15 @@ impl Tally {
             counters: Counters::default(),
             orientation: vec![ObjectSides::default(); scene.objects.len()],
             escapes_by_patch: if wanted.discrete {
-                vec![0; scene.patch_count()]
+                PatchCounts::zeros(scene.patch_count())
             } else {
-                Vec::new()
+                PatchCounts::default()
             },
-            absorbed_by_patch: Vec::new(),
+            absorbed_by_patch: PatchCounts::default(),
             counts: wanted
                 .discrete
                 .then(|| PairCounts::new(scene.patch_count())),
-            kernel_by_patch: wanted
-                .per_patch
-                .then(|| PatchKernelSums::new(scene.patch_count())),
+            kernel_by_patch: wanted.kernel_sums(scene.patch_count()),
         }
     }
 
@@ -253,14 +267,8 @@ impl Tally {
     pub fn merge(&mut self, other: &Tally) {
         self.counters.add(&other.counters);
         add_sides(&mut self.orientation, &other.orientation);
-        for (a, b) in self
-            .escapes_by_patch
-            .iter_mut()
-            .zip(&other.escapes_by_patch)
-        {
-            *a += b;
-        }
-        add_counts(&mut self.absorbed_by_patch, &other.absorbed_by_patch);
+        self.escapes_by_patch.add(&other.escapes_by_patch);
+        self.absorbed_by_patch.add(&other.absorbed_by_patch);
         if let (Some(a), Some(b)) = (&mut self.counts, &other.counts) {
             a.merge(b);
         }
@@ -278,21 +286,8 @@ impl Tally {
         Tally {
             counters: self.counters,
             orientation: self.orientation.clone(),
-            escapes_by_patch: self
-                .escapes_by_patch
-                .iter()
-                .zip(&part.escapes_by_patch)
-                .map(|(t, p)| t - p)
-                .collect(),
-            absorbed_by_patch: if part.absorbed_by_patch.is_empty() {
-                self.absorbed_by_patch.clone()
-            } else {
-                self.absorbed_by_patch
-                    .iter()
-                    .zip(&part.absorbed_by_patch)
-                    .map(|(t, p)| t - p)
-                    .collect()
-            },
+            escapes_by_patch: self.escapes_by_patch.minus(&part.escapes_by_patch),
+            absorbed_by_patch: self.absorbed_by_patch.minus(&part.absorbed_by_patch),
             counts: match (&self.counts, &part.counts) {
                 (Some(t), Some(p)) => Some(t.without(p)),
                 _ => None,
@@ -364,34 +359,30 @@ impl Tally {
         let mut tally = Tally {
             counters: Counters::default(),
             orientation: vec![ObjectSides::default(); scene.objects.len()],
-            escapes_by_patch: if wanted.discrete {
-                vec![0; scene.patch_count()]
-            } else {
-                Vec::new()
-            },
-            absorbed_by_patch: Vec::new(),
+            escapes_by_patch: PatchCounts::default(),
+            absorbed_by_patch: PatchCounts::default(),
             counts: None,
-            kernel_by_patch: wanted
-                .per_patch
-                .then(|| PatchKernelSums::new(scene.patch_count())),
+            kernel_by_patch: wanted.kernel_sums(scene.patch_count()),
         };
         let mut batch_keys = Vec::with_capacity(batches.len());
+        let (mut escapes, mut absorbed) = (Vec::new(), Vec::new());
         for b in batches {
             tally.counters.add(&b.counters);
             b.sides.add_to(&mut tally.orientation);
             if let Some(k) = &mut tally.kernel_by_patch {
                 k.add_pairs(&b.pair_keys, &b.pair_terms);
+                k.add_escapes(&b.escape_patches, &b.escape_terms);
             }
-            for &p in &b.escape_patches {
-                tally.escapes_by_patch[p as usize] += 1;
-            }
-            if !b.absorbed_patches.is_empty() && tally.absorbed_by_patch.is_empty() {
-                tally.absorbed_by_patch = vec![0; scene.patch_count()];
-            }
-            for &p in &b.absorbed_patches {
-                tally.absorbed_by_patch[p as usize] += 1;
-            }
+            escapes.extend_from_slice(&b.escape_patches);
+            absorbed.extend_from_slice(&b.absorbed_patches);
             batch_keys.push(b.pair_keys);
+        }
+        let n = scene.patch_count();
+        if wanted.discrete {
+            tally.escapes_by_patch = PatchCounts::of_patches(n, escapes);
+        }
+        if !absorbed.is_empty() {
+            tally.absorbed_by_patch = PatchCounts::of_patches(n, absorbed);
         }
         (tally, batch_keys)
     }
@@ -401,11 +392,11 @@ impl Tally {
     /// `F_ij = N_ij / N_i` is the geometric form factor whatever else the row loses.
     pub fn lost_by_patch(&self) -> std::borrow::Cow<'_, [u64]> {
         if self.absorbed_by_patch.is_empty() {
-            return std::borrow::Cow::Borrowed(&self.escapes_by_patch);
+            return self.escapes_by_patch.dense();
         }
         let mut lost = self.escapes_by_patch.clone();
-        add_counts(&mut lost, &self.absorbed_by_patch);
-        std::borrow::Cow::Owned(lost)
+        lost.add(&self.absorbed_by_patch);
+        std::borrow::Cow::Owned(lost.dense().into_owned())
     }
 
     /// The environment patch's area in tracing space ([`environment::area`]).
@@ -416,36 +407,38 @@ impl Tally {
 
     /// The tally of the enclosed scene, whose patch `n_p` is the environment, and the patch areas with the
     /// environment's last ([`super::environment`]). Needs the discrete counts for the pair counts
-    /// (without them only eq. (27) is enclosed).
+    /// (without them only eq. (27) is enclosed), and the environment's per-patch sums of eq. (27)
+    /// ([`Wanted::environment`]) for the enclosed per-patch sums (without them there are none).
     pub fn enclosed(&self, scene: &Scene) -> (Tally, Vec<f64>) {
         let n = scene.patch_count();
-        let env = n as u32;
         let mut areas: Vec<f64> = scene.patches.iter().map(|p| p.area).collect();
         let a_scene: f64 = areas.iter().sum();
         let a_env = self.environment_area(scene);
         areas.push(a_env);
 
         let c = &self.counters;
-        let mut t = self.clone();
-        t.counts = self.counts.as_ref().map(|counts| {
-            let mut entries: Vec<(u64, u64)> = Vec::new();
-            counts.for_each(|i, j, k| entries.push((pair_key(i, j), k)));
-            for (i, &e) in self.escapes_by_patch.iter().enumerate() {
-                if e > 0 {
-                    entries.push((pair_key(i as u32, env), e));
-                }
-            }
-            if c.misses > 0 {
-                entries.push((pair_key(env, env), c.misses));
-            }
-            PairCounts::from_entries(n + 1, entries)
-        });
-        t.escapes_by_patch = vec![0; if self.counts.is_some() { n + 1 } else { 0 }];
+        // The counts are rebuilt, not cloned: a large scene's are most of the tally.
+        let mut t = Tally {
+            counts: self.enclosed_counts(n),
+            ..self.without_counts()
+        };
+        t.escapes_by_patch = if self.counts.is_some() {
+            PatchCounts::zeros(n + 1)
+        } else {
+            PatchCounts::default()
+        };
         if !t.absorbed_by_patch.is_empty() {
-            t.absorbed_by_patch.push(0);
+            let mut absorbed = Vec::new();
+            self.absorbed_by_patch
+                .for_each_counted(|i, k| absorbed.push((i, k)));
+            t.absorbed_by_patch = PatchCounts::of_entries(n + 1, absorbed);
         }
         t.counters.pairs += c.escapes + c.misses;
         t.counters.escapes = 0;
+        t.kernel_by_patch = self
+            .kernel_by_patch
+            .as_ref()
+            .and_then(|k| k.enclosed(c.misses, scene.bounding_radius()));
 
         // Eq. (27) with A_T' = A_T + A_env: take the scene's log2(A_T / pi) back out of each term.
         let log2_over_pi = |a: f64| (a / std::f64::consts::PI).log2();
@@ -457,18 +450,48 @@ impl Tally {
         );
         (t, areas)
     }
-}
 
-/// Adds per-patch counts `b` into `a`, which is empty until something is counted (then as long as `b`).
-fn add_counts(a: &mut Vec<u64>, b: &[u64]) {
-    if b.is_empty() {
-        return;
+    /// The pair counts of the enclosed scene of `n` patches (the tally's scene), whose patch `n` is the
+    /// environment ([`Tally::enclosed`]): each patch's escapes are its pairs with the environment, each
+    /// line that met nothing a pair of the environment with itself. `None` without pair counts.
+    pub fn enclosed_counts(&self, n: usize) -> Option<PairCounts> {
+        let counts = self.counts.as_ref()?;
+        let env = n as u32;
+        let mut entries: Vec<(u64, u64)> = Vec::with_capacity(counts.distinct_pairs() + n + 1);
+        // In pair-key order (the smaller patch first, then the larger), so that the counts are built
+        // without sorting: (i, env) follows every pair (i, j) of the scene.
+        let mut next_row = 0u32;
+        let escapes = self.escapes_by_patch.dense();
+        let mut escapes_up_to = |row: u32, entries: &mut Vec<(u64, u64)>| {
+            for i in next_row..row {
+                let e = escapes.get(i as usize).copied().unwrap_or(0);
+                if e > 0 {
+                    entries.push((pair_key(i, env), e));
+                }
+            }
+            next_row = next_row.max(row);
+        };
+        counts.for_each(|i, j, k| {
+            escapes_up_to(i, &mut entries);
+            entries.push((pair_key(i, j), k));
+        });
+        escapes_up_to(env, &mut entries);
+        if self.counters.misses > 0 {
+            entries.push((pair_key(env, env), self.counters.misses));
+        }
+        debug_assert!(entries.windows(2).all(|w| w[0].0 < w[1].0));
+        Some(PairCounts::from_entries(n + 1, entries))
     }
-    if a.is_empty() {
-        a.resize(b.len(), 0);
-    }
-    for (x, y) in a.iter_mut().zip(b) {
-        *x += y;
+
+    /// Per patch of the enclosed scene of `n` patches, the segments leaving its front side that arrive
+    /// at no front side: only those absorbed at back sides (the escapes are pairs with the environment,
+    /// which loses nothing); empty when there are none.
+    pub fn enclosed_lost(&self, n: usize) -> Vec<u64> {
+        let mut lost = self.absorbed_by_patch.dense().into_owned();
+        if !lost.is_empty() {
+            lost.resize(n + 1, 0);
+        }
+        lost
     }
 }
 
@@ -488,6 +511,9 @@ pub struct BatchTally {
     /// Beside each pair key, its log kernel ([`PatchKernelSums::pair_term`]), when
     /// [`Wanted::per_patch`].
     pub pair_terms: Vec<f64>,
+    /// Beside each escape patch, the log kernel of its segment to the environment sphere, when
+    /// [`Wanted::environment`].
+    pub escape_terms: Vec<f64>,
 }
 
 /// Pairs the canonical hits of a batch of lines and tallies the segments (paper sec. 3.2.2): the hot
@@ -572,16 +598,18 @@ fn tally_batch(prepared: &LineTally, lines: &[Line], hits: &LineHits) -> BatchTa
         ..BatchTally::default()
     };
     let objects = &prepared.objects;
+    let (miss_cos, miss_chord) = environment::miss(scene.bounding_radius());
     let c = &mut t.counters;
     for (k, line) in lines.iter().enumerate() {
         let line_hits = hits.of_line(k);
         if line_hits.is_empty() {
             c.misses += 1;
-            env_sum.add(1.0, 2.0);
+            env_sum.add(miss_cos, miss_chord);
             continue;
         }
         let sides = &mut t.sides;
         let pair_terms = &mut t.pair_terms;
+        let escape_terms = &mut t.escape_terms;
         let ends = prepared
             .planes
             .segments_and_ends(scene, line, line_hits, |s| match s {
@@ -611,6 +639,9 @@ fn tally_batch(prepared: &LineTally, lines: &[Line], hits: &LineHits) -> BatchTa
                     sides.count(objects.object(patch), 2);
                     let (cos_product, distance) = environment::escape(scene, line, patch, at_start);
                     env_sum.add(cos_product, distance);
+                    if wanted.environment {
+                        escape_terms.push(PatchKernelSums::pair_term(cos_product, distance));
+                    }
                 }
                 Segment::BackSeen { patch, front } => {
                     c.unpaired += 1;

@@ -86,10 +86,12 @@ pub(crate) fn read_bytes(
     for (element, kind, items) in sources {
         for (k, item) in items.iter().enumerate() {
             let at = |message: String| file_error(format!("{element} {k}: {message}"));
+            let mut inline = [0; INLINE_INDICES];
             let indices = item
                 .indices
-                .as_deref()
-                .ok_or_else(|| at("no list `vertex_indices`".into()))?;
+                .as_ref()
+                .ok_or_else(|| at("no list `vertex_indices`".into()))?
+                .values(&mut inline);
             let material = materials.of(&mut b, item);
             match kind {
                 Kind::Faces => {
@@ -124,7 +126,7 @@ struct Item {
     xyz_given: u8,
     /// The first of [`INDEX_LISTS`] given (its rank there) and its values when it is a list of integers.
     indices_rank: u8,
-    indices: Option<Box<[i64]>>,
+    indices: Option<IndexList>,
     /// `red`, `green`, `blue` as reflectance (see [`face_colour`]), when any channel is given.
     colour: Option<Box<[Option<f64>; 3]>>,
 }
@@ -154,7 +156,7 @@ impl PropertyAccess for Item {
             let rank = rank as u8;
             if rank <= self.indices_rank {
                 self.indices_rank = rank;
-                self.indices = index_list(&property).map(Vec::into_boxed_slice);
+                self.indices = index_list(&property);
             }
         } else if let Some(channel) = ["red", "green", "blue"].iter().position(|&c| c == name) {
             let colour = self.colour.get_or_insert_with(|| Box::new([None; 3]));
@@ -281,16 +283,64 @@ fn number(p: &Property) -> Option<f64> {
 }
 
 /// A list property of vertex indices.
-fn index_list(p: &Property) -> Option<Vec<i64>> {
+fn index_list(p: &Property) -> Option<IndexList> {
     Some(match p {
-        Property::ListChar(v) => v.iter().map(|&x| x.into()).collect(),
-        Property::ListUChar(v) => v.iter().map(|&x| x.into()).collect(),
-        Property::ListShort(v) => v.iter().map(|&x| x.into()).collect(),
-        Property::ListUShort(v) => v.iter().map(|&x| x.into()).collect(),
-        Property::ListInt(v) => v.iter().map(|&x| x.into()).collect(),
-        Property::ListUInt(v) => v.iter().map(|&x| x.into()).collect(),
+        Property::ListChar(v) => IndexList::of(v.iter().map(|&x| x.into())),
+        Property::ListUChar(v) => IndexList::of(v.iter().map(|&x| x.into())),
+        Property::ListShort(v) => IndexList::of(v.iter().map(|&x| x.into())),
+        Property::ListUShort(v) => IndexList::of(v.iter().map(|&x| x.into())),
+        Property::ListInt(v) => IndexList::of(v.iter().map(|&x| x.into())),
+        Property::ListUInt(v) => IndexList::of(v.iter().map(|&x| x.into())),
         _ => return None,
     })
+}
+
+/// Index lists of at most this many non-negative values are kept in their item.
+const INLINE_INDICES: usize = 4;
+
+/// A face's (or strip's) vertex indices as read. Triangles and quads, the faces of large meshes, are
+/// kept in the item itself: a list of their own for each of millions of faces cost 32 bytes of a
+/// small-object allocation per face, memory that the allocator keeps for small objects once they are
+/// freed, where the BVH build that comes next needs it.
+enum IndexList {
+    /// `len` values, each within `0..2^32`.
+    Inline {
+        len: u8,
+        values: [u32; INLINE_INDICES],
+    },
+    /// Any other list.
+    Long(Box<[i64]>),
+}
+
+impl IndexList {
+    fn of(values: impl ExactSizeIterator<Item = i64> + Clone) -> Self {
+        let fits = |v: &i64| u32::try_from(*v).is_ok();
+        if values.len() <= INLINE_INDICES && values.clone().all(|v| fits(&v)) {
+            let mut inline = [0; INLINE_INDICES];
+            for (slot, v) in inline.iter_mut().zip(values.clone()) {
+                *slot = v as u32;
+            }
+            IndexList::Inline {
+                len: values.len() as u8,
+                values: inline,
+            }
+        } else {
+            IndexList::Long(values.collect())
+        }
+    }
+
+    /// The values, written into `inline` when they are kept inline.
+    fn values<'a>(&'a self, inline: &'a mut [i64; INLINE_INDICES]) -> &'a [i64] {
+        match self {
+            IndexList::Inline { len, values } => {
+                for (slot, &v) in inline.iter_mut().zip(values) {
+                    *slot = v.into();
+                }
+                &inline[..usize::from(*len)]
+            }
+            IndexList::Long(values) => values,
+        }
+    }
 }
 
 /// A face's colour as reflectance in [0, 1]: integer channels are 0-255, float channels 0-1.

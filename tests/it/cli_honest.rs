@@ -312,3 +312,50 @@ fn convergence_json_completions_man_and_help() {
         assert!(text.contains("Example"), "{sub}: {text}");
     }
 }
+
+/// The lines advice for a coverage of 0.99 says when it is only a lower bound, and the runs it advises
+/// bear it out: on `@labyrinth` at 1e5 lines the extrapolation has not settled (half the lines advise
+/// markedly fewer), and a run of the lines it advises indeed falls short of 0.99; on the icosphere
+/// `@sphere:2` it has settled, and 5% more lines than it advises reach 0.99.
+#[test]
+fn the_lines_advice_says_when_it_is_a_lower_bound() {
+    let advised = |scene: &str, lines: &str| {
+        let doc = json_run(&[scene, "--lines", lines]);
+        let s = &doc["sampling"];
+        let n = s["lines_for_coverage_0_99"].as_u64().unwrap();
+        (
+            s["lines_advice"].as_str().unwrap().to_string(),
+            n,
+            s.clone(),
+        )
+    };
+    let coverage_at = |scene: &str, lines: f64| {
+        let doc = json_run(&[scene, "--lines", &format!("{}", lines.ceil())]);
+        doc["sampling"]["coverage"].as_f64().unwrap()
+    };
+
+    let (advice, n, s) = advised("@labyrinth", "1e5");
+    assert_eq!(advice, "lower-bound", "{s}");
+    let half = s["lines_for_coverage_0_99_from_half"].as_u64().unwrap();
+    assert!(n as f64 > 1.25 * half as f64, "{s}");
+    let c = coverage_at("@labyrinth", n as f64);
+    assert!(
+        c < 0.99,
+        "@labyrinth at the {n} lines advised: coverage {c}"
+    );
+    let table = scx(&["analyze", "@labyrinth", "--lines", "1e5", "-q"]);
+    let text = String::from_utf8_lossy(&table.stdout);
+    assert!(
+        text.contains("an extrapolation that has not settled: it grew")
+            && text.contains("from half the lines, so more may be needed"),
+        "{text}"
+    );
+
+    let (advice, n, s) = advised("@sphere:2", "1e5");
+    assert_eq!(advice, "estimate", "{s}");
+    let c = coverage_at("@sphere:2", 1.05 * n as f64);
+    assert!(
+        c >= 0.99,
+        "@sphere:2 at 1.05 x the {n} lines advised: coverage {c}"
+    );
+}

@@ -266,19 +266,12 @@ fn per_patch_file_has_the_scenes_own_geometry() {
     );
 }
 
-/// Wrong kinds of file and --enclose are refused before any line is cast, with exit code 2.
+/// Wrong kinds of file are refused before any line is cast, with exit code 2.
 #[test]
 fn per_patch_files_are_checked_before_work() {
     for args in [
         &["analyze", "@cube:2", "--patches", "p.txt"][..],
         &["analyze", "@cube:2", "--form-factors", "f.json"],
-        &[
-            "analyze",
-            "@cornell-open",
-            "--enclose",
-            "--patches",
-            "p.csv",
-        ],
         &[
             "analyze",
             "@cube:2",
@@ -443,5 +436,162 @@ fn object_results_add_up_to_the_scene() {
             Some(num(row, "continuous_mutual_information_term"))
         );
         assert_eq!(json["segments"].as_f64(), Some(num(row, "segments")));
+    }
+}
+
+/// Runs `scx analyze` with `args` and the four per-patch files written into `dir` (`p.csv`, `ff.csv`,
+/// `ff.mtx`, `o.csv`), and returns its JSON report.
+fn run_with_all_files(dir: &std::path::Path, args: &[&str]) -> serde_json::Value {
+    let file = |name: &str| dir.join(name).to_str().unwrap().to_string();
+    let (p, ff, mtx, o) = (file("p.csv"), file("ff.csv"), file("ff.mtx"), file("o.csv"));
+    let mut all: Vec<&str> = args.to_vec();
+    all.extend([
+        "-q",
+        "--format",
+        "json",
+        "--patches",
+        &p,
+        "--form-factors",
+        &ff,
+        "--form-factors",
+        &mtx,
+        "--objects",
+        &o,
+    ]);
+    let out = scx(&all);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).unwrap()
+}
+
+/// `scx analyze @cornell-open --enclose` with every per-patch file: the environment is the last row of
+/// the patch table (id = the patch count, object and material `environment`, its counted area, no
+/// centroid nor normal, no radiosity) and of F (row and column `patches`); the area fractions sum to 1;
+/// the rows' H_s and I_s^c terms add up to the report's readings; every row of F sums to 1 in counts
+/// (N_ij over j, plus the segments absorbed at back sides, is N_i); reciprocity A_i F_ij = A_j F_ji
+/// holds within the errors with the environment's counted area. Both sides share N_ij, so what differs
+/// is N_i / A_i against N_j / A_j: the error is the Poisson error of each row's segments (relative
+/// 1 / sqrt(N_i)), and the pairs' deviations in it must look like chance (worst below 5, root mean
+/// square below 1.5). The objects, the environment's last, add up too.
+#[test]
+fn enclosed_files_have_the_environment_row_and_add_up() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let doc = run_with_all_files(
+        d,
+        &["analyze", "@cornell-open", "--lines", "1e6", "--enclose"],
+    );
+    let n = doc["patches"].as_u64().unwrap() as usize;
+    let (header, rows) = read_csv(&d.join("p.csv"));
+    assert_eq!(rows.len(), n + 1, "the environment's row");
+    let col = |name: &str| header.iter().position(|h| h == name).unwrap();
+    let num = |r: &[String], name: &str| r[col(name)].parse::<f64>().unwrap();
+    let env = &rows[n];
+    assert_eq!(
+        env[..3],
+        [n.to_string(), "environment".into(), "environment".into()]
+    );
+    for empty in ["centroid_x", "normal_z", "radiosity", "incoming_radiosity"] {
+        assert!(env[col(empty)].is_empty(), "{empty}: {env:?}");
+    }
+    // serde_json reads floats to within an ulp or so, not always to the bit.
+    let close = |x: f64, y: f64| (x - y).abs() <= 1e-10 * y.abs().max(1.0);
+    let env_area = doc["environment_area"]["value"].as_f64().unwrap();
+    assert!(close(num(env, "area"), env_area));
+    let sum = |f: &dyn Fn(&[String]) -> f64| rows.iter().map(|r| f(r)).sum::<f64>();
+    assert!(close(sum(&|r| num(r, "area_fraction")), 1.0));
+    let reading = |m: &str| doc["visibility"][m]["value"].as_f64().unwrap();
+    assert!(close(
+        sum(&|r| num(r, "area_fraction") * num(r, "row_entropy")),
+        reading("entropy")
+    ));
+    let isc = reading("continuous_mutual_information");
+    assert!(close(
+        sum(&|r| num(r, "continuous_mutual_information_term")),
+        isc
+    ));
+
+    // F: rows sum to 1 in counts; reciprocity with the counted areas.
+    let (_, ff) = read_csv(&d.join("ff.csv"));
+    let mut row_sum = vec![0u64; n + 1];
+    let mut entry = std::collections::HashMap::new();
+    let mut totals = vec![0u64; n + 1];
+    for e in &ff {
+        let (i, j): (usize, usize) = (e[0].parse().unwrap(), e[1].parse().unwrap());
+        let (n_ij, n_i): (u64, u64) = (e[2].parse().unwrap(), e[3].parse().unwrap());
+        row_sum[i] += n_ij;
+        totals[i] = n_i;
+        entry.insert(
+            (i, j),
+            (e[4].parse::<f64>().unwrap(), e[5].parse::<f64>().unwrap()),
+        );
+    }
+    for (i, r) in rows.iter().enumerate() {
+        let absorbed: u64 = r[col("absorbed")].parse().unwrap();
+        assert_eq!(row_sum[i] + absorbed, totals[i], "row {i}");
+        assert_eq!(totals[i].to_string(), r[col("segments")], "row {i}");
+    }
+    assert!(entry.keys().any(|&(i, j)| i == n && j == n), "the misses");
+    let area = |i: usize| num(&rows[i], "area");
+    let deviations: Vec<f64> = entry
+        .iter()
+        .filter(|((i, j), _)| i < j)
+        .map(|(&(i, j), &(f_ij, _))| {
+            let (x, y) = (area(i) * f_ij, area(j) * entry[&(j, i)].0);
+            (x - y) / (x * x / totals[i] as f64 + y * y / totals[j] as f64).sqrt()
+        })
+        .collect();
+    let worst = deviations.iter().fold(0.0f64, |m, z| m.max(z.abs()));
+    let rms = (deviations.iter().map(|z| z * z).sum::<f64>() / deviations.len() as f64).sqrt();
+    assert!(
+        worst < 5.0 && rms < 1.5,
+        "reciprocity off by up to {worst} standard errors (rms {rms})"
+    );
+    assert!(
+        entry.keys().filter(|&&(i, j)| i < j && j == n).count() > 20,
+        "pairs with the environment among them"
+    );
+    let mtx = std::fs::read_to_string(d.join("ff.mtx")).unwrap();
+    let size = mtx.lines().find(|l| !l.starts_with('%')).unwrap();
+    assert_eq!(size, format!("{} {} {}", n + 1, n + 1, ff.len()));
+
+    // The objects: the scene's, then the environment.
+    let (oh, objects) = read_csv(&d.join("o.csv"));
+    let ocol = |name: &str| oh.iter().position(|h| h == name).unwrap();
+    let last = objects.last().unwrap();
+    assert_eq!(last[0], "environment");
+    assert_eq!(last[ocol("area")], env[col("area")]);
+    let osum = |name: &str| {
+        objects
+            .iter()
+            .map(|o| o[ocol(name)].parse::<f64>().unwrap())
+            .sum::<f64>()
+    };
+    assert!(close(osum("area_fraction"), 1.0));
+    assert!(close(osum("continuous_mutual_information_term"), isc));
+    let json_objects = doc["objects"].as_array().unwrap();
+    assert_eq!(json_objects.len(), objects.len());
+    assert_eq!(json_objects.last().unwrap()["name"], "environment");
+}
+
+/// A closed scene has no environment: `--enclose` changes nothing, and every per-patch file is the
+/// same bytes as without it.
+#[test]
+fn enclose_leaves_the_files_of_a_closed_scene_alone() {
+    let (plain, enclosed) = (tempfile::tempdir().unwrap(), tempfile::tempdir().unwrap());
+    let args = ["analyze", "@cube:4", "--lines", "2e5", "--seed", "5"];
+    let a = run_with_all_files(plain.path(), &args);
+    let mut with = args.to_vec();
+    with.push("--enclose");
+    let b = run_with_all_files(enclosed.path(), &with);
+    assert_eq!(a["visibility"], b["visibility"]);
+    assert!(b["environment_area"].is_null());
+    for name in ["p.csv", "ff.csv", "ff.mtx", "o.csv"] {
+        let x = std::fs::read(plain.path().join(name)).unwrap();
+        let y = std::fs::read(enclosed.path().join(name)).unwrap();
+        assert!(!x.is_empty() && x == y, "{name} differs");
     }
 }

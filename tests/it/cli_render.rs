@@ -6,11 +6,23 @@ use scene_complexity::internals::scenes;
 
 /// A careful PLY reader for the files `scx render` writes, ASCII or binary little-endian: the header's
 /// elements and properties, then the vertices `(x, y, z, r, g, b)` and the faces
-/// `(indices, r, g, b, value)`.
+/// `(indices, r, g, b, value)`, the value `None` where the `valued` flag is 0 (its `value` then 0).
 #[derive(Debug, PartialEq)]
 struct Ply {
     vertices: Vec<([f64; 3], [u8; 3])>,
-    faces: Vec<(Vec<usize>, [u8; 3], f64)>,
+    faces: Vec<(Vec<usize>, [u8; 3], Option<f64>)>,
+}
+
+/// The value of a face from its `valued` flag and `value`; a face without one has the value 0.
+fn face_value(valued: u8, value: f64) -> Option<f64> {
+    match valued {
+        1 => Some(value),
+        0 => {
+            assert_eq!(value, 0.0, "no value is written as 0");
+            None
+        }
+        other => panic!("valued {other}"),
+    }
 }
 
 /// The header's format name and element counts, and the body's bytes.
@@ -51,6 +63,7 @@ fn read_header(bytes: &[u8]) -> (String, usize, usize, &[u8]) {
             "uchar red",
             "uchar green",
             "uchar blue",
+            "uchar valued",
             "double value"
         ]
     );
@@ -89,10 +102,11 @@ fn read_ascii(text: &str, n_vertices: usize, n_faces: usize) -> Ply {
     for _ in 0..n_faces {
         let w: Vec<&str> = lines.next().unwrap().split(' ').collect();
         let k: usize = w[0].parse().unwrap();
-        assert_eq!(w.len(), 1 + k + 4);
+        assert_eq!(w.len(), 1 + k + 5);
         let idx: Vec<usize> = w[1..=k].iter().map(|x| x.parse().unwrap()).collect();
         let c = [k + 1, k + 2, k + 3].map(|i| w[i].parse::<u8>().unwrap());
-        faces.push((idx, c, w[k + 4].parse::<f64>().unwrap()));
+        let value = face_value(w[k + 4].parse().unwrap(), w[k + 5].parse().unwrap());
+        faces.push((idx, c, value));
     }
     assert_eq!(lines.next(), None, "nothing after the faces");
     Ply { vertices, faces }
@@ -124,7 +138,9 @@ fn read_binary(mut body: &[u8], n_vertices: usize, n_faces: usize) -> Ply {
             let idx = (0..k)
                 .map(|_| i32::from_le_bytes(take(body, 4).try_into().unwrap()) as usize)
                 .collect();
-            (idx, rgb_of(body), f64_of(body))
+            let colour = rgb_of(body);
+            let valued = take(body, 1)[0];
+            (idx, colour, face_value(valued, f64_of(body)))
         })
         .collect();
     assert!(body.is_empty(), "nothing after the faces");
@@ -186,7 +202,8 @@ fn render_writes_a_png_and_a_ply_that_parse() {
             );
             assert_eq!(c, *colour, "patch {p}: vertex colours are the face's");
         }
-        assert!(*value >= 0.0, "patch {p}: radiosity {value}");
+        let value = value.expect("every patch of a closed room has a radiosity");
+        assert!(value >= 0.0, "patch {p}: radiosity {value}");
     }
 }
 
@@ -330,6 +347,41 @@ fn the_patches_mesh_is_binary_by_default_and_ascii_on_request() {
         bytes_b.len(),
         bytes_a.len()
     );
+}
+
+/// Patches without a value (@cube:30 at 2e4 lines leaves some with no line) are flagged `valued 0` in
+/// both formats, which hold the same numbers, and scx reads its own patches mesh back in both: the same
+/// patches, each of the scene's area.
+#[test]
+fn scx_reads_back_its_patches_mesh_in_both_formats() {
+    let dir = tempfile::tempdir().unwrap();
+    let (bin, text) = (dir.path().join("b.ply"), dir.path().join("a.ply"));
+    let (b, a) = (bin.to_str().unwrap(), text.to_str().unwrap());
+    render(dir.path(), "@cube:30", "2e4", &["--patches-mesh", b]);
+    let ascii = ["--patches-mesh", a, "--patches-mesh-format", "ascii"];
+    render(dir.path(), "@cube:30", "2e4", &ascii);
+    let (_, mesh_b) = read_ply(&std::fs::read(&bin).unwrap());
+    let (_, mesh_a) = read_ply(&std::fs::read(&text).unwrap());
+    assert_eq!(mesh_b, mesh_a, "the same mesh, colours, flags and values");
+    let unvalued = mesh_b.faces.iter().filter(|f| f.2.is_none()).count();
+    assert!(
+        (1..mesh_b.faces.len()).contains(&unvalued),
+        "{unvalued} patches without a value"
+    );
+    let scene = scenes::load("@cube:30").unwrap();
+    for path in [b, a] {
+        let back = scenes::load(path).unwrap_or_else(|e| panic!("{path}: {e}"));
+        assert_eq!(back.patch_count(), scene.patch_count(), "{path}");
+        let (got, want) = (
+            back.total_area_scene_units(),
+            scene.total_area_scene_units(),
+        );
+        let relative = (got - want).abs() / want;
+        assert!(relative < 1e-12, "{path}: area off by {relative:e}");
+        let out = scx(&["analyze", path, "--lines", "1e4", "-q"]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(out.status.success(), "{path}: {err}");
+    }
 }
 
 /// A fine mesh at few lines: the picture is noise, and the warning says how much and how many lines

@@ -106,7 +106,7 @@ fn the_public_cornell_boxes_give_finite_measures() {
                 rows[j as usize] += k;
             }
         });
-        assert!(enclosed.escapes_by_patch.iter().all(|&e| e == 0));
+        assert!(enclosed.escapes_by_patch.dense().iter().all(|&e| e == 0));
         // Every patch some line left has a row summing to 1: N_ij / N_i over j, with nothing escaping.
         let sampled = rows.iter().filter(|&&r| r > 0).count();
         assert!(sampled >= scene.patch_count(), "{name}: {sampled} rows");

@@ -239,7 +239,7 @@ fn transition_rows_sum_to_one_in_the_cornell_box() {
         let ff = FormFactors::from_counts(
             scene.patch_count(),
             a.tally.counts.as_ref().unwrap(),
-            &a.tally.escapes_by_patch,
+            &a.tally.escapes_by_patch.dense(),
         );
         let mats = PatchMaterials::of_scene(&scene).unwrap();
         let s = solve(&ff, &mats, &SolveOptions::default()).unwrap();

@@ -263,3 +263,24 @@ fn the_noise_summary_follows_the_square_root_law() {
     assert!(coarse.median_relative_error.unwrap() < 0.05, "{coarse:?}");
     assert_eq!(coarse.unsampled_patches, 0);
 }
+
+/// A flat scene (one triangle, in each axis plane) has a default view that shows its front: the
+/// bounding box has no depth, so a view framed on it alone would look from the triangle's own plane.
+#[test]
+fn the_default_view_of_a_flat_scene_shows_its_front() {
+    for (corners, plane) in [
+        ("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "z = 0"),
+        ("v 0 0 0\nv 1 0 0\nv 0 0 1\nf 1 3 2\n", "y = 0"),
+        ("v 0 0 0\nv 0 1 0\nv 0 0 1\nf 1 2 3\n", "x = 0"),
+    ] {
+        let scene = obj::load_text("triangle.obj", corners, &|_| {
+            Err(obj::MtlError::other("no MTL"))
+        })
+        .unwrap();
+        let s = samples(&scene, None);
+        let front = count(&s, |x| matches!(x, Sample::Front { .. }));
+        let back = count(&s, |x| matches!(x, Sample::Back { .. }));
+        assert!(front * 10 > s.len(), "{plane}: {front} front samples");
+        assert_eq!(back, 0, "{plane}: the back of the triangle shows");
+    }
+}

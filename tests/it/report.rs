@@ -110,3 +110,57 @@ fn form_factors_are_a_closed_reciprocal_matrix() {
         }
     }
 }
+
+/// The tables of an enclosed open scene, as the Python binding reads them: the patch table has the
+/// environment's row last (its counted area, no centroid, object and material `environment`), the
+/// object table the environment's object, and F is one row and column larger, every row a distribution
+/// (the open Cornell box has no segments to back sides).
+#[test]
+fn the_tables_of_an_enclosed_scene_have_the_environment() {
+    let scene = load("@cornell-open").unwrap();
+    let tracer = make_tracer(Backend::Rust, &scene, Query::Single).unwrap();
+    let spec = RunSpec {
+        per_patch: true,
+        enclose: true,
+        ..RunSpec::new(100_000, 3)
+    };
+    let a = analyze(&scene, tracer.as_ref(), &spec, &RunControl::default()).unwrap();
+    assert!(a.enclosed);
+    let n = scene.patch_count();
+    let t = report::patch_table(&scene, a.patches.as_ref().unwrap());
+    assert_eq!(t.rows(), n + 1);
+    assert!(t.columns.iter().all(|c| c.values.len() == n + 1));
+    assert_eq!(
+        t.row_text(n)[..3],
+        [n.to_string(), "environment".into(), "environment".into()]
+    );
+    match &t.column("centroid_x").unwrap().values {
+        Values::Numbers(v) => assert!(v[n].is_none() && v[..n].iter().all(Option::is_some)),
+        other => panic!("{other:?}"),
+    }
+    let env_area = a.environment_area.unwrap().value;
+    assert_eq!(numbers(&t, "area")[n], env_area);
+    let fractions: f64 = numbers(&t, "area_fraction").iter().sum();
+    assert!((fractions - 1.0).abs() < 1e-12);
+    let objects = report::object_table(&a);
+    assert_eq!(objects.rows(), scene.objects.len() + 1);
+    assert_eq!(
+        objects.row_text(scene.objects.len())[0],
+        scene_complexity::ENVIRONMENT
+    );
+
+    let f = FormFactors::of(&a, n).unwrap();
+    assert_eq!(f.patches, n + 1);
+    let mut rows = vec![0.0; f.patches];
+    for (k, &(i, _, _)) in f.entries.iter().enumerate() {
+        rows[i as usize] += f.value(k).0;
+    }
+    assert!(rows.iter().all(|r| (r - 1.0).abs() < 1e-12), "{rows:?}");
+    let to_environment: u64 = f
+        .entries
+        .iter()
+        .filter(|e| e.1 == n as u32)
+        .map(|e| e.2)
+        .sum();
+    assert_eq!(to_environment, a.escapes + 2 * a.tally.counters.misses);
+}

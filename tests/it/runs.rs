@@ -366,8 +366,8 @@ fn resumed_and_merged_runs_read_the_scene_file_as_first_read() {
     assert_eq!(flipped["pairs"], 0, "a room turned inside out has no pairs");
 }
 
-/// The per-patch files asked of a run: the per-patch table and the form factors in both formats, as
-/// command-line arguments writing into `dir` with names beginning with `stem`.
+/// The per-patch files asked of a run: the per-patch and per-object tables and the form factors in both
+/// formats, as command-line arguments writing into `dir` with names beginning with `stem`.
 fn patch_file_args(dir: &Path, stem: &str) -> Vec<String> {
     let file = |ext: &str| {
         dir.join(format!("{stem}{ext}"))
@@ -382,12 +382,14 @@ fn patch_file_args(dir: &Path, stem: &str) -> Vec<String> {
         file("-ff.csv"),
         "--form-factors".into(),
         file("-ff.mtx"),
+        "--objects".into(),
+        file("-objects.csv"),
     ]
 }
 
 /// The bytes of the per-patch files of `patch_file_args(dir, stem)`.
 fn patch_files(dir: &Path, stem: &str) -> Vec<(String, Vec<u8>)> {
-    ["-patches.csv", "-ff.csv", "-ff.mtx"]
+    ["-patches.csv", "-ff.csv", "-ff.mtx", "-objects.csv"]
         .iter()
         .map(|ext| {
             let name = format!("{stem}{ext}");
@@ -418,22 +420,42 @@ fn run_with_files(args: &[&str], files: &[String]) -> serde_json::Value {
     run_json(&all)
 }
 
-/// `--patches` and `--form-factors` after `--resume` from a half-way state, and from `scx merge` of 3
-/// shards, write the very bytes of the run cast at once: the per-patch sums of eq. (27) travel in the
-/// states, as exact integers. On a closed cube and on the lit Cornell box (radiosity columns).
+/// `--patches`, `--form-factors` and `--objects` after `--resume` from a half-way state, and from `scx
+/// merge` of 3 shards, write the very bytes of the run cast at once: the per-patch sums of eq. (27)
+/// travel in the states, as exact integers. On a closed cube, on the lit Cornell box (radiosity
+/// columns) and on the open Cornell box enclosed (`--enclose`: the environment's row, whose sums of the
+/// escapes travel too), whose files are also the same bytes with 1 thread as with 2.
 #[test]
 fn per_patch_files_of_resumed_and_merged_runs_are_the_single_runs() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     let state = |name: &str| d.join(name).to_str().unwrap().to_string();
     let cornell = scene_file("cornell.obj");
-    for scene in ["@cube:4", cornell.as_str()] {
-        let base = ["analyze", scene, "--tracer", "rust", "--format", "json"];
+    for (scene, enclose) in [
+        ("@cube:4", false),
+        (cornell.as_str(), false),
+        ("@cornell-open", true),
+    ] {
+        let mut base = vec!["analyze", scene, "--tracer", "rust", "--format", "json"];
+        if enclose {
+            base.push("--enclose");
+        }
         let single = run_with_files(
             &joined(&base, &["--lines", "6e5"]),
             &patch_file_args(d, "single"),
         );
         let single_files = patch_files(d, "single");
+        if enclose {
+            let text = String::from_utf8_lossy(&single_files[0].1).to_string();
+            let last = text.lines().last().unwrap();
+            assert!(last.starts_with("28,environment,environment,"), "{last}");
+            let one_thread = run_with_files(
+                &joined(&base, &["--lines", "6e5", "--threads", "1"]),
+                &patch_file_args(d, "one"),
+            );
+            assert_eq!(one_thread["threads"], 1);
+            assert_same_files(&single_files, &patch_files(d, "one"), "1 thread");
+        }
         // The columns that need the per-patch sums are filled, and the radiosities of the lit box.
         let text = String::from_utf8_lossy(&single_files[0].1).to_string();
         let mut lines = text.lines().map(|l| l.split(',').collect::<Vec<_>>());
@@ -549,7 +571,7 @@ fn states_without_per_patch_sums_say_so() {
             }
         }
         // The form factors need only the pair counts, which every state keeps.
-        assert_same_files(&single[1..], &files[1..], what);
+        assert_same_files(&single[1..3], &files[1..3], what);
     };
 
     let half = file("bare-half.scx");

@@ -11,6 +11,7 @@ use tempfile::TempDir;
 const EMBREE: &str = "libembree-dev";
 const LIBCLANG: &str = "libclang-dev";
 const FONT: &str = "fonts-dejavu-core";
+const VENV: &str = "python3-venv";
 
 /// Debian 12's libembree-dev (Embree 3) with its runtime library.
 const EMBREE3_DEB: &[&str] = &[
@@ -40,12 +41,29 @@ const LIBCLANG_CPP_14: &[&str] = &[
     "usr/lib/llvm-14/lib/libclang-cpp.so",
 ];
 const DEJAVU: &str = "usr/share/fonts/truetype/dejavu/DejaVuSans.ttf";
+/// Debian 12's python3-venv: ensurepip (python3.11-venv) and the pip wheel it installs from
+/// (python3-pip-whl).
+const PYTHON_VENV_DEB: &[&str] = &[
+    "usr/lib/python3.11/ensurepip/__init__.py",
+    "usr/share/python-wheels/pip-23.0.1-py3-none-any.whl",
+];
 
 /// A fake root: empty files at the given paths.
 struct Root(TempDir);
 
 impl Root {
+    /// A machine with Debian's Python and python3-venv (the README's install of the Python package
+    /// needs them), and the files of `groups`.
     fn new(groups: &[&[&str]]) -> Root {
+        let root = Root::bare(groups);
+        for path in PYTHON_VENV_DEB {
+            root.add(path);
+        }
+        root
+    }
+
+    /// A machine with the files of `groups` only.
+    fn bare(groups: &[&[&str]]) -> Root {
         let root = Root(tempfile::tempdir().expect("temp dir"));
         for path in groups.iter().flat_map(|g| g.iter()) {
             root.add(path);
@@ -53,7 +71,7 @@ impl Root {
         root
     }
 
-    /// Debian 12 with everything installed: Embree 3, libclang 14, the font.
+    /// Debian 12 with everything installed: Embree 3, libclang 14, the font, python3-venv.
     fn debian12() -> Root {
         Root::new(&[
             EMBREE3_DEB,
@@ -105,8 +123,21 @@ impl Root {
 }
 
 #[test]
-fn an_empty_machine_misses_all_three() {
-    assert_eq!(Root::new(&[]).missing(&[]), [EMBREE, LIBCLANG, FONT]);
+fn an_empty_machine_misses_all_four() {
+    assert_eq!(Root::bare(&[]).missing(&[]), [EMBREE, LIBCLANG, FONT, VENV]);
+}
+
+#[test]
+fn debians_python_without_venv_misses_python3_venv() {
+    // Debian's python3 alone (the state of a fresh Debian 12): `python3 -m venv` fails without
+    // ensurepip, and ensurepip without pip's wheel.
+    let root = Root::debian12();
+    root.remove(PYTHON_VENV_DEB);
+    assert_eq!(root.missing(&[]), [VENV]);
+    root.add(PYTHON_VENV_DEB[0]);
+    assert_eq!(root.missing(&[]), [VENV], "ensurepip without the pip wheel");
+    root.add(PYTHON_VENV_DEB[1]);
+    assert!(root.missing(&[]).is_empty());
 }
 
 #[test]

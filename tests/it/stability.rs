@@ -83,7 +83,7 @@ fn block_counts(
     to: &dyn Fn(usize) -> bool,
 ) -> (f64, f64) {
     let counts = a.tally.counts.as_ref().expect("counts");
-    let rows = row_totals(n, counts, &a.tally.escapes_by_patch);
+    let rows = row_totals(n, counts, &a.tally.escapes_by_patch.dense());
     let mut block = 0.0;
     counts.for_each(|i, j, c| {
         let (i, j) = (i as usize, j as usize);
@@ -1121,7 +1121,10 @@ fn enclosing_leaves_the_sampling_of_the_scenes_rows_alone() {
         )
         .unwrap();
         let report = a.sampling.expect("pairs were counted");
-        (report.sampling, report.lines_for_coverage)
+        (
+            report.sampling,
+            (report.lines_for_coverage, report.from_half),
+        )
     };
     let ((plain, plain_lines), (enclosed, enclosed_lines)) = (sampling(false), sampling(true));
     assert_eq!(enclosed.rows, scene.patch_count());
@@ -1172,7 +1175,7 @@ fn enclose_closes_open_scenes_consistently() {
     assert_eq!(areas.len(), 7);
     let n = 7;
     let counts = t.counts.as_ref().unwrap();
-    let rows = row_totals(n, counts, &t.escapes_by_patch);
+    let rows = row_totals(n, counts, &t.escapes_by_patch.dense());
     let mut f = vec![vec![0.0; n]; n];
     scene_complexity::internals::measure::channel::for_each_form_factor(
         counts,
@@ -1215,7 +1218,7 @@ fn enclose_closes_open_scenes_consistently() {
     );
     let (t, _) = a.tally.enclosed(&open);
     let counts = t.counts.as_ref().unwrap();
-    let rows = row_totals(6, counts, &t.escapes_by_patch);
+    let rows = row_totals(6, counts, &t.escapes_by_patch.dense());
     let mut f = vec![vec![0.0; 6]; 6];
     scene_complexity::internals::measure::channel::for_each_form_factor(
         counts,

@@ -27,7 +27,7 @@ fn run(scene: &Scene, tracer: &dyn Tracer, lines: u64, seed: u64) -> Analysis {
 fn form_factors(scene: &Scene, a: &Analysis) -> Vec<Vec<f64>> {
     let n = scene.patch_count();
     let counts = a.tally.counts.as_ref().unwrap();
-    let rows = row_totals(n, counts, &a.tally.escapes_by_patch);
+    let rows = row_totals(n, counts, &a.tally.escapes_by_patch.dense());
     let mut f = vec![vec![0.0; n]; n];
     for_each_form_factor(counts, &rows, |i, j, v| f[i][j] = v);
     f
@@ -51,7 +51,7 @@ fn unit_cube_form_factors_and_mutual_information_match_closed_form() {
         let rows = row_totals(
             6,
             a.tally.counts.as_ref().unwrap(),
-            &a.tally.escapes_by_patch,
+            &a.tally.escapes_by_patch.dense(),
         );
         for i in 0..6 {
             assert_eq!(f[i][i], 0.0, "a planar patch cannot see itself");

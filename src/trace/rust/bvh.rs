@@ -10,7 +10,9 @@
 //! traversal is made for nearest hits: at every node it decodes 8-bit quantized child boxes and orders
 //! the children by the ray's octant. A global line keeps every intersection, so order is worthless to us;
 //! we keep obvhs's CWBVH *topology* (its SAH collapse into 8-wide nodes and leaves of up to 3 triangles)
-//! but store exact f32 child boxes in SSE lanes and traverse with a plain unordered stack.
+//! but store exact f32 child boxes in SSE lanes and traverse with a plain unordered stack. The tree is
+//! obvhs's to the bit, built with less memory: two of its steps are ours, its PLOC (`ploc.rs`) and
+//! its collapse (`collapse.rs`), which on a large mesh were the peak of a run's memory.
 //!
 //! Measured (`cargo bench --bench bvh_layouts`: 10^6 global lines on one thread, every candidate decided
 //! by the watertight test, M lines per CPU-second, shared machine):
@@ -40,10 +42,13 @@
 use glam::{Vec3A, Vec4};
 use obvhs::aabb::Aabb;
 use obvhs::bvh2::reinsertion::ReinsertionOptimizer;
-use obvhs::cwbvh::{bvh2_to_cwbvh::bvh2_to_cwbvh, CwBvh};
+use obvhs::bvh2::{Bvh2, Bvh2Node};
+use obvhs::ploc::{PlocSearchDistance, SortPrecision};
 use obvhs::ray::safe_inverse;
 use obvhs::BvhBuildParams;
 
+use super::collapse::Collapse;
+use super::ploc::{self, Pending};
 use super::watertight::ShearedRay;
 use crate::scene::Scene;
 use crate::trace::{Hit, HitRules, Line, LineHits, RawHit, TraceError, Tracer};
@@ -110,20 +115,113 @@ struct Node {
     wide: bool,
 }
 
-/// obvhs's `build_cwbvh` (PLOC, reinsertion, collapse to 8-wide nodes with leaves of at most 3), the
-/// same steps on the same boxes, without the copy of the boxes it makes, and the boxes freed before the
-/// collapse: on a large scene the build is the peak of a run's memory.
-fn build_cwbvh(boxes: Vec<Aabb>, params: BvhBuildParams) -> CwBvh {
-    let indices = (0..boxes.len() as u32).collect();
-    let mut bvh2 = params.ploc_search_distance.build(
-        &boxes,
-        indices,
-        params.sort_precision,
-        params.search_depth_threshold,
-    );
-    drop(boxes);
+/// The tree of `scene`'s triangles (their boxes grown by `margin`): obvhs's `build_cwbvh` (PLOC,
+/// reinsertion, collapse to 8-wide nodes with leaves of at most 3), the same steps on the same boxes, with
+/// less memory, since on a large scene the build is the peak of a run's memory: PLOC starts from leaves
+/// made straight from the triangles (no list of boxes beside them), and the collapse is ours
+/// ([`Collapse`]: one byte per decision where obvhs keeps eight, and no compressed nodes) and writes
+/// our [`Node`]s directly. Returns the nodes and the scene's index of each triangle in BVH order.
+fn build(scene: &Scene, margin: f32, params: &BvhBuildParams) -> (Vec<Node>, Vec<u32>) {
+    let mut bvh2 = binary_bvh(scene, margin, params);
     ReinsertionOptimizer::run(&mut bvh2, params.reinsertion_batch_ratio, None);
-    bvh2_to_cwbvh(&bvh2, params.max_prims_per_leaf.clamp(1, 3), true, false)
+    let collapse = Collapse::new(&bvh2, params.max_prims_per_leaf);
+    let mut nodes = Vec::with_capacity(collapse.node_count());
+    let mut ids = Vec::with_capacity(scene.triangles.len());
+    if !bvh2.nodes.is_empty() {
+        emit(&collapse, 0, &mut nodes, &mut ids);
+    }
+    (nodes, ids)
+}
+
+/// obvhs's PLOC build (`build_ploc`, one triangle per leaf, the triangle's index as its primitive; our
+/// [`ploc`] in its memory) from leaves made here: the same boxes and the same bounds of them all, in
+/// the same operations.
+fn binary_bvh(scene: &Scene, margin: f32, params: &BvhBuildParams) -> Bvh2 {
+    let mut total = Aabb::empty();
+    let leaves: Vec<Pending> = scene
+        .triangles
+        .iter()
+        .enumerate()
+        .map(|(i, t)| {
+            let aabb = inflated_box(t.map(|v| scene.positions[v as usize]), margin);
+            total.extend(aabb.min);
+            total.extend(aabb.max);
+            Pending::leaf(&aabb, i as u32)
+        })
+        .collect();
+    type Ploc = fn(Vec<Pending>, Aabb, SortPrecision, usize) -> Vec<Bvh2Node>;
+    let ploc: Ploc = match params.ploc_search_distance {
+        PlocSearchDistance::Minimum => ploc::build::<1>,
+        PlocSearchDistance::VeryLow => ploc::build::<2>,
+        PlocSearchDistance::Low => ploc::build::<6>,
+        PlocSearchDistance::Medium => ploc::build::<14>,
+        PlocSearchDistance::High => ploc::build::<24>,
+        PlocSearchDistance::VeryHigh => ploc::build::<32>,
+    };
+    Bvh2 {
+        nodes: ploc(
+            leaves,
+            total,
+            params.sort_precision,
+            params.search_depth_threshold,
+        ),
+        // The leaves hold the triangles' indices themselves (neither reinsertion nor the collapse reads
+        // this mapping).
+        primitive_indices: Vec::new(),
+        max_depth: None,
+    }
+}
+
+/// Writes the 8-wide node made of binary node `index` (and its subtree) into `nodes` in depth-first
+/// order, and its leaves' triangles into `ids` in obvhs's order (each node's leaves before its
+/// subtrees), with exact f32 boxes: the union of the children's boxes, down to the triangles' grown
+/// boxes (the binary leaves'). Returns the node's box.
+fn emit(collapse: &Collapse, index: u32, nodes: &mut Vec<Node>, ids: &mut Vec<u32>) -> Aabb {
+    let empty = Vec4::splat(f32::INFINITY);
+    let at = nodes.len();
+    nodes.push(Node {
+        bounds: [[[empty, -empty]; 3]; 2],
+        children: [0; WIDTH],
+        wide: false,
+    });
+    let mut slots = [(0, Aabb::empty()); WIDTH];
+    let (mut inner, mut inner_count) = ([(0, 0); WIDTH], 0);
+    let mut used = 0;
+    for child in collapse.children(index).into_iter().flatten() {
+        if collapse.is_leaf(child) {
+            let first = ids.len() as u32;
+            let mut bounds = Aabb::empty();
+            collapse.leaves(child, &mut |leaf| {
+                ids.push(leaf.first_index);
+                bounds = bounds.union(&leaf.aabb);
+            });
+            slots[used] = (
+                LEAF | (ids.len() as u32 - first) << LEAF_START_BITS | first,
+                bounds,
+            );
+        } else {
+            inner[inner_count] = (used, child);
+            inner_count += 1;
+        }
+        used += 1;
+    }
+    // Subtrees after the node's leaves, in slot order: the triangles' order of obvhs's collapse.
+    for &(slot, child) in &inner[..inner_count] {
+        let reference = nodes.len() as u32;
+        slots[slot] = (reference, emit(collapse, child, nodes, ids));
+    }
+    let node = &mut nodes[at];
+    let mut whole = Aabb::empty();
+    for (k, (child, bounds)) in slots[..used].iter().enumerate() {
+        node.children[k] = *child;
+        for (axis, [lower, upper]) in node.bounds[k / 4].iter_mut().enumerate() {
+            lower[k % 4] = bounds.min[axis];
+            upper[k % 4] = bounds.max[axis];
+        }
+        whole = whole.union(bounds);
+    }
+    node.wide = used > 4;
+    whole
 }
 
 /// A line prepared for the slab tests of [`Node`]s.
@@ -180,28 +278,11 @@ impl BvhTracer {
                 scene.triangles.len()
             )));
         }
-        let m = margin(scene);
-        let boxes: Vec<Aabb> = scene
-            .triangles
-            .iter()
-            .map(|t| inflated_box(t.map(|v| scene.positions[v as usize]), m))
-            .collect();
-        let mut cw = if boxes.is_empty() {
-            CwBvh::default()
-        } else {
-            build_cwbvh(boxes, params)
-        };
-        let ids = std::mem::take(&mut cw.primitive_indices);
+        let (nodes, ids) = build(scene, margin(scene), &params);
         let triangles: Vec<[[f32; 3]; 3]> = ids
             .iter()
             .map(|&i| scene.triangles[i as usize].map(|v| scene.positions[v as usize]))
             .collect();
-        // The same boxes again (the same operations on the same corners), in BVH order.
-        let ordered_boxes: Vec<Aabb> = triangles.iter().map(|&t| inflated_box(t, m)).collect();
-        let mut nodes = Vec::with_capacity(cw.nodes.len());
-        if !cw.nodes.is_empty() {
-            convert(&cw, 0, &ordered_boxes, &mut nodes);
-        }
         Ok(BvhTracer {
             nodes,
             triangles,
@@ -301,49 +382,6 @@ impl BvhTracer {
         });
         best
     }
-}
-
-/// Copies node `index` of `cw` (and its subtree) into `nodes` in depth-first order, with exact f32
-/// boxes: the union of the children's boxes, down to the triangles' inflated boxes (`boxes`, in primitive
-/// order), rather than the CWBVH's 8-bit quantized ones. Returns the node's box.
-fn convert(cw: &CwBvh, index: usize, boxes: &[Aabb], nodes: &mut Vec<Node>) -> Aabb {
-    let empty = Vec4::splat(f32::INFINITY);
-    let at = nodes.len();
-    nodes.push(Node {
-        bounds: [[[empty, -empty]; 3]; 2],
-        children: [0; WIDTH],
-        wide: false,
-    });
-    let source = &cw.nodes[index];
-    let mut whole = Aabb::empty();
-    let mut used = 0;
-    for ch in 0..WIDTH {
-        if source.is_child_empty(ch) {
-            continue;
-        }
-        let (child, bounds) = if source.is_leaf(ch) {
-            let (first, count) = source.child_primitives(ch);
-            let bounds = boxes[first as usize..(first + count) as usize]
-                .iter()
-                .fold(Aabb::empty(), |acc, b| acc.union(b));
-            (LEAF | count << LEAF_START_BITS | first, bounds)
-        } else {
-            let child = nodes.len() as u32;
-            let bounds = convert(cw, source.child_node_index(ch) as usize, boxes, nodes);
-            (child, bounds)
-        };
-        let node = &mut nodes[at];
-        node.children[used] = child;
-        let half = &mut node.bounds[used / 4];
-        for (axis, [lower, upper]) in half.iter_mut().enumerate() {
-            lower[used % 4] = bounds.min[axis];
-            upper[used % 4] = bounds.max[axis];
-        }
-        whole = whole.union(&bounds);
-        used += 1;
-    }
-    nodes[at].wide = used > 4;
-    whole
 }
 
 /// Triangles per leaf, at most (obvhs's CWBVH allows 1 to 3).
@@ -490,6 +528,122 @@ impl std::fmt::Debug for BvhTracer {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use obvhs::cwbvh::{bvh2_to_cwbvh::bvh2_to_cwbvh, CwBvh};
+
+    /// The tree as obvhs builds it (`build_cwbvh`'s steps: PLOC on a list of the boxes, reinsertion,
+    /// `bvh2_to_cwbvh`), copied into our nodes with exact boxes: what [`build`] must reproduce.
+    fn obvhs_tree(scene: &Scene, params: &BvhBuildParams) -> (Vec<Node>, Vec<u32>) {
+        let m = margin(scene);
+        let boxes: Vec<Aabb> = scene
+            .triangles
+            .iter()
+            .map(|t| inflated_box(t.map(|v| scene.positions[v as usize]), m))
+            .collect();
+        let indices = (0..boxes.len() as u32).collect();
+        let mut bvh2 = params.ploc_search_distance.build(
+            &boxes,
+            indices,
+            params.sort_precision,
+            params.search_depth_threshold,
+        );
+        ReinsertionOptimizer::run(&mut bvh2, params.reinsertion_batch_ratio, None);
+        let cw = bvh2_to_cwbvh(&bvh2, params.max_prims_per_leaf.clamp(1, 3), true, false);
+        let ordered: Vec<Aabb> = cw
+            .primitive_indices
+            .iter()
+            .map(|&i| boxes[i as usize])
+            .collect();
+        let mut nodes = Vec::new();
+        copy_cwbvh(&cw, 0, &ordered, &mut nodes);
+        (nodes, cw.primitive_indices)
+    }
+
+    /// Node `index` of `cw` and its subtree, depth first, with the union of the triangles' boxes.
+    fn copy_cwbvh(cw: &CwBvh, index: usize, boxes: &[Aabb], nodes: &mut Vec<Node>) -> Aabb {
+        let empty = Vec4::splat(f32::INFINITY);
+        let at = nodes.len();
+        nodes.push(Node {
+            bounds: [[[empty, -empty]; 3]; 2],
+            children: [0; WIDTH],
+            wide: false,
+        });
+        let source = &cw.nodes[index];
+        let mut whole = Aabb::empty();
+        let mut used = 0;
+        for ch in (0..WIDTH).filter(|&ch| !source.is_child_empty(ch)) {
+            let (child, bounds) = if source.is_leaf(ch) {
+                let (first, count) = source.child_primitives(ch);
+                let bounds = boxes[first as usize..(first + count) as usize]
+                    .iter()
+                    .fold(Aabb::empty(), |acc, b| acc.union(b));
+                (LEAF | count << LEAF_START_BITS | first, bounds)
+            } else {
+                let child = nodes.len() as u32;
+                (
+                    child,
+                    copy_cwbvh(cw, source.child_node_index(ch) as usize, boxes, nodes),
+                )
+            };
+            let node = &mut nodes[at];
+            node.children[used] = child;
+            for (axis, [lower, upper]) in node.bounds[used / 4].iter_mut().enumerate() {
+                lower[used % 4] = bounds.min[axis];
+                upper[used % 4] = bounds.max[axis];
+            }
+            whole = whole.union(&bounds);
+            used += 1;
+        }
+        nodes[at].wide = used > 4;
+        whole
+    }
+
+    /// Our build (leaves made from the triangles, our collapse) gives obvhs's tree: the same nodes, the
+    /// same children in the same slots, the same boxes to the bit, the same triangle order; on scenes of
+    /// 1 to ~10^4 triangles, leaves of 1 to 3 and obvhs's three presets.
+    #[test]
+    fn the_build_is_obvhs_tree() {
+        let mut single = crate::scene::SceneBuilder::new("one triangle");
+        let v = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]].map(|p| single.vertex(p));
+        let material = single.material(crate::scene::Material::default());
+        single.polygon(&v, material, "triangle");
+        let mut scenes = vec![single.build().unwrap()];
+        for spec in [
+            "@tetrahedron",
+            "@cornell",
+            "@cube:30",
+            "@cubes512",
+            "@fig4:b",
+            "@sphere:3",
+        ] {
+            scenes.push(crate::scenes::load(spec).unwrap());
+        }
+        let presets = [
+            BvhBuildParams::fast_build(),
+            BvhBuildParams::medium_build(),
+            BvhBuildParams::slow_build(),
+        ];
+        for scene in &scenes {
+            for (preset, leaf) in presets.iter().flat_map(|p| [1, 2, 3].map(|l| (p, l))) {
+                let params = BvhBuildParams {
+                    pre_split: false,
+                    max_prims_per_leaf: leaf,
+                    ..*preset
+                };
+                let (ours, ids) = build(scene, margin(scene), &params);
+                let (theirs, their_ids) = obvhs_tree(scene, &params);
+                assert_eq!(ids, their_ids, "{} leaves {leaf}", scene.name);
+                assert_eq!(ours.len(), theirs.len(), "{} leaves {leaf}", scene.name);
+                for (a, b) in ours.iter().zip(&theirs) {
+                    let bits = |n: &Node| {
+                        n.bounds
+                            .map(|h| h.map(|s| s.map(|v| v.to_array().map(f32::to_bits))))
+                    };
+                    assert_eq!(bits(a), bits(b), "{}", scene.name);
+                    assert_eq!((a.children, a.wide), (b.children, b.wide), "{}", scene.name);
+                }
+            }
+        }
+    }
 
     #[test]
     fn inflated_boxes_contain_the_triangle_with_room() {

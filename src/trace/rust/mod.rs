@@ -6,6 +6,8 @@
 //! serves as the reference for small scenes and for tests.
 
 pub mod bvh;
+mod collapse;
+mod ploc;
 pub mod watertight;
 
 pub use bvh::BvhTracer;
