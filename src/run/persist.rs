@@ -932,6 +932,7 @@ mod tests {
     use crate::run::control::RunControl;
     use crate::run::{cast, start, CastHooks, CastOptions};
     use crate::trace::{make_tracer, Backend, Query};
+    use crate::sample::lines::Sampler;
 
     /// A state saved and read back reports the same numbers, bit for bit; a truncated file, a flipped
     /// byte and a stranger are refused with a sentence.
