@@ -1,7 +1,8 @@
 //! Drawing alone: nanoseconds per independent global line, of `batch_lines` (blocks of draws from
 //! interleaved PCG lanes) and of the straightforward path it must equal bit for bit (`global_line` on
-//! `batch_rng`, line after line), on one thread, over the batches of an analysis (seed 1, radius 1).
-//! Runs alternate between the two; medians of the runs (the machine is shared).
+//! `batch_rng`, line after line), and per randomised quasi-Monte Carlo line (`sobol_lines`, batches dealt
+//! to 16 groups as a run deals them), on one thread, over the batches of an analysis (seed 1, radius 1).
+//! Runs alternate between the three; medians of the runs (the machine is shared).
 //!
 //! `cargo bench --bench draw [-- LINES [RUNS]]`, default 3e7 lines and 5 runs.
 
@@ -9,7 +10,9 @@ use std::hint::black_box;
 use std::time::Instant;
 
 use scene_complexity::internals::run::BatchPlan;
-use scene_complexity::internals::sample::lines::{batch_lines, batch_rng, global_line};
+use scene_complexity::internals::sample::lines::{
+    batch_lines, batch_rng, global_line, sobol_lines,
+};
 use scene_complexity::internals::trace::Line;
 
 fn main() {
@@ -22,8 +25,11 @@ fn main() {
         .map_or(3e7, |a| a.parse::<f64>().expect("LINES")) as u64;
     let runs = args.get(1).map_or(5, |a| a.parse::<usize>().expect("RUNS"));
     let plan = BatchPlan::new(lines);
-    let (mut blocks, mut reference) = (Vec::new(), Vec::new());
+    let (mut blocks, mut reference, mut sobol) = (Vec::new(), Vec::new(), Vec::new());
     for _ in 0..runs {
+        sobol.push(time_pass(&plan, |b, n, out| {
+            sobol_lines(1, b % 16, b / 16 * plan.batch_size, n, 1.0, out)
+        }));
         blocks.push(time_pass(&plan, |b, n, out| batch_lines(1, b, n, 1.0, out)));
         reference.push(time_pass(&plan, |b, n, out| {
             let mut rng = batch_rng(1, b);
@@ -37,6 +43,7 @@ fn main() {
         per_line(&mut reference)
     );
     println!("  batch_lines               {:6.2}", per_line(&mut blocks));
+    println!("  sobol_lines               {:6.2}", per_line(&mut sobol));
 }
 
 /// Seconds to draw every batch of `plan` with `draw(batch, count, out)`, into a reused buffer.

@@ -106,10 +106,11 @@ pub use run::persist::{
 pub use run::{
     remaining_lines, start, Budget, CastOptions, ErrorMethod, ExtendError, Measures, MergeError,
     MissingLines, PersistError, RunControl, RunIdentity, RunSpec, RunState, SavedRun, SceneRef,
-    Scope, Shard, SpecDifference, StopReason, Target, Tracing, DEFAULT_ESTIMATOR, DEFAULT_GROUPS,
+    Scope, Shard, SpecDifference, SpecError, StartError, StopReason, Target, Tracing,
+    DEFAULT_ESTIMATOR, DEFAULT_GROUPS,
 };
 pub use sample::counts::PairCounts;
-pub use sample::lines::{BundleError, LineSource, MAX_BUNDLE_GRID};
+pub use sample::lines::{BundleError, LineSource, Sampler, MAX_BUNDLE_GRID};
 pub use sample::tally::{Tally, Wanted};
 
 // What is computed from a run.

@@ -328,6 +328,7 @@ def analyze(
     estimator: str = "chao-wang-jost",
     errors: str = "groups",
     bundle: Optional[int] = None,
+    sampler: str = "independent",
     per_patch: bool = False,
     shard: Optional[Tuple[int, int]] = None,
     save: Optional[_Path] = None,

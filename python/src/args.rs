@@ -7,7 +7,7 @@ use pyo3::types::{PyBool, PyFloat, PyInt, PyString};
 
 use scene_complexity::{
     EntropyEstimator, ErrorMethod, LineSource, Measure, Measures, ObjectSet, Planarity, Reach,
-    ReadPolicy, SceneOptions, DEFAULT_PLANARITY, MAX_BUNDLE_GRID,
+    ReadPolicy, Sampler, SceneOptions, DEFAULT_PLANARITY, MAX_BUNDLE_GRID,
 };
 
 use crate::errors::bad_argument;
@@ -184,6 +184,17 @@ pub fn target_measure(key: &str) -> PyResult<Measure> {
         bad_argument(format!(
             "target_measure: `{key}` is not one of {}",
             keys.join(", ")
+        ))
+    })
+}
+
+/// A line sampler by name (`scx analyze --sampler`).
+pub fn sampler(name: &str) -> PyResult<Sampler> {
+    Sampler::from_name(name).ok_or_else(|| {
+        let names: Vec<&str> = Sampler::NAMES.iter().map(|(n, _)| *n).collect();
+        bad_argument(format!(
+            "sampler: `{name}` is not one of {}",
+            names.join(", ")
         ))
     })
 }

@@ -300,7 +300,7 @@ fn optional_path(value: Option<&Bound<'_, PyAny>>, what: &str) -> PyResult<Optio
 #[pyo3(signature = (scene, lines=None, seed=None, *, threads=None, measures=None,
                     target_stderr=None, target_measure="mutual_information_corrected",
                     seconds=None, enclose=false, groups=None, estimator="chao-wang-jost",
-                    errors="groups", bundle=None, per_patch=false, shard=None, save=None,
+                    errors="groups", bundle=None, sampler="independent", per_patch=false, shard=None, save=None,
                     keep_state=true, progress=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn analyze(
@@ -318,6 +318,7 @@ pub fn analyze(
     estimator: &str,
     errors: &str,
     bundle: Option<&Bound<'_, PyAny>>,
+    sampler: &str,
     per_patch: bool,
     shard: Option<&Bound<'_, PyAny>>,
     save: Option<&Bound<'_, PyAny>>,
@@ -363,11 +364,6 @@ pub fn analyze(
             "a shard takes no seconds or target_stderr: every shard must cast its whole share",
         ));
     }
-    if per_patch && enclose {
-        return Err(bad_argument(
-            "per_patch describes the scene's own patches; it does not take enclose=True",
-        ));
-    }
     // The command line's spec (src/cli/analyze.rs `spec_of` over `RunOptions::spec`).
     let spec = RunSpec {
         measures: args::measures(measures)?,
@@ -384,8 +380,10 @@ pub fn analyze(
         },
         estimator: args::estimator(estimator)?,
         errors: args::errors(errors)?,
+        sampler: args::sampler(sampler)?,
         ..RunSpec::new(lines, seed)
     };
+    spec.check().map_err(bad_argument)?;
     let (state, identity) = {
         let s = scene.get();
         let state = start(&s.inner, &spec).map_err(scene_error)?;

@@ -105,7 +105,8 @@ def test_bad_files_and_built_ins(tmp_path):
         ({"bundle": 10_000}, "bundle"),
         ({"shard": (1, 2)}, "shard needs save=PATH"),
         ({"shard": (3, 2), "save": "x.scx"}, "the shard k must be a whole number from 1 to 2"),
-        ({"per_patch": True, "enclose": True}, "does not take enclose=True"),
+        ({"sampler": "halton"}, "sampler: `halton` is not one of independent, sobol"),
+        ({"sampler": "sobol", "bundle": 4}, "does not take bundles"),
         ({"progress": 3}, "progress must be True, False or a callable"),
     ],
 )

@@ -147,3 +147,37 @@ def test_form_factors_rows_sum_to_one_and_are_reciprocal():
     assert entries["n_ij"].sum() == 2 * a.pairs
     with pytest.raises(ValueError, match="no form factors"):
         scx.analyze(scene, lines=1e5, measures=["continuous"]).form_factors()
+
+
+def test_to_dict_of_a_sobol_run_is_the_json_of_scx_analyze():
+    a = scx.analyze("@cube:4", lines=2e5, seed=3, sampler="sobol", threads=1)
+    assert a.to_dict()["sampler"] == "sobol"
+    cli = run_cli(
+        "analyze", "@cube:4", "--lines", "2e5", "--seed", "3", "--tracer", "rust", "--sampler", "sobol"
+    )
+    assert without_process(a.to_dict()) == without_process(cli)
+    independent = scx.analyze("@cube:4", lines=2e5, seed=3, threads=1)
+    assert a.continuous_mutual_information.value != independent.continuous_mutual_information.value
+
+
+def test_an_enclosed_run_has_the_environment_as_its_last_patch(tmp_path):
+    # An open box: the environment closes it, so every row of F (the environment's too) sums to 1 and
+    # the per-patch terms, the environment's included, add up to the enclosed scene's measures.
+    pytest.importorskip("scipy")
+    scene = scx.load("@cornell-open:2")
+    a = scx.analyze(scene, lines=3e5, seed=5, enclose=True, per_patch=True)
+    p = a.patches()
+    n = scene.patch_count
+    assert len(p["id"]) == n + 1
+    assert p["object"][-1] == "environment"
+    assert float(np.sum(p["continuous_mutual_information_term"])) == pytest.approx(
+        a.continuous_mutual_information.value, rel=1e-9
+    )
+    F, _ = a.form_factors()
+    assert F.shape == (n + 1, n + 1)
+    np.testing.assert_allclose(np.asarray(F.sum(axis=1)).ravel(), 1.0, rtol=1e-12)
+    cli = run_cli(
+        "analyze", "@cornell-open:2", "--lines", "3e5", "--seed", "5", "--tracer", "rust",
+        "--enclose", "--patches", str(tmp_path / "p.csv"),
+    )
+    assert without_process(a.to_dict()) == without_process(cli)

@@ -26,15 +26,16 @@ pub use reliability::{
 pub use warnings::{RunWarning, RunWarningKind};
 
 use patch_results as per_patch;
-use values::{visibility_estimates, VisibilityOfRun};
+use values::{visibility_estimates, Replication, VisibilityOfRun};
 
 use crate::measure::estimators::EntropyEstimator;
 use crate::measure::radiosity::{MaterialError, PatchMaterials};
 use crate::measure::{student_t_975, ByMeasure, Estimate, Measure};
 use crate::run::{
     BatchPlan, BatchSet, CastHooks, CastOptions, ErrorMethod, FinishedRun, RunControl, RunSpec,
-    RunState, StopReason, TargetReading,
+    RunState, SpecError, StartError, StopReason, TargetReading,
 };
+use crate::sample::lines::Sampler;
 use crate::sample::tally::{ObjectSides, Tally, Wanted};
 use crate::scene::Scene;
 use crate::trace::{TraceError, Tracer};
@@ -45,12 +46,24 @@ pub enum AnalysisError {
     /// A material outside the physical range (bad input), found before any line is cast.
     #[error(transparent)]
     Material(#[from] MaterialError),
+    /// Settings of the run that contradict each other (bad input), found before any line is cast.
+    #[error(transparent)]
+    Spec(#[from] SpecError),
     /// The radiosity system has no solution, or the solver gave up (bad input: the materials).
     #[error(transparent)]
     Solve(#[from] SolveFailure),
     /// Tracing failed.
     #[error(transparent)]
     Trace(#[from] TraceError),
+}
+
+impl From<StartError> for AnalysisError {
+    fn from(e: StartError) -> Self {
+        match e {
+            StartError::Material(e) => AnalysisError::Material(e),
+            StartError::Spec(e) => AnalysisError::Spec(e),
+        }
+    }
 }
 
 impl AnalysisError {
@@ -315,7 +328,7 @@ pub fn finish(
             &run,
             &cfg.solve,
             cfg.estimator,
-            visibility.jackknifed,
+            (visibility.jackknifed, visibility.debiased),
             visibility
                 .sampling
                 .as_ref()
@@ -359,7 +372,11 @@ pub fn finish(
         for (m, e) in r.estimates.iter() {
             estimates.set(m, Some(*e));
         }
-        for (m, v) in r.reliability.iter() {
+        let mut verdicts = r.reliability.clone();
+        if cfg.sampler == Sampler::Sobol && !visibility.debiased {
+            reliability::flag_dependent_lines(&mut verdicts);
+        }
+        for (m, v) in verdicts.iter() {
             reliability.set(m, Some(v.clone()));
         }
     }
@@ -414,16 +431,17 @@ fn judged_visibility(
 }
 
 /// Whether a run's delete-a-group replicates can be computed (for the bias estimates behind the
-/// verdicts), and whether they also give the standard errors (`--errors jackknife`). Not with
-/// `--enclose` nor Chao–Shen (its second pass needs every count of the replicate), and not with fewer
-/// than 2 groups.
-fn replication(cfg: &RunSpec, run: &FinishedRun, enclose: bool) -> (bool, bool) {
+/// verdicts), whether they also give the standard errors (`--errors jackknife`), and whether they
+/// debias the readings on corrected rows (the Sobol' sampler). Not with `--enclose` nor Chao–Shen (its
+/// second pass needs every count of the replicate), and not with fewer than 2 groups.
+fn replication(cfg: &RunSpec, run: &FinishedRun, enclose: bool) -> Replication {
     let replicable =
         !enclose && cfg.estimator != EntropyEstimator::ChaoShen && run.groups.len() >= 2;
-    (
+    Replication {
         replicable,
-        replicable && cfg.errors == ErrorMethod::Jackknife,
-    )
+        jackknife: replicable && cfg.errors == ErrorMethod::Jackknife,
+        debias: cfg.sampler == Sampler::Sobol,
+    }
 }
 
 /// The standard error of `measure` and the verdict on its reading, from the run so far, judged as the

@@ -69,14 +69,16 @@ pub struct SolveFailure {
 }
 
 /// Solves the radiosity system of the whole run, of every group, and with each group left out when
-/// `jackknife`, and measures each.
+/// `jackknife` (then the replicates give the standard errors) or `debias` (then they debias the
+/// readings on corrected rows, as for the visibility measures of a run of Sobol' lines), and measures
+/// each.
 pub(crate) fn estimates(
     scene: &Scene,
     materials: &PatchMaterials,
     run: &FinishedRun,
     opts: &SolveOptions,
     estimator: EntropyEstimator,
-    jackknife: bool,
+    (jackknife, debias): (bool, bool),
     sampling: &SamplingReport,
 ) -> Result<(RadiosityOutcome, Option<RadiosityReadings>), SolveFailure> {
     let areas: Vec<f64> = scene.patches.iter().map(|p| p.area).collect();
@@ -87,7 +89,7 @@ pub(crate) fn estimates(
         .par_iter()
         .map(|g| solve(g).ok().flatten().map(|r| r.0))
         .collect();
-    let replicates: Option<Vec<Option<RadiosityValues>>> = jackknife.then(|| {
+    let replicates: Option<Vec<Option<RadiosityValues>>> = (jackknife || debias).then(|| {
         run.groups
             .par_iter()
             .map(|g| {
@@ -112,15 +114,26 @@ pub(crate) fn estimates(
         Ok(Some(solved)) => solved,
     };
     let all = Some(all);
-    let spread = Spread {
+    let with_replicates = Spread {
         all: &all,
         groups: &per_group,
         replicates: replicates.as_deref(),
     };
+    let spread = Spread {
+        replicates: replicates.as_deref().filter(|_| jackknife),
+        ..with_replicates
+    };
     let all = all.as_ref().expect("solved above");
     let estimates = ByMeasure::from_fn(|m| {
         let pick = value_of(m)?;
-        spread.estimate(|v| v.as_ref().map(pick))
+        let value = |v: &Option<RadiosityValues>| v.as_ref().map(pick);
+        if debias && m.rests_on_corrected_rows() {
+            with_replicates
+                .debiased(value)
+                .or_else(|| spread.estimate(value))
+        } else {
+            spread.estimate(value)
+        }
     });
     let c = &run.total.counters;
     let facts = RunFacts {

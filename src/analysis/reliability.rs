@@ -248,6 +248,25 @@ fn corrected(mut r: Reliability, e: Estimate, bias: f64, lines: u64) -> Reliabil
     r
 }
 
+/// Flags every reading on corrected rows of a run whose lines are not independent (the Sobol' sampler)
+/// and whose corrections the delete-a-group jackknife could not take out (an enclosed scene, Chao–Shen): the
+/// entropy estimators' corrections assume independent lines, and such a reading is biased.
+pub(crate) fn flag_dependent_lines(verdicts: &mut ByMeasure<Reliability>) {
+    for m in Measure::ALL
+        .into_iter()
+        .filter(|m| m.rests_on_corrected_rows())
+    {
+        if let Some(r) = verdicts.get_mut(m) {
+            r.flag(
+                "the lines are randomised quasi-Monte Carlo (sobol): the bias correction assumes \
+                 independent lines, and the jackknife that replaces it is not available here (an \
+                 enclosed scene, or the Chao-Shen estimator)"
+                    .into(),
+            );
+        }
+    }
+}
+
 /// Flags a reading below 0 (an entropy or mutual information).
 fn flag_negative(r: &mut Reliability, e: Estimate, what: &str) {
     if e.value < -2.0 * e.stderr.unwrap_or(0.0) {
@@ -392,7 +411,12 @@ fn verdict(
         }
         VerdictRule::Unbiased => {
             let (report, _) = evidence.discrete(info.family)?;
-            let bias = report.sampling.mse_bias;
+            // The rows' multinomial estimate of the plug-in's bias, unless the jackknife gives one (Sobol'
+            // lines, whose rows are no multinomial samples).
+            let bias = evidence
+                .bias
+                .and_then(|b| b.of(m))
+                .unwrap_or(report.sampling.mse_bias);
             let mut r = Reliability::new(if bias.abs() <= stderr(e) {
                 Verdict::Ok
             } else {

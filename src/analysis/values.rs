@@ -134,25 +134,46 @@ pub(super) struct VisibilityOfRun {
     pub(super) environment_area: Option<Estimate>,
     /// Whether the standard errors came from the jackknife.
     pub(super) jackknifed: bool,
+    /// Whether the readings on corrected rows are the jackknife's debiased ones (Sobol' lines).
+    pub(super) debiased: bool,
     /// How the rows were sampled (when counted).
     pub(super) sampling: Option<SamplingReport>,
     /// The verdict on every reading.
     pub(super) reliability: ByMeasure<Reliability>,
 }
 
+/// How a run uses its delete-a-group replicates.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) struct Replication {
+    /// They can be computed (not with `--enclose`, Chao–Shen or fewer than 2 groups).
+    pub(super) replicable: bool,
+    /// They give the standard errors (`--errors jackknife`).
+    pub(super) jackknife: bool,
+    /// The lines within a group are not independent (the Sobol' sampler): the readings that rest on
+    /// corrected rows ([`Measure::rests_on_corrected_rows`]) are the jackknife's bias-corrected ones
+    /// ([`Spread::debiased`]), since the entropy estimators' corrections assume independent lines.
+    pub(super) debias: bool,
+}
+
 /// Every visibility measure of a finished run with its standard error (by the jackknife when asked and
 /// possible), and the environment's area when enclosed. The delete-a-group replicates are computed
 /// whenever they can be (`replicable`) and the rows are covered well enough for an `ok` corrected
-/// reading, for the bias estimates behind its verdict; `jackknife` says whether they also give the
-/// standard errors (and are then always computed).
+/// reading, for the bias estimates behind its verdict, or the readings on corrected rows are to be
+/// debiased; `jackknife` says whether they also give the standard errors (and are then always
+/// computed).
 pub(super) fn visibility_estimates(
     scene: &Scene,
     run: &FinishedRun,
     estimator: EntropyEstimator,
     enclose: bool,
-    (replicable, jackknife): (bool, bool),
+    rep: Replication,
     wanted: Wanted,
 ) -> VisibilityOfRun {
+    let Replication {
+        replicable,
+        jackknife,
+        debias,
+    } = rep;
     let values_of = |t: &Tally| GroupValues::of(scene, t, estimator, enclose, false);
     let (all, per_group): (GroupValues, Vec<GroupValues>) = if rows_in_parallel(scene) {
         rayon::join(
@@ -167,9 +188,10 @@ pub(super) fn visibility_estimates(
     };
     // Below the coverage of an ok verdict the bias changes no verdict: the replicates cost only then.
     let covered = all.sampling.is_some_and(|s| s.coverage >= COVERAGE_OK);
-    let replicates = (jackknife || (replicable && covered))
+    let replicates = (jackknife || (replicable && (covered || debias)))
         .then(|| jackknife_replicates(scene, &run.total, &run.groups, estimator))
         .flatten();
+    let debiased = |m: Measure| debias && replicates.is_some() && m.rests_on_corrected_rows();
     let areas = areas(scene);
     let with_replicates = Spread {
         all: &all,
@@ -180,17 +202,37 @@ pub(super) fn visibility_estimates(
         replicates: replicates.as_deref().filter(|_| jackknife),
         ..with_replicates
     };
+    // The bias estimate behind a corrected reading's verdict: the jackknife's estimate of its bias; for a
+    // debiased reading, whose first-order bias is gone, its distance to the debiased plug-in reading
+    // (both free of the 1 / lines term, they part where the higher terms are not small: rows sampled too
+    // thinly for either to be trusted). With Sobol' lines the jackknife also estimates E(MSE)'s bias,
+    // which the multinomial formula overstates.
     let bias = ByMeasure::from_fn(|m| {
         let info = m.info();
-        (info.family == Family::Visibility && info.verdict == VerdictRule::Corrected)
-            .then(|| with_replicates.jackknife_bias(|g| value_of(m, g)))
-            .flatten()
+        if info.family != Family::Visibility {
+            return None;
+        }
+        let jackknife = |m: Measure| with_replicates.jackknife_bias(|g| value_of(m, g));
+        match info.verdict {
+            VerdictRule::Corrected if debiased(m) => {
+                let debiased_value = |m: Measure| with_replicates.debiased(|g| value_of(m, g));
+                Some(debiased_value(m)?.value - debiased_value(plug_in_of(m)?)?.value)
+            }
+            VerdictRule::Corrected => jackknife(m),
+            VerdictRule::Unbiased if debias => jackknife(m),
+            _ => None,
+        }
     });
     let mut estimates = if run.total.counters.lines == 0 {
         exact_only(&areas)
     } else {
         estimates(&areas, &spread, wanted)
     };
+    for m in Measure::of_family(Family::Visibility).filter(|&m| debiased(m)) {
+        if let Some(e) = with_replicates.debiased(|g| value_of(m, g)) {
+            estimates.set(m, Some(e));
+        }
+    }
     let mut environment_area = None;
     if enclose {
         // The environment's area is counted, so H_p has a spread over the groups too.
@@ -220,7 +262,10 @@ pub(super) fn visibility_estimates(
         // Enclosed, the escapes are pairs with the environment: only back sides still lose segments.
         open: c.absorbed > 0 || (c.escapes > 0 && !enclose),
     };
-    let reliability = reliability::verdicts(&estimates, sampling.as_ref(), Some(&bias), facts);
+    let mut reliability = reliability::verdicts(&estimates, sampling.as_ref(), Some(&bias), facts);
+    if debias && replicates.is_none() {
+        reliability::flag_dependent_lines(&mut reliability);
+    }
     VisibilityOfRun {
         estimates,
         sampling,
@@ -231,6 +276,16 @@ pub(super) fn visibility_estimates(
             .map(|d| (d.unsampled_patches, d.unsampled_area_fraction)),
         environment_area,
         jackknifed: spread.replicates.is_some(),
+        debiased: debias && replicates.is_some(),
+    }
+}
+
+/// The plug-in reading a corrected visibility reading corrects.
+fn plug_in_of(m: Measure) -> Option<Measure> {
+    match m {
+        Measure::EntropyCorrected => Some(Measure::Entropy),
+        Measure::MutualInformationCorrected => Some(Measure::MutualInformation),
+        _ => None,
     }
 }
 

@@ -99,6 +99,7 @@ pub fn run_spec(cell: &Cell, seed: u64) -> RunSpec {
             radiosity: false,
         },
     };
+    spec.sampler = cell.sampler;
     spec.budget.target = cell.target.map(|t| Target {
         measure: t.measure,
         stderr: t.stderr,

@@ -9,6 +9,7 @@ use std::ops::Range;
 
 use super::scenes::CalibrationScene;
 use crate::measure::Measure;
+use crate::sample::lines::Sampler;
 use crate::scenes::solids::Solid;
 
 /// Which measures a cell's runs compute.
@@ -45,6 +46,8 @@ pub struct Cell {
     pub measures: CellMeasures,
     /// A precision target: each run stops when the watched standard error is reached on an `ok` reading.
     pub target: Option<CellTarget>,
+    /// How the runs draw their lines (`scx analyze --sampler`).
+    pub sampler: Sampler,
 }
 
 impl Cell {
@@ -57,7 +60,13 @@ impl Cell {
             seeds,
             measures: CellMeasures::All,
             target: None,
+            sampler: Sampler::Independent,
         }
+    }
+
+    /// The same cell with lines drawn by `sampler`.
+    pub fn with_sampler(self, sampler: Sampler) -> Cell {
+        Cell { sampler, ..self }
     }
 
     /// The same cell with a precision target on `measure` (and `lines` as the cap).
@@ -81,9 +90,10 @@ impl Cell {
         self.first_seed..self.first_seed + self.seeds
     }
 
-    /// How its lines read in a table: the count, or the target and the cap.
+    /// How its lines read in a table: the count, or the target and the cap; and the sampler when it is
+    /// not the default.
     pub fn lines_label(&self) -> String {
-        match self.target {
+        let lines = match self.target {
             None => short_count(self.lines),
             Some(t) => format!(
                 "target se {} on {}, cap {}",
@@ -91,6 +101,10 @@ impl Cell {
                 t.measure.key(),
                 short_count(self.lines)
             ),
+        };
+        match self.sampler {
+            Sampler::Independent => lines,
+            other => format!("{lines} {}", other.name()),
         }
     }
 }

@@ -11,7 +11,7 @@ use scene_complexity::{
     remaining_lines, start, Budget, CastOptions, Measures, RunControl, RunIdentity, RunSpec,
     RunState, SceneRef, Scope, Shard, StopReason, Target,
 };
-use scene_complexity::{LineSource, MAX_BUNDLE_GRID};
+use scene_complexity::{LineSource, Sampler, MAX_BUNDLE_GRID};
 
 use super::args::{
     parse_count, parse_positive, parse_seconds, parse_whole_in, target_measure_parser,
@@ -54,6 +54,12 @@ pub struct AnalyzeArgs {
     /// packets); 0 casts independent lines. The standard errors include the correlation within a bundle.
     #[arg(long, default_value_t = 0, value_parser = parse_bundle)]
     bundle: u32,
+    /// How the lines are drawn: `independent` (each line on its own), or `sobol` (randomised
+    /// quasi-Monte Carlo: one Owen-scrambled Sobol' sequence per standard-error group, lines that cover
+    /// the space of lines more evenly; not with --bundle). docs/sampling.md says for which measures it
+    /// pays.
+    #[arg(long, default_value = "independent", value_parser = parse_sampler)]
+    sampler: Sampler,
     /// Close an open scene with a virtual, absorbing environment patch (the bounding sphere, facing
     /// inwards): escaping segments become pairs with it, rows of F sum to 1, and every visibility measure
     /// is that of the enclosed scene. Its area is counted: the part of the sphere that sees the scene's
@@ -92,7 +98,7 @@ pub struct AnalyzeArgs {
     /// and --threads may differ from the first run's: they change no number.
     #[arg(long, value_name = "FILE", conflicts_with_all = [
         "seed", "groups", "estimator", "errors", "measures", "seconds", "target_stderr",
-        "target_measure", "bundle", "enclose", "shard", "planarity", "strict_planarity",
+        "target_measure", "bundle", "sampler", "enclose", "shard", "planarity", "strict_planarity",
         "flip_normals", "two_sided"])]
     resume: Option<PathBuf>,
     #[command(flatten)]
@@ -154,6 +160,10 @@ fn parse_bundle(s: &str) -> Result<u32, String> {
     LineSource::bundles(g).map(|_| g).map_err(|e| e.to_string())
 }
 
+fn parse_sampler(s: &str) -> Result<Sampler, String> {
+    Sampler::from_name(s).ok_or_else(|| format!("`{s}`: expected independent or sobol"))
+}
+
 /// The spec of a new run from the arguments: the command line, parsed once.
 fn spec_of(args: &AnalyzeArgs) -> Result<RunSpec, Failure> {
     let measures = match &args.measures {
@@ -171,6 +181,13 @@ fn spec_of(args: &AnalyzeArgs) -> Result<RunSpec, Failure> {
             stderr,
         }),
     };
+    if args.sampler == Sampler::Sobol && args.bundle > 0 {
+        return Err(Failure::bad_input(format!(
+            "--sampler sobol draws single lines (each a point of a randomised Sobol' sequence) and does \
+             not take --bundle {}: drop one of them",
+            args.bundle
+        )));
+    }
     let lines = args.lines.unwrap_or(if budget.is_open_ended() {
         1_000_000_000_000
     } else {
@@ -180,6 +197,7 @@ fn spec_of(args: &AnalyzeArgs) -> Result<RunSpec, Failure> {
         measures,
         budget,
         source: LineSource::bundles(args.bundle).map_err(Failure::bad_input)?,
+        sampler: args.sampler,
         enclose: args.enclose,
         per_patch: args.files.wants_per_patch(),
         ..args.run.spec(lines, args.run.seed.value)

@@ -7,7 +7,7 @@ use std::time::Instant;
 use scene_complexity::calibrate::{
     self, report, suite, CalibrationScene, Cell, CellMeasures, CellReport, CellTarget, SuiteLevel,
 };
-use scene_complexity::Measure;
+use scene_complexity::{Measure, Sampler};
 
 use super::args::{
     parse_count, parse_positive, parse_seed, parse_whole_in, target_measure_parser, ReportOutput,
@@ -51,6 +51,10 @@ pub struct CalibrateArgs {
     /// The measure the target watches.
     #[arg(long, default_value = Measure::DEFAULT_TARGET.key(), value_parser = target_measure_parser())]
     target_measure: Measure,
+    /// How the runs draw their lines, for every cell (the suite's or `--scene`'s): `independent` or
+    /// `sobol` (`scx analyze --sampler`).
+    #[arg(long, default_value = "independent", value_parser = parse_sampler)]
+    sampler: Sampler,
     /// Print the cells and exit.
     #[arg(long)]
     list: bool,
@@ -89,10 +93,17 @@ fn parse_measures(s: &str) -> Result<CellMeasures, String> {
     }
 }
 
+fn parse_sampler(s: &str) -> Result<Sampler, String> {
+    Sampler::from_name(s).ok_or_else(|| format!("`{s}`: expected independent or sobol"))
+}
+
 /// The cells the arguments ask for.
 fn cells(args: &CalibrateArgs) -> Vec<Cell> {
     if args.scene.is_empty() {
-        return suite(args.suite.unwrap_or(SuiteLevel::Small));
+        return suite(args.suite.unwrap_or(SuiteLevel::Small))
+            .into_iter()
+            .map(|c| c.with_sampler(args.sampler))
+            .collect();
     }
     let target = args.target_stderr.map(|stderr| CellTarget {
         measure: args.target_measure,
@@ -108,6 +119,7 @@ fn cells(args: &CalibrateArgs) -> Vec<Cell> {
                 seeds: args.seeds,
                 measures: args.measures,
                 target,
+                sampler: args.sampler,
             })
         })
         .collect()

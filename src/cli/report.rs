@@ -15,7 +15,7 @@ use scene_complexity::{
     Analysis, LinesAdvice, RadiosityOutcome, Reliability, SamplingReport, TargetOutcome, Verdict,
     COVERAGE_OK,
 };
-use scene_complexity::{ErrorMethod, Shard, StopReason, Tracing};
+use scene_complexity::{ErrorMethod, Sampler, Shard, StopReason, Tracing};
 use scene_complexity::{Estimate, Family, Measure};
 
 use super::table::{fixed, Align, Table};
@@ -194,10 +194,10 @@ pub fn table(run: &RunInfo, a: &Analysis) -> String {
         s,
         "lines    {}{}  seed {}  tracer {} ({})  threads {}  {:.3} s  ({:.2} M lines/s)",
         a.lines,
-        if bundle(a) > 0 {
-            format!(" in bundles of {0} x {0}", bundle(a))
-        } else {
-            String::new()
+        match (bundle(a), a.spec.sampler) {
+            (0, Sampler::Sobol) => " (sobol: randomised quasi-Monte Carlo)".to_string(),
+            (0, Sampler::Independent) => String::new(),
+            (grid, _) => format!(" in bundles of {grid} x {grid}"),
         },
         a.spec.seed,
         run.tracing.backend.name(),
@@ -340,6 +340,15 @@ pub fn table(run: &RunInfo, a: &Analysis) -> String {
             "bundles: the corrections infer unseen patch pairs as if the lines were independent; the lines \
              of a bundle repeat their neighbours' pairs, which can shift the corrected values (the plug-in \
              values, I_s^c and E(MSE) stay unbiased)."
+        );
+    }
+    if a.spec.sampler == Sampler::Sobol && a.estimate(Measure::MutualInformationCorrected).is_some()
+    {
+        let _ = writeln!(
+            s,
+            "sobol: the estimator's corrections assume independent lines; the corrected readings are its \
+             values less the delete-a-group jackknife's estimate of their bias, with the jackknife's \
+             standard errors, or flagged where there is no jackknife (docs/sampling.md)."
         );
     }
     if let Some(t) = &a.target {

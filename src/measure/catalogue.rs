@@ -467,6 +467,17 @@ impl Measure {
         self.info().key
     }
 
+    /// Whether the reading rests on bias-corrected row entropies: a corrected reading, or a ratio to
+    /// I_s^c of one. Their corrections assume each row a multinomial sample, which independent lines
+    /// give and randomised quasi-Monte Carlo lines do not.
+    pub const fn rests_on_corrected_rows(self) -> bool {
+        match self.info().verdict {
+            VerdictRule::Corrected => true,
+            VerdictRule::RatioOf { of, .. } => matches!(of.info().verdict, VerdictRule::Corrected),
+            _ => false,
+        }
+    }
+
     /// The measures of `family`, in report order.
     pub fn of_family(family: Family) -> impl Iterator<Item = Measure> {
         Measure::ALL

@@ -168,6 +168,7 @@ pub fn json(run: &Context, a: &Analysis) -> Value {
         "tracer": run.tracing.backend.name(),
         "query": run.tracing.query.to_string(),
         "bundle": bundle(a),
+        "sampler": a.spec.sampler.name(),
         "lines": a.lines,
         "seed": a.spec.seed,
         "threads": run.process.as_ref().map(|p| p.threads),

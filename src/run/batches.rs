@@ -5,7 +5,7 @@
 use rayon::prelude::*;
 
 use super::plan::BatchPlan;
-use crate::sample::lines::LineSource;
+use crate::sample::lines::{sobol_lines, LineSource, Sampler};
 use crate::trace::{Line, LineHits, RawHit, TraceError, Tracer};
 
 /// The lines of a run: its batch plan, where its lines come from, and the seed of their streams. A
@@ -16,6 +16,11 @@ pub struct LineStream {
     pub plan: BatchPlan,
     /// Independent lines or bundles (`plan` must hold whole bundles, [`BatchPlan::for_source`]).
     pub source: LineSource,
+    /// Independent lines, or one randomised Sobol' sequence per group (then `source` is
+    /// [`LineSource::Independent`]: [`crate::run::RunSpec::check`]).
+    pub sampler: Sampler,
+    /// The run's standard-error groups: batch `b` belongs to group `b mod groups`.
+    pub groups: u64,
     /// Seed of the streams.
     pub seed: u64,
 }
@@ -27,14 +32,31 @@ impl LineStream {
         LineStream {
             plan: BatchPlan::new(lines),
             source: LineSource::Independent,
+            sampler: Sampler::Independent,
+            groups: crate::run::DEFAULT_GROUPS as u64,
             seed,
         }
     }
 
-    /// Appends batch `batch`'s lines to `out` (tracing space, bounding radius `radius`).
+    /// Appends batch `batch`'s lines to `out` (tracing space, bounding radius `radius`). With the Sobol'
+    /// sampler, batch `b` is the `k`-th batch of group `g = b mod G` (`k = b / G`) and takes points
+    /// `k * batch_size ..` of that group's sequence: a group's lines are a prefix of one
+    /// low-discrepancy sequence, whichever batches a thread, shard or resume draws.
     pub fn draw(&self, batch: u64, radius: f64, out: &mut Vec<Line>) {
-        self.source
-            .batch_lines(self.seed, batch, self.plan.batch_len(batch), radius, out);
+        let count = self.plan.batch_len(batch);
+        match self.sampler {
+            Sampler::Independent => {
+                self.source
+                    .batch_lines(self.seed, batch, count, radius, out);
+            }
+            Sampler::Sobol => {
+                debug_assert_eq!(self.source, LineSource::Independent, "checked by the spec");
+                let groups = self.groups.max(1);
+                let (group, k) = (batch % groups, batch / groups);
+                let first = k * self.plan.batch_size;
+                sobol_lines(self.seed, group, first, count, radius, out);
+            }
+        }
     }
 }
 

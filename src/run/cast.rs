@@ -9,7 +9,7 @@ use std::time::{Duration, Instant};
 use super::batches::LineStream;
 use super::control::{RunControl, StopReason};
 use super::plan::{BatchPlan, BatchSet, MAX_ROUND_KEYS, MAX_ROUND_LINES};
-use super::spec::RunSpec;
+use super::spec::{RunSpec, SpecError};
 use super::state::{RunState, TracedBatches};
 use crate::measure::radiosity::{MaterialError, PatchMaterials};
 use crate::sample::tally::Wanted;
@@ -56,9 +56,21 @@ fn gathered(scene: &Scene, cfg: &RunSpec) -> Result<Wanted, MaterialError> {
     })
 }
 
-/// The empty state of a run of `cfg` on `scene`, checked before any line is cast (the materials, when
-/// radiosity is asked for).
-pub fn start(scene: &Scene, cfg: &RunSpec) -> Result<RunState, MaterialError> {
+/// Why a run cannot start.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum StartError {
+    /// A material outside the physical range (radiosity asked for).
+    #[error(transparent)]
+    Material(#[from] MaterialError),
+    /// Settings that contradict each other.
+    #[error(transparent)]
+    Spec(#[from] SpecError),
+}
+
+/// The empty state of a run of `cfg` on `scene`, checked before any line is cast (its settings, and the
+/// materials when radiosity is asked for).
+pub fn start(scene: &Scene, cfg: &RunSpec) -> Result<RunState, StartError> {
+    cfg.check()?;
     Ok(RunState::new(
         cfg.plan(),
         cfg.group_count(),
@@ -151,6 +163,8 @@ pub fn cast(
     let stream = LineStream {
         plan,
         source: cfg.source,
+        sampler: cfg.sampler,
+        groups: state.group_count(),
         seed: cfg.seed,
     };
     // A budget longer than the clock can count (`--seconds 1e30`) is no limit: the run ends with its

@@ -28,11 +28,14 @@ pub mod state;
 
 pub use batches::{all_batches, map_batches, map_traced_batches, Batch, LineStream, TraceBuffers};
 pub use cast::{
-    cast, remaining_lines, start, CastHooks, CastOptions, Scope, Shard, TargetReading, TargetWatch,
+    cast, remaining_lines, start, CastHooks, CastOptions, Scope, Shard, StartError, TargetReading,
+    TargetWatch,
 };
 pub use control::{Budget, RunControl, StopReason, Target};
 pub use errors::{ErrorMethod, Spread};
 pub use persist::{PersistError, RunIdentity, SavedRun, SceneRef, Tracing};
 pub use plan::{BatchPlan, BatchSet};
-pub use spec::{ExtendError, Measures, RunSpec, SpecDifference, DEFAULT_ESTIMATOR, DEFAULT_GROUPS};
+pub use spec::{
+    ExtendError, Measures, RunSpec, SpecDifference, SpecError, DEFAULT_ESTIMATOR, DEFAULT_GROUPS,
+};
 pub use state::{FinishedRun, MergeError, MissingLines, RunState, StateParts, TracedBatches};

@@ -931,6 +931,7 @@ mod tests {
     use super::*;
     use crate::run::control::RunControl;
     use crate::run::{cast, start, CastHooks, CastOptions};
+    use crate::sample::lines::Sampler;
     use crate::trace::{make_tracer, Backend, Query};
 
     /// A state saved and read back reports the same numbers, bit for bit; a truncated file, a flipped
@@ -1154,6 +1155,46 @@ mod tests {
         let (a, b) = (state.finish(&scene), old.state.finish(&scene));
         assert_eq!(a.total.counters, b.total.counters);
         assert!(b.total.kernel_by_patch.is_none());
+    }
+
+    /// A state written before the sampler was part of a run's spec (no `sampler` field) loads as a run of
+    /// independent lines; a state with its field names the sampler it was drawn with.
+    #[test]
+    fn states_without_a_sampler_load_as_independent_lines() {
+        let cfg = RunSpec::new(20_000, 2);
+        let (scene, state) = cube_run(&cfg);
+        let tracing = Tracing {
+            backend: Backend::Rust,
+            query: Query::Single,
+        };
+        let scene_ref = SceneRef::of("@cube:3", &SceneOptions::default(), &scene);
+        let identity = RunIdentity::new(scene_ref.clone(), cfg.clone(), None, tracing);
+        let bytes = encode(&identity, &state, 1.0);
+        let mut doc: ciborium::Value = ciborium::from_reader(&bytes[HEADER..]).unwrap();
+        let spec = doc
+            .as_map_mut()
+            .unwrap()
+            .iter_mut()
+            .find(|(k, _)| k.as_text() == Some("identity"))
+            .and_then(|(_, v)| v.as_map_mut())
+            .and_then(|m| m.iter_mut().find(|(k, _)| k.as_text() == Some("spec")))
+            .and_then(|(_, v)| v.as_map_mut())
+            .unwrap();
+        let before = spec.len();
+        spec.retain(|(k, _)| k.as_text() != Some("sampler"));
+        assert_eq!(spec.len(), before - 1, "the spec had its sampler");
+        let mut payload = Vec::new();
+        ciborium::into_writer(&doc, &mut payload).unwrap();
+        let old = decode("old.scx", &framed(&payload)).unwrap();
+        assert_eq!(old.identity().spec.sampler, Sampler::Independent);
+        assert_eq!(old.identity().spec, cfg);
+        let sobol = RunSpec {
+            sampler: Sampler::Sobol,
+            ..cfg
+        };
+        let identity = RunIdentity::new(scene_ref, sobol.clone(), None, tracing);
+        let read = decode("s.scx", &encode(&identity, &state, 1.0)).unwrap();
+        assert_eq!(read.identity().spec, sobol);
     }
 
     /// The state of an enclosed run of the open `@cornell-open:2` with per-patch sums, its scene, its

@@ -14,7 +14,7 @@ use super::errors::ErrorMethod;
 use super::plan::BatchPlan;
 use crate::measure::estimators::EntropyEstimator;
 use crate::measure::radiosity::SolveOptions;
-use crate::sample::lines::LineSource;
+use crate::sample::lines::{LineSource, Sampler};
 
 /// Default number of independent groups of lines behind every standard error.
 pub const DEFAULT_GROUPS: usize = 16;
@@ -65,6 +65,11 @@ pub struct RunSpec {
     /// Independent lines, or bundles of parallel lines ([`LineSource`]); a bundle never straddles two
     /// batches, so the group spread includes the correlation within a bundle.
     pub source: LineSource,
+    /// Independent lines, or randomised quasi-Monte Carlo lines: one scrambled Sobol' sequence per
+    /// standard-error group ([`Sampler`]; not with bundles). Absent from states saved before it existed,
+    /// which read as independent lines.
+    #[serde(default)]
+    pub sampler: Sampler,
     /// Groups for the standard errors ([`super::errors`]).
     pub groups: usize,
     /// Which measures to compute.
@@ -95,6 +100,7 @@ impl RunSpec {
             lines,
             seed,
             source: LineSource::Independent,
+            sampler: Sampler::Independent,
             groups: DEFAULT_GROUPS,
             measures: Measures::ALL,
             estimator: DEFAULT_ESTIMATOR,
@@ -103,6 +109,14 @@ impl RunSpec {
             budget: Budget::default(),
             solve: SolveOptions::default(),
             per_patch: false,
+        }
+    }
+
+    /// Whether the settings go together: the Sobol' sampler draws single lines, not bundles.
+    pub fn check(&self) -> Result<(), SpecError> {
+        match (self.sampler, self.source) {
+            (Sampler::Sobol, LineSource::Bundles { grid }) => Err(SpecError::SobolBundles { grid }),
+            _ => Ok(()),
         }
     }
 
@@ -236,6 +250,20 @@ fn in_words(v: &serde_json::Value) -> String {
             .collect::<Vec<_>>()
             .join(", "),
     }
+}
+
+/// Settings of a run that contradict each other.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum SpecError {
+    /// The Sobol' sampler with bundles.
+    #[error(
+        "the sobol sampler draws single lines, each a point of one randomised Sobol' sequence, and does \
+         not take bundles (asked: bundles of {grid} x {grid}); use independent lines for bundles"
+    )]
+    SobolBundles {
+        /// The bundle grid asked for.
+        grid: u32,
+    },
 }
 
 /// Why a run cannot be continued to more lines.

@@ -16,5 +16,6 @@ pub mod lines;
 mod order;
 pub mod pairs;
 pub mod patch_counts;
+pub mod sobol;
 pub mod sparse;
 pub mod tally;

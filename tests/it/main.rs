@@ -17,6 +17,7 @@ mod radiosity;
 mod render;
 mod report;
 mod rust_bvh;
+mod sampler;
 mod scene_files;
 mod stability;
 mod visibility;
