@@ -3,7 +3,7 @@
 use std::path::Path;
 
 use scene_complexity::{
-    load_stream, load_with_policy, read_guarded, ReadPolicy, Scene, SceneError, SceneOptions,
+    load_stream, load_with_policy, read_guarded, ReadPolicy, Scene, SceneOptions,
 };
 
 use super::exit::Failure;
