@@ -9,8 +9,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyString;
 
 use scene_complexity::{
-    load_with_policy, write_scene, Material, ReadPolicy, SceneBuilder, SceneError as LibSceneError,
-    SceneOptions, CATALOGUE,
+    load_with_policy, write_scene, Material, ReadPolicy, SceneBuilder, SceneOptions, CATALOGUE,
 };
 
 use crate::args::{self, repr};
