@@ -22,7 +22,7 @@ mod pcg_lanes;
 use rand::RngCore;
 use rand_pcg::Pcg64;
 
-use super::sobol::ScrambledSobol;
+use super::sobol::{splitmix64, ScrambledSobol};
 use crate::geom::{orthonormal_basis, uniform01, unit_from_draw, DVec3};
 use crate::trace::Line;
 use pcg_lanes::{PcgLanes, LANES};
@@ -472,14 +472,6 @@ fn point_in_unit_disc(rng: &mut impl RngCore) -> DiscPoint {
     }
 }
 
-/// SplitMix64's finaliser: spreads a seed over all 64 bits.
-fn splitmix64(x: u64) -> u64 {
-    let mut z = x.wrapping_add(0x9e37_79b9_7f4a_7c15);
-    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-    z ^ (z >> 31)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -589,7 +581,13 @@ mod tests {
     fn lines_span_the_sphere() {
         let mut lines = Vec::new();
         batch_lines(1, 0, 1000, 1.0, &mut lines);
-        for l in &lines {
+        assert_lines_cross_the_unit_sphere(&lines);
+    }
+
+    /// Each line has a unit direction and runs from outside the unit sphere to outside it on the other
+    /// side.
+    fn assert_lines_cross_the_unit_sphere(lines: &[Line]) {
+        for l in lines {
             let d = l.dir.map(f64::from);
             let o = l.origin.map(f64::from);
             let dn = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
@@ -633,16 +631,7 @@ mod tests {
     fn sobol_lines_span_the_sphere_and_are_reproducible() {
         let mut lines = Vec::new();
         sobol_lines(1, 0, 0, 1000, 1.0, &mut lines);
-        for l in &lines {
-            let d = l.dir.map(f64::from);
-            let o = l.origin.map(f64::from);
-            let dn = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
-            assert!((dn - 1.0).abs() < 1e-6);
-            let on = (o[0] * o[0] + o[1] * o[1] + o[2] * o[2]).sqrt();
-            assert!(on >= 1.0);
-            let end = [0, 1, 2].map(|a| o[a] + l.t_max as f64 * d[a]);
-            assert!((end[0] * end[0] + end[1] * end[1] + end[2] * end[2]).sqrt() >= 1.0);
-        }
+        assert_lines_cross_the_unit_sphere(&lines);
         let mut again = Vec::new();
         sobol_lines(1, 0, 500, 500, 1.0, &mut again);
         assert_eq!(

@@ -181,8 +181,9 @@ pub fn unit(digits: u64) -> f64 {
     (digits >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
 }
 
-/// SplitMix64's finaliser.
-fn splitmix64(x: u64) -> u64 {
+/// SplitMix64's finaliser: spreads a seed over all 64 bits (the scrambles' seeds, and the
+/// independent sampler's per-batch streams).
+pub(crate) fn splitmix64(x: u64) -> u64 {
     let mut z = x.wrapping_add(0x9e37_79b9_7f4a_7c15);
     z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
     z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
