@@ -555,23 +555,12 @@ fn threads_or_all(py: Python<'_>, threads: Option<&Bound<'_, PyAny>>) -> PyResul
     }
 }
 
-/// Refuses a state given twice (by the same name, or by two names of one file).
+/// Refuses a state given twice (`files::repeated_path`).
 fn check_distinct(paths: &[PathBuf]) -> PyResult<()> {
-    let real = |p: &PathBuf| std::fs::canonicalize(p).unwrap_or_else(|_| p.clone());
-    for (k, path) in paths.iter().enumerate() {
-        if let Some(first) = paths[..k].iter().find(|q| real(q) == real(path)) {
-            let also = if first == path {
-                String::new()
-            } else {
-                format!(" (as {} and {})", first.display(), path.display())
-            };
-            return Err(bad_argument(format!(
-                "{} is given twice{also}: name each state once",
-                path.display()
-            )));
-        }
+    match scene_complexity::files::repeated_path(paths) {
+        Some(message) => Err(bad_argument(message)),
+        None => Ok(()),
     }
-    Ok(())
 }
 
 /// Joins the saved states of a run's shards (or of any parts of one run) into the analysis of the whole

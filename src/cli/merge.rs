@@ -107,24 +107,12 @@ fn merged(files: Vec<StateFile>, scene: &Scene) -> Result<Merged, Failure> {
     })
 }
 
-/// Refuses a state given twice (by the same name, or by two names of one file: `./s.scx`, a link),
-/// naming it: its batches would otherwise show up as an overlap of the file with itself.
+/// Refuses a state given twice ([`scene_complexity::files::repeated_path`]).
 fn check_states_distinct(states: &[PathBuf]) -> Result<(), Failure> {
-    let real = |p: &PathBuf| std::fs::canonicalize(p).unwrap_or_else(|_| p.clone());
-    for (k, path) in states.iter().enumerate() {
-        if let Some(first) = states[..k].iter().find(|q| real(q) == real(path)) {
-            let also = if first == path {
-                String::new()
-            } else {
-                format!(" (as {} and {})", first.display(), path.display())
-            };
-            return Err(Failure::bad_input(format!(
-                "{} is given twice{also}: name each state once",
-                path.display()
-            )));
-        }
+    match scene_complexity::files::repeated_path(states) {
+        Some(message) => Err(Failure::bad_input(message)),
+        None => Ok(()),
     }
-    Ok(())
 }
 
 /// Warns about each state that a live run still holds (its `FILE.lock` names a process that is

@@ -12,6 +12,25 @@ use std::fs::{File, OpenOptions};
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 
+/// The first path named twice in `paths`, by the same name or by two names of one file (`./s.scx`, a
+/// link), as a message naming it: a state given twice to a merge would otherwise show up as an overlap
+/// of the file with itself.
+pub fn repeated_path(paths: &[PathBuf]) -> Option<String> {
+    let real = |p: &PathBuf| std::fs::canonicalize(p).unwrap_or_else(|_| p.clone());
+    paths.iter().enumerate().find_map(|(k, path)| {
+        let first = paths[..k].iter().find(|q| real(q) == real(path))?;
+        let also = if first == path {
+            String::new()
+        } else {
+            format!(" (as {} and {})", first.display(), path.display())
+        };
+        Some(format!(
+            "{} is given twice{also}: name each state once",
+            path.display()
+        ))
+    })
+}
+
 /// Where the bytes meant for a path go.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub enum Destination {
