@@ -248,9 +248,7 @@ pub(super) fn visibility_estimates(
         let lines_for_coverage = all.lines_factor.map(|k| lines_for(k, lines));
         // From half the lines only when there is advice to check.
         let half = match all.lines_factor {
-            Some(k) if k > 1.0 => {
-                half_run_lines_for_coverage(scene, &run.groups, estimator, enclose)
-            }
+            Some(k) if k > 1.0 => half_run_lines_for_coverage(scene, run, estimator, enclose),
             _ => HalfRun::NotComputed,
         };
         SamplingReport::new(sampling, lines, lines_for_coverage, half)
@@ -300,29 +298,40 @@ fn lines_for(k: f64, lines: u64) -> u64 {
 /// settled ([`SamplingReport::advice`]). Not computed with fewer than 2 groups or without pair counts.
 fn half_run_lines_for_coverage(
     scene: &Scene,
-    groups: &[Tally],
+    run: &FinishedRun,
     estimator: EntropyEstimator,
     enclose: bool,
 ) -> HalfRun {
-    let Some((first, rest)) = groups[..groups.len() / 2].split_first() else {
+    let (Some(counts), Some((first, rest))) = (
+        run.first_half.as_ref(),
+        run.groups[..run.groups.len() / 2].split_first(),
+    ) else {
         return HalfRun::NotComputed;
     };
-    if first.counts.is_none() {
-        return HalfRun::NotComputed;
-    }
     // The per-patch sums of eq. (27) play no part in the coverage.
     let mut half = Tally {
         counters: first.counters,
         orientation: first.orientation.clone(),
         escapes_by_patch: first.escapes_by_patch.clone(),
         absorbed_by_patch: first.absorbed_by_patch.clone(),
-        counts: first.counts.clone(),
+        counts: None,
         kernel_by_patch: None,
     };
     for g in rest {
         half.merge(g);
     }
-    match GroupValues::of(scene, &half, estimator, enclose, true).lines_factor {
+    let factor = if enclose {
+        half.counts = Some(counts.clone());
+        GroupValues::of(scene, &half, estimator, enclose, true).lines_factor
+    } else {
+        // Only the rows' integer sums: the same coverage as every sum's, read from the half's counts
+        // where they are.
+        let a = channel::area_distribution(&areas(scene));
+        let a = a.as_slice().expect("a fresh array is contiguous");
+        let rows = Rows::outcome_frequencies(a.len(), counts, &half.lost_by_patch());
+        lines_factor_for_coverage(a, &rows, COVERAGE_OK)
+    };
+    match factor {
         Some(k) => HalfRun::Lines(lines_for(k, half.counters.lines)),
         None => HalfRun::BeyondReach,
     }

@@ -102,13 +102,18 @@ impl OutcomeTable {
 }
 
 impl RowSums {
-    fn add_patch_outcome(&mut self, x: u64, log2_area: f64, table: &OutcomeTable) {
-        let (x_log2_x, x_kernel) = table.of(x);
-        let xf = x as f64;
+    /// Counts one outcome seen `x` times in the integer sums only.
+    fn count_outcome(&mut self, x: u64) {
         self.segments += x;
         self.seen += 1;
         self.singletons += u64::from(x == 1);
         self.doubletons += u64::from(x == 2);
+    }
+
+    fn add_patch_outcome(&mut self, x: u64, log2_area: f64, table: &OutcomeTable) {
+        let (x_log2_x, x_kernel) = table.of(x);
+        let xf = x as f64;
+        self.count_outcome(x);
         self.x_log2_x += x_log2_x;
         self.x_squared += xf * xf;
         self.x_log2_area += xf * log2_area;
@@ -142,11 +147,8 @@ impl RowSums {
         if e == 0 {
             return;
         }
-        self.segments += e;
+        self.count_outcome(e);
         self.escapes += e;
-        self.seen += 1;
-        self.singletons += u64::from(e == 1);
-        self.doubletons += u64::from(e == 2);
         self.x_kernel += table.of(e).1;
     }
 
@@ -266,6 +268,30 @@ impl Rows {
         Rows { estimator, sums }
     }
 
+    /// Every row's integer sums alone (segments, escapes, outcomes seen, seen once, seen twice; the
+    /// floating-point sums left 0) over `rows` patches: as many as [`Rows::gather`]'s and all that a
+    /// row's coverage reads ([`crate::measure::sampling::lines_factor_for_coverage`]), at a fraction of
+    /// its cost.
+    pub fn outcome_frequencies(rows: usize, counts: &PairCounts, escapes: &[u64]) -> Vec<RowSums> {
+        let mut sums = vec![RowSums::default(); rows.max(escapes.len())];
+        counts.for_each(|i, j, c| {
+            let (i, j) = (i as usize, j as usize);
+            if i == j {
+                sums[i].count_outcome(2 * c);
+            } else {
+                sums[i].count_outcome(c);
+                sums[j].count_outcome(c);
+            }
+        });
+        for (row, &e) in sums.iter_mut().zip(escapes) {
+            if e > 0 {
+                row.count_outcome(e);
+                row.escapes += e;
+            }
+        }
+        sums
+    }
+
     /// The rows of `total` without one group's share of it (`group` with its escapes, a part of
     /// `total`): each of the group's outcomes is lowered by its count. This is a leave-one-group-out
     /// replicate of the delete-a-group jackknife ([`crate::measure::estimate::Estimate::from_jackknife`]),
@@ -340,6 +366,51 @@ mod tests {
                 pair_key(i, j)
             })
             .collect()
+    }
+
+    /// A row's integer sums counted straight from the keys (a map of outcomes per row, a segment from a
+    /// patch to itself twice), in both count layouts, with escapes; and the same as a full gather's.
+    #[test]
+    fn outcome_frequencies_count_each_rows_outcomes() {
+        use std::collections::BTreeMap;
+        for patches in [40u32, 3000] {
+            let n = patches as usize;
+            let mut ks = keys(3, 20_000, patches);
+            let counts = PairCounts::from_keys(n, &mut ks.clone());
+            let escapes: Vec<u64> = (0..n as u64)
+                .map(|i| [0, 1, 2, 5][(i % 4) as usize])
+                .collect();
+            let mut outcomes = vec![BTreeMap::<u64, u64>::new(); n];
+            for k in ks.drain(..) {
+                let (i, j) = crate::sample::counts::split_key(k);
+                let (i, j) = (i as usize, j as usize);
+                *outcomes[i].entry(j as u64).or_default() += 1;
+                *outcomes[j].entry(i as u64).or_default() += 1;
+            }
+            let rows = Rows::outcome_frequencies(n, &counts, &escapes);
+            let a = vec![1.0 / n as f64; n];
+            let gathered = Rows::gather(&a, &counts, &escapes, EntropyEstimator::ChaoWangJost);
+            for i in 0..n {
+                let mut xs: Vec<u64> = outcomes[i].values().copied().collect();
+                if escapes[i] > 0 {
+                    xs.push(escapes[i]);
+                }
+                let expected = (
+                    xs.iter().sum::<u64>(),
+                    escapes[i],
+                    xs.len() as u64,
+                    xs.iter().filter(|&&x| x == 1).count() as u64,
+                    xs.iter().filter(|&&x| x == 2).count() as u64,
+                );
+                let of = |r: &RowSums| (r.segments, r.escapes, r.seen, r.singletons, r.doubletons);
+                assert_eq!(of(&rows[i]), expected, "{patches} patches, row {i}");
+                assert_eq!(
+                    of(&gathered.sums[i]),
+                    expected,
+                    "{patches} patches, row {i}"
+                );
+            }
+        }
     }
 
     /// Lowering the total's rows by a group's counts gives the rows of the other groups' counts, for every

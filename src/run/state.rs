@@ -96,6 +96,10 @@ pub struct FinishedRun {
     pub total: Tally,
     /// Each non-empty group, in group order.
     pub groups: Vec<Tally>,
+    /// The pair counts of the first half of [`FinishedRun::groups`] (a run of about half the lines, the
+    /// same whatever the threads, shards or resumes), summed with the total's: for telling whether the
+    /// lines advice has settled. `None` without pair counts or with fewer than 2 groups.
+    pub first_half: Option<PairCounts>,
 }
 
 /// The batches a state lacks of its run ([`RunState::missing_lines`]).
@@ -373,8 +377,20 @@ impl RunState {
             })
             .unwrap_or_else(|| Tally::empty(scene, self.wanted));
         let counts: Vec<&PairCounts> = groups.iter().filter_map(|t| t.counts.as_ref()).collect();
-        total.counts = PairCounts::sum_of(&counts);
-        FinishedRun { total, groups }
+        let mut first_half = None;
+        if counts.len() >= 2 {
+            let (all, half) =
+                PairCounts::sum_and_sum_of_first(&counts, counts.len() / 2).expect("some counts");
+            total.counts = Some(all);
+            first_half = Some(half);
+        } else {
+            total.counts = PairCounts::sum_of(&counts);
+        }
+        FinishedRun {
+            total,
+            groups,
+            first_half,
+        }
     }
 }
 

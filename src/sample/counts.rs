@@ -145,14 +145,38 @@ impl PairCounts {
             parts[1..].iter().for_each(|p| total.merge(p));
             return Some(total);
         }
-        let lists: Vec<&SparseCounts> = parts
-            .iter()
-            .map(|p| match &p.0 {
-                Layout::Sparse(list) => list,
-                Layout::Dense(_) => unreachable!("counts of one scene always share a layout"),
-            })
-            .collect();
+        let lists: Vec<&SparseCounts> = parts.iter().map(|p| p.sparse()).collect();
         Some(PairCounts(Layout::Sparse(SparseCounts::sum_of(&lists))))
+    }
+
+    /// The sum of counts of one scene and, from the same pass, the sum of the first `first` of them
+    /// ([`SparseCounts::sum_and_sum_of_first`]); `None` without any.
+    pub fn sum_and_sum_of_first(
+        parts: &[&PairCounts],
+        first: usize,
+    ) -> Option<(PairCounts, PairCounts)> {
+        let head = *parts.first()?;
+        if let Layout::Dense(_) = head.0 {
+            let firsts = PairCounts::sum_of(&parts[..first.clamp(1, parts.len())])?;
+            let mut all = firsts.clone();
+            parts[first.clamp(1, parts.len())..]
+                .iter()
+                .for_each(|p| all.merge(p));
+            return Some((all, firsts));
+        }
+        let lists: Vec<&SparseCounts> = parts.iter().map(|p| p.sparse()).collect();
+        let (all, firsts) = SparseCounts::sum_and_sum_of_first(&lists, first);
+        Some((
+            PairCounts(Layout::Sparse(all)),
+            PairCounts(Layout::Sparse(firsts)),
+        ))
+    }
+
+    fn sparse(&self) -> &SparseCounts {
+        match &self.0 {
+            Layout::Sparse(list) => list,
+            Layout::Dense(_) => unreachable!("counts of one scene always share a layout"),
+        }
     }
 
     /// Number of distinct unordered pairs seen.
@@ -535,6 +559,44 @@ mod tests {
         let mut dtwice = dense.clone();
         dtwice.merge(&dense);
         assert_eq!(entries(&dtwice), entries(&twice));
+    }
+
+    /// The sum of the first parts, made with the sum of all, in both layouts: the same as merging them
+    /// in turn.
+    #[test]
+    fn the_first_parts_are_summed_with_all() {
+        let mut rng = 77u64;
+        for patches in [300usize, DENSE_MAX_PATCHES + 1] {
+            let parts: Vec<PairCounts> = (0..5)
+                .map(|_| {
+                    let mut keys: Vec<u64> = (0..4000)
+                        .map(|_| {
+                            rng = rng
+                                .wrapping_mul(6364136223846793005)
+                                .wrapping_add(1442695040888963407);
+                            let (a, b) = ((rng >> 33) as u32 % 300, (rng >> 13) as u32 % 300);
+                            pair_key(a, b)
+                        })
+                        .collect();
+                    PairCounts::from_keys(patches, &mut keys)
+                })
+                .collect();
+            let refs: Vec<&PairCounts> = parts.iter().collect();
+            for first in 1..=parts.len() {
+                let (all, firsts) = PairCounts::sum_and_sum_of_first(&refs, first).unwrap();
+                let in_turn = |parts: &[PairCounts]| {
+                    let mut sum = parts[0].clone();
+                    parts[1..].iter().for_each(|p| sum.merge(p));
+                    entries(&sum)
+                };
+                assert_eq!(entries(&all), in_turn(&parts), "{patches}, first {first}");
+                assert_eq!(
+                    entries(&firsts),
+                    in_turn(&parts[..first]),
+                    "{patches}, first {first}"
+                );
+            }
+        }
     }
 
     /// A bucket too large for the cache is split by its top bits first; the result is sorted all the

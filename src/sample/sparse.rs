@@ -319,29 +319,56 @@ impl SparseCounts {
     /// grown as it goes is copied when it outgrows its block, which holds the old and the new one at
     /// once).
     pub fn sum_of(parts: &[&SparseCounts]) -> SparseCounts {
+        SparseCounts::sums(parts, None).0
+    }
+
+    /// The sum of all `parts` and, from the same pass, the sum of the first `first` of them (the
+    /// first half of a run's groups, a run of half its lines): the merge sums each key range's first
+    /// parts and its others apart before adding the two, so the first sum costs only its copy.
+    pub fn sum_and_sum_of_first(
+        parts: &[&SparseCounts],
+        first: usize,
+    ) -> (SparseCounts, SparseCounts) {
+        let (all, firsts) = SparseCounts::sums(parts, Some(first.min(parts.len())));
+        (all, firsts.expect("asked for"))
+    }
+
+    fn sums(parts: &[&SparseCounts], first: Option<usize>) -> (SparseCounts, Option<SparseCounts>) {
         let packing = match parts.first() {
             Some(p) => p.packing,
-            None => return SparseCounts::with_packing(Packing::for_patches(2)),
+            None => {
+                let empty = SparseCounts::with_packing(Packing::for_patches(2));
+                return (empty.clone(), first.map(|_| empty));
+            }
         };
         assert!(
             parts.iter().all(|p| p.packing == packing),
             "counts of one scene"
         );
         let pieces = key_pieces(parts);
-        let bound = parts.iter().map(|p| p.len()).sum();
-        let mut out = SparseCounts::with_capacity(packing, bound);
+        let bound = |parts: &[&SparseCounts]| parts.iter().map(|p| p.len()).sum();
+        let mut out = SparseCounts::with_capacity(packing, bound(parts));
+        let mut out_first = first.map(|k| SparseCounts::with_capacity(packing, bound(&parts[..k])));
         let wave = 8 * rayon::current_num_threads();
         for some in pieces.chunks(wave) {
-            let merged: Vec<SparseCounts> = some
+            let merged: Vec<(SparseCounts, Option<SparseCounts>)> = some
                 .par_iter()
-                .map(|piece| merge_piece(parts, piece))
+                .map(|piece| merge_piece(parts, piece, first))
                 .collect();
-            for m in merged {
-                out.entries.extend_from_slice(&m.entries);
-                out.wide.extend_from_slice(&m.wide);
+            for (m, m_first) in merged {
+                out.append(&m);
+                if let (Some(o), Some(m)) = (&mut out_first, m_first) {
+                    o.append(&m);
+                }
             }
         }
-        out
+        (out, out_first)
+    }
+
+    /// Appends counts of pairs that all come after these ones.
+    fn append(&mut self, later: &SparseCounts) {
+        self.entries.extend_from_slice(&later.entries);
+        self.wide.extend_from_slice(&later.wide);
     }
 
     /// The entries (and side entries) whose packed pairs lie in `from..to`.
@@ -393,9 +420,29 @@ fn key_pieces(parts: &[&SparseCounts]) -> Vec<(u64, u64)> {
     starts.zip(ends).collect()
 }
 
+/// The sum of the parts' entries in one range and, when `first` is given, the sum of the first `first`
+/// parts' entries in it (which the sum of all is then made from).
+fn merge_piece(
+    parts: &[&SparseCounts],
+    piece: &(u64, u64),
+    first: Option<usize>,
+) -> (SparseCounts, Option<SparseCounts>) {
+    let Some(k) = first else {
+        return (merge_tree(parts, piece), None);
+    };
+    let (firsts, others) = (
+        merge_tree(&parts[..k], piece),
+        merge_tree(&parts[k..], piece),
+    );
+    let all = merge_runs(parts[0].packing, firsts.run(), others.run());
+    (all, Some(firsts))
+}
+
 /// The sum of the parts' entries in one range, merged pairwise as a balanced tree.
-fn merge_piece(parts: &[&SparseCounts], &(from, to): &(u64, u64)) -> SparseCounts {
-    let packing = parts[0].packing;
+fn merge_tree(parts: &[&SparseCounts], &(from, to): &(u64, u64)) -> SparseCounts {
+    let Some(packing) = parts.first().map(|p| p.packing) else {
+        return SparseCounts::with_packing(Packing::for_patches(2));
+    };
     let runs: Vec<Run> = parts
         .iter()
         .map(|p| p.slice(from, to))
@@ -660,6 +707,39 @@ mod tests {
         assert!(key_pieces(&refs).len() > 2);
         assert_eq!(sum, expected);
         assert_eq!(SparseCounts::sum_of(&refs[1..2]), parts[1]);
+    }
+
+    /// The sum of the first parts, made in the same pass as the sum of all, is the sum of the first
+    /// parts' maps, and the sum of all unchanged, for every split point (empty parts, side entries and
+    /// several pieces included).
+    #[test]
+    fn the_sum_of_the_first_parts_comes_with_the_sum() {
+        let mut rng = 17;
+        let patches = 1 << 28;
+        let maps: Vec<BTreeMap<(u32, u32), u64>> = [60_000, 0, 30_000, 90_000, 7, 20_000]
+            .iter()
+            .map(|&len| random_map(&mut rng, 4000, len, 1 << 9))
+            .collect();
+        let parts: Vec<SparseCounts> = maps.iter().map(|m| of_map(patches, m)).collect();
+        let refs: Vec<&SparseCounts> = parts.iter().collect();
+        assert!(key_pieces(&refs).len() > 2);
+        let sum_of_maps = |maps: &[BTreeMap<(u32, u32), u64>]| {
+            let mut sum = BTreeMap::new();
+            for (&k, &c) in maps.iter().flatten() {
+                *sum.entry(k).or_insert(0) += c;
+            }
+            sum
+        };
+        for first in 1..=parts.len() {
+            let (all, firsts) = SparseCounts::sum_and_sum_of_first(&refs, first);
+            assert_eq!(to_map(&all), sum_of_maps(&maps), "all, first {first}");
+            assert_eq!(all, SparseCounts::sum_of(&refs), "first {first}");
+            assert_eq!(
+                to_map(&firsts),
+                sum_of_maps(&maps[..first]),
+                "first {first}"
+            );
+        }
     }
 
     /// A field that fills up only when two counts are added spills into the side list.
