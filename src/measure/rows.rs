@@ -17,6 +17,7 @@
 
 use super::estimators::{chao_wang_jost_unseen, digamma, grassberger_g, EntropyEstimator};
 use crate::sample::counts::PairCounts;
+use rayon::prelude::*;
 
 /// The sums of one row (see the module documentation). Outcome counts are whole numbers, so the
 /// integer parts are kept as integers.
@@ -328,12 +329,18 @@ impl Rows {
 
     /// Each row's entropy over the patches (bits) by the rows' estimator; `None` for Chao–Shen.
     pub fn corrected_entropies(&self) -> Option<Vec<f64>> {
-        self.sums
-            .iter()
-            .map(|r| r.corrected_entropy(self.estimator))
-            .collect()
+        let of = |r: &RowSums| r.corrected_entropy(self.estimator);
+        // A row's unseen-outcome sum takes up to thousands of terms: many rows are shared out (each row
+        // on its own, so the values do not depend on the threads).
+        if self.sums.len() >= PARALLEL_ROWS {
+            return self.sums.par_iter().map(of).collect();
+        }
+        self.sums.iter().map(of).collect()
     }
 }
+
+/// From this many rows on, [`Rows::corrected_entropies`] shares them out among threads.
+const PARALLEL_ROWS: usize = 1024;
 
 /// `log2 a_i`, read as 0 for a patch without area (it meets no line, so no count needs it).
 fn log2_areas(area_fractions: &[f64]) -> Vec<f64> {
