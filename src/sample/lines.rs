@@ -200,26 +200,125 @@ pub fn sobol_lines(
     out: &mut Vec<Line>,
 ) {
     out.reserve(count);
-    ScrambledSobol::new(seed, group)
-        .for_each_unit(first, count, |u| out.push(line_from_unit(u, radius)));
+    let mut units = [[0.0; 4]; UNITS_AT_A_TIME];
+    let mut held = 0;
+    ScrambledSobol::new(seed, group).for_each_unit(first, count, |u| {
+        units[held] = u;
+        held += 1;
+        if held == UNITS_AT_A_TIME {
+            lines_from_units(&units, radius, out);
+            held = 0;
+        }
+    });
+    lines_from_units(&units[..held], radius, out);
 }
 
-/// The global line of the unit point `u` (see [`sobol_lines`]).
+/// Points made into lines at a time by [`lines_from_units`].
+const UNITS_AT_A_TIME: usize = 16;
+
+/// The global lines of unit points (see [`sobol_lines`]), stage by stage over all of them, each stage a
+/// loop over arrays: the polynomials are long chains of dependent operations, which overlap (and share
+/// vector registers) when the points' chains are computed side by side rather than a line at a time.
+/// The arithmetic of each line is that of [`turn`] and [`concentric_disc_polynomial`], operation for
+/// operation.
 #[inline]
-fn line_from_unit(u: [f64; 4], radius: f64) -> Line {
+fn lines_from_units(units: &[[f64; 4]], radius: f64, out: &mut Vec<Line>) {
+    const N: usize = UNITS_AT_A_TIME;
+    let column = |d: usize| {
+        let mut c = [0.0; N];
+        c.iter_mut().zip(units).for_each(|(c, u)| *c = u[d]);
+        c
+    };
+    let (s, azimuth, a, b) = (column(0), column(1), column(2), column(3));
     // Marsaglia's disc point with squared radius u1 and angle 2 pi u2 gives the direction of z = 1 - 2 u1
     // and azimuth 2 pi u2: uniform on the sphere when u1 and u2 are uniform.
-    let s = u[0];
-    let (cos, sin) = turn(u[1]);
-    let r = s.sqrt();
-    let direction = (r * cos, r * sin, s);
-    let (px, py) = concentric_disc_polynomial(2.0 * u[2] - 1.0, 2.0 * u[3] - 1.0);
-    line_from_discs(direction, (px, py, px * px + py * py), radius)
+    let (cos, sin) = turns(&azimuth);
+    let (a, b) = (a.map(|a| 2.0 * a - 1.0), b.map(|b| 2.0 * b - 1.0));
+    let (px, py) = concentric_discs(&a, &b);
+    for i in 0..units.len() {
+        let r = s[i].sqrt();
+        let direction = (r * cos[i], r * sin[i], s[i]);
+        let point = (px[i], py[i], px[i] * px[i] + py[i] * py[i]);
+        out.push(line_from_discs(direction, point, radius));
+    }
 }
 
-/// `(cos 2 pi t, sin 2 pi t)` for `t` in [0, 1): the quarter turn and the angle within it are exact
-/// (`4 t` splits exactly), the angle's sine and cosine by [`sin_cos_small`].
+/// [`turn`] of each of `t`, without a branch: the quarter selects operands and signs.
 #[inline(always)]
+fn turns<const N: usize>(t: &[f64; N]) -> ([f64; N], [f64; N]) {
+    use std::f64::consts::{FRAC_1_SQRT_2, FRAC_PI_2};
+    let mut x = [0.0; N];
+    let mut quarter = [0u64; N];
+    for i in 0..N {
+        let quarters = 4.0 * t[i];
+        // `floor` for 0 <= quarters < 4.
+        let q = quarters as u8;
+        quarter[i] = u64::from(q);
+        x[i] = (quarters - f64::from(q) - 0.5) * FRAC_PI_2;
+    }
+    let (s, c) = sin_cos_small_all(&x);
+    let (mut cos, mut sin) = ([0.0; N], [0.0; N]);
+    for i in 0..N {
+        let (c, s) = (FRAC_1_SQRT_2 * (c[i] - s[i]), FRAC_1_SQRT_2 * (c[i] + s[i]));
+        // Quarters 0..4 give (c, s), (-s, c), (-c, -s), (s, -c).
+        let q = quarter[i];
+        let swap = q & 1 == 1;
+        let (first, second) = if swap { (s, c) } else { (c, s) };
+        let negate_first = ((q ^ (q >> 1)) & 1) << 63;
+        let negate_second = ((q >> 1) & 1) << 63;
+        cos[i] = f64::from_bits(first.to_bits() ^ negate_first);
+        sin[i] = f64::from_bits(second.to_bits() ^ negate_second);
+    }
+    (cos, sin)
+}
+
+/// [`concentric_disc_polynomial`] of each `(a[i], b[i])`.
+#[inline(always)]
+fn concentric_discs<const N: usize>(a: &[f64; N], b: &[f64; N]) -> ([f64; N], [f64; N]) {
+    use std::f64::consts::FRAC_PI_4;
+    let (mut major, mut x) = ([0.0; N], [0.0; N]);
+    let mut a_major = [false; N];
+    for i in 0..N {
+        a_major[i] = a[i].abs() > b[i].abs();
+        let (big, small) = if a_major[i] {
+            (a[i], b[i])
+        } else {
+            (b[i], a[i])
+        };
+        major[i] = big;
+        x[i] = FRAC_PI_4 * (small / big);
+    }
+    let (s, c) = sin_cos_small_all(&x);
+    let (mut px, mut py) = ([0.0; N], [0.0; N]);
+    for i in 0..N {
+        // For |b| >= |a| the angle is pi/2 - x: its cosine is sin x, its sine cos x.
+        let (cos, sin) = if a_major[i] {
+            (c[i], s[i])
+        } else {
+            (s[i], c[i])
+        };
+        // The centre (0 / 0 above) maps to itself.
+        let centre = a[i] == 0.0 && b[i] == 0.0;
+        px[i] = if centre { 0.0 } else { major[i] * cos };
+        py[i] = if centre { 0.0 } else { major[i] * sin };
+    }
+    (px, py)
+}
+
+/// [`sin_cos_small`] of each of `x`.
+#[inline(always)]
+fn sin_cos_small_all<const N: usize>(x: &[f64; N]) -> ([f64; N], [f64; N]) {
+    let (mut s, mut c) = ([0.0; N], [0.0; N]);
+    for i in 0..N {
+        (s[i], c[i]) = sin_cos_small(x[i]);
+    }
+    (s, c)
+}
+
+/// `(cos 2 pi t, sin 2 pi t)` for `t` in [0, 1), a point at a time: the reference [`turns`] must equal
+/// bit for bit. The quarter turn and the angle within it are exact (`4 t` splits exactly), the angle's
+/// sine and cosine by [`sin_cos_small`].
+#[cfg(test)]
 fn turn(t: f64) -> (f64, f64) {
     use std::f64::consts::{FRAC_1_SQRT_2, FRAC_PI_2};
     let quarters = 4.0 * t;
@@ -273,6 +372,7 @@ const fn taylor<const N: usize>(first: u32) -> [f64; N] {
 /// [`concentric_disc`] with the angle's sine and cosine by [`sin_cos_small`] (the angle is within
 /// pi/4 of an axis): the same map to within 1e-13.
 #[inline(always)]
+#[cfg(test)]
 fn concentric_disc_polynomial(a: f64, b: f64) -> (f64, f64) {
     use std::f64::consts::FRAC_PI_4;
     if a == 0.0 && b == 0.0 {
@@ -684,6 +784,60 @@ mod tests {
                 se < se_independent / 2.0,
                 "{name}: se {se} vs {se_independent}"
             );
+        }
+    }
+
+    /// The global line of one unit point, a point at a time (the code the Sobol' lines were first made
+    /// with): the reference for [`lines_from_units`].
+    fn line_from_unit(u: [f64; 4], radius: f64) -> Line {
+        let s = u[0];
+        let (cos, sin) = turn(u[1]);
+        let r = s.sqrt();
+        let direction = (r * cos, r * sin, s);
+        let (px, py) = concentric_disc_polynomial(2.0 * u[2] - 1.0, 2.0 * u[3] - 1.0);
+        line_from_discs(direction, (px, py, px * px + py * py), radius)
+    }
+
+    /// Lines made stage by stage over many points are those made a point at a time, bit for bit: on a
+    /// stretch of the scrambled sequence (whole and partial chunks), and on points at the quarter turns,
+    /// the disc's centre and its diagonals (where |a| = |b|), and the ends of [0, 1).
+    #[test]
+    fn lines_made_side_by_side_are_the_lines_made_one_by_one() {
+        let below_one = 1.0 - f64::EPSILON / 2.0;
+        let special = [
+            0.0, 0.25, 0.5, 0.75, below_one, 0.125, 0.375, 0.625, 0.875, 1e-300,
+        ];
+        let mut units = Vec::new();
+        for &x in &special {
+            for &y in &special {
+                units.push([x, y, x, y]);
+                units.push([y, x, 0.5, y]);
+                units.push([x, y, y, 1.0 - y]);
+            }
+        }
+        ScrambledSobol::new(9, 3).for_each_unit(1000, 20_000, |u| units.push(u));
+        for radius in [1.0, 37.5] {
+            let expected: Vec<Line> = units.iter().map(|&u| line_from_unit(u, radius)).collect();
+            for len in [units.len(), 5, UNITS_AT_A_TIME, UNITS_AT_A_TIME + 3] {
+                let mut got = Vec::new();
+                for chunk in units[..len].chunks(UNITS_AT_A_TIME) {
+                    lines_from_units(chunk, radius, &mut got);
+                }
+                let bits = |l: &Line| {
+                    (
+                        l.origin.map(f32::to_bits),
+                        l.dir.map(f32::to_bits),
+                        l.t_max.to_bits(),
+                    )
+                };
+                for (k, (g, e)) in got.iter().zip(&expected[..len]).enumerate() {
+                    assert_eq!(bits(g), bits(e), "unit {k}: {:?}", units[k]);
+                }
+                assert_eq!(got.len(), len);
+            }
+            let mut batch = Vec::new();
+            sobol_lines(9, 3, 1000, 20_000, radius, &mut batch);
+            assert_eq!(batch, expected[expected.len() - 20_000..], "sobol_lines");
         }
     }
 
