@@ -257,12 +257,30 @@ pub fn cast(
             let rate = cast_batches as f64 / start.elapsed().as_secs_f64().max(1e-3);
             round = ((rate * seconds) as u64).max(first_round);
         } else {
-            // Doubling: few rounds, and a time budget is checked before every batch anyway.
-            round = state.batches_done().max(64);
+            // Doubling: few rounds, and a time budget is checked before every batch anyway. The round
+            // still to be counted is part of the run so far.
+            let counted_or_not =
+                state.batches_done() + pending.as_ref().map_or(0, |p| p.len() as u64);
+            round = counted_or_not.max(64);
         }
         round = round.min(max_round_batches(plan, wanted, state));
+        if pending.is_some() {
+            round = leaving_a_short_last_round(round, scope.end - cursor, state.batches_done());
+        }
     };
     Ok(stop_reason)
+}
+
+/// The next round of a run with `remaining` batches left after it is cast, when it would be the last:
+/// shortened so that a last round of about an eighth of the `done` batches (at least 64) follows. The
+/// last round's counting has no tracing to overlap with, so the shorter it is, the less of the run is
+/// spent with one core idle; the round before it is counted while it is traced.
+fn leaving_a_short_last_round(round: u64, remaining: u64, done: u64) -> u64 {
+    let last = (done / 8).max(64);
+    if remaining > round || remaining <= last {
+        return round;
+    }
+    remaining - last
 }
 
 /// How far past the predicted need of a precision target a run goes before it checks again.
@@ -316,4 +334,28 @@ fn next_batches(done: &BatchSet, mut cursor: u64, end: u64, count: u64) -> (Vec<
         cursor += 1;
     }
     (out, cursor)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A round that would end the run leaves a last round of an eighth of the batches done (at least
+    /// 64); other rounds, and a last round already that short, are left as they are; every batch is
+    /// still cast.
+    #[test]
+    fn the_last_round_is_short() {
+        assert_eq!(leaving_a_short_last_round(2000, 1948, 5376), 1948 - 672);
+        assert_eq!(leaving_a_short_last_round(2000, 1948, 100), 1948 - 64);
+        assert_eq!(leaving_a_short_last_round(2000, 5000, 5376), 2000);
+        assert_eq!(leaving_a_short_last_round(2000, 672, 5376), 2000);
+        let (mut done, mut left, mut rounds) = (1024u64, 7324 - 1024, Vec::new());
+        while left > 0 {
+            let round = leaving_a_short_last_round(done.max(64), left, done).min(left);
+            rounds.push(round);
+            (done, left) = (done + round, left - round);
+        }
+        assert_eq!(rounds.iter().sum::<u64>(), 7324 - 1024);
+        assert!(*rounds.last().unwrap() <= 7324 / 8, "{rounds:?}");
+    }
 }

@@ -315,7 +315,7 @@ impl SparseCounts {
     /// The key range is cut into pieces of a few thousand entries a part, merged in parallel a wave at a
     /// time, in cache, straight from the parts (no copies of them), and appended in order to one list.
     /// That list reserves the parts' total length, an upper bound of its own, but only the pages it
-    /// writes become resident, so no more than the result, the parts and one wave is ever held (a list
+    /// writes become resident, so no more than the result, the parts and two waves are ever held (a list
     /// grown as it goes is copied when it outgrows its block, which holds the old and the new one at
     /// once).
     pub fn sum_of(parts: &[&SparseCounts]) -> SparseCounts {
@@ -350,18 +350,21 @@ impl SparseCounts {
         let mut out = SparseCounts::with_capacity(packing, bound(parts));
         let mut out_first = first.map(|k| SparseCounts::with_capacity(packing, bound(&parts[..k])));
         let wave = 8 * rayon::current_num_threads();
+        // A wave is appended (one thread: copies into pages touched for the first time) while the next
+        // one is merged.
+        let mut merged = Vec::new();
         for some in pieces.chunks(wave) {
-            let merged: Vec<(SparseCounts, Option<SparseCounts>)> = some
-                .par_iter()
-                .map(|piece| merge_piece(parts, piece, first))
-                .collect();
-            for (m, m_first) in merged {
-                out.append(&m);
-                if let (Some(o), Some(m)) = (&mut out_first, m_first) {
-                    o.append(&m);
-                }
-            }
+            let (next, ()) = rayon::join(
+                || {
+                    some.par_iter()
+                        .map(|piece| merge_piece(parts, piece, first))
+                        .collect()
+                },
+                || append_pieces(&mut out, &mut out_first, std::mem::take(&mut merged)),
+            );
+            merged = next;
         }
+        append_pieces(&mut out, &mut out_first, merged);
         (out, out_first)
     }
 
@@ -402,6 +405,20 @@ impl SparseCounts {
     /// The packed entry of a pair and its count, and whether the count needs a side entry.
     pub(super) fn entry_of(packing: Packing, packed: u64, count: u64) -> (u64, bool) {
         (packing.entry(packed, count), count >= packing.field_max())
+    }
+}
+
+/// Appends merged pieces, in key order, to the sum of all and to the sum of the first parts.
+fn append_pieces(
+    out: &mut SparseCounts,
+    out_first: &mut Option<SparseCounts>,
+    pieces: Vec<(SparseCounts, Option<SparseCounts>)>,
+) {
+    for (all, firsts) in pieces {
+        out.append(&all);
+        if let (Some(o), Some(f)) = (out_first.as_mut(), firsts) {
+            o.append(&f);
+        }
     }
 }
 
