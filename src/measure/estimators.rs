@@ -54,10 +54,11 @@ pub fn grassberger_g(n: f64) -> f64 {
 /// The unseen-outcome term of Chao, Wang and Jost (2013), eq. (7):
 /// `f1/N (1-A)^(1-N) (-ln A - sum_{r=1}^{N-1} (1-A)^r / r)`, with
 /// `A = 2 f2 / ((N-1) f1 + 2 f2)` (or its f2 = 0 form). Written as the tail `sum_{m>=1} x^m / (m + N - 1)`,
-/// `x = 1 - A`, which needs no cancellation: summed directly when it converges fast, otherwise from the
-/// complement, and, when both would take more than [`UNSEEN_TERMS`] terms (a row of millions of samples
-/// with few repeats, or a forged state), from its integral form (`unseen_tail_of_long_rows`): the
-/// work per row is bounded whatever the counts.
+/// `x = 1 - A`: for a long row with `A N` up to 4 (the usual case, from thinly to well sampled rows) from
+/// its series in `A` (`unseen_tail_near_one`, about 40 terms); otherwise summed directly when it converges
+/// fast, else from the complement, and, when both would take more than [`UNSEEN_TERMS`] terms (a row of
+/// millions of samples with few repeats, or a forged state), from its integral form
+/// (`unseen_tail_of_long_rows`): the work per row is bounded whatever the counts.
 pub fn chao_wang_jost_unseen(n: f64, f1: f64, f2: f64) -> f64 {
     if f1 == 0.0 || n < 2.0 {
         return 0.0;
@@ -71,7 +72,9 @@ pub fn chao_wang_jost_unseen(n: f64, f1: f64, f2: f64) -> f64 {
         return 0.0;
     }
     let x = 1.0 - a;
-    let tail = if (40.0 / a).min(n) > UNSEEN_TERMS {
+    let tail = if a * n <= SERIES_A_N && n > SERIES_MIN_N {
+        unseen_tail_near_one(n - 1.0, a)
+    } else if (40.0 / a).min(n) > UNSEEN_TERMS {
         unseen_tail_of_long_rows(n, a)
     } else if 40.0 / a < n {
         // Geometric decay: ~40/A terms reach 1e-17.
@@ -98,6 +101,36 @@ pub fn chao_wang_jost_unseen(n: f64, f1: f64, f2: f64) -> f64 {
         (-(a.ln()) - partial).max(0.0) * x.powf(1.0 - n)
     };
     f1 / n * tail
+}
+
+/// Up to this `A N`, and from this `N` on, [`chao_wang_jost_unseen`] takes its tail from the series in `A`
+/// ([`unseen_tail_near_one`]): about 40 terms where the sums take `min(N, 40/A)`, and accurate to about
+/// `e^(A N)` roundings (1e-13 at the bound).
+const SERIES_A_N: f64 = 4.0;
+const SERIES_MIN_N: f64 = 128.0;
+
+/// The tail `sum_{m>=1} x^m / (m + n)` (`x = 1 - A`, `n = N - 1`) as a series in `A`: the tail is
+/// `x / (n + 1) 2F1(1, n + 1; n + 2; x)`, and 2F1(a, b; a + b; z) near z = 1 has the logarithmic
+/// expansion of Abramowitz and Stegun 15.3.10, here
+/// `x sum_k (n + 1)_k / k! A^k [psi(k + 1) - psi(n + 1 + k) - ln A]`. The coefficients peak near
+/// `k = A n` and then fall like `(A n)^k / k!`.
+fn unseen_tail_near_one(n: f64, a: f64) -> f64 {
+    const EULER: f64 = 0.577_215_664_901_532_9;
+    let ln_a = a.ln();
+    // psi(n + 1 + k) - psi(k + 1), from k = 0 (the harmonic number H_n).
+    let mut harmonic = digamma_series(n + 1.0) + EULER;
+    let (mut coefficient, mut sum, mut k) = (1.0f64, 0.0f64, 0.0f64);
+    loop {
+        sum += coefficient * (-ln_a - harmonic);
+        let largest_left = coefficient * (ln_a.abs() + harmonic + 1.0);
+        if (k > a * (n + 1.0) && largest_left < 1e-17 * sum.abs()) || k >= 1000.0 {
+            break;
+        }
+        harmonic += 1.0 / (n + 1.0 + k) - 1.0 / (k + 1.0);
+        coefficient *= a * (n + 1.0 + k) / (k + 1.0);
+        k += 1.0;
+    }
+    (1.0 - a) * sum
 }
 
 /// The most terms [`chao_wang_jost_unseen`] sums; beyond, the sum's integral form is used.
@@ -214,6 +247,47 @@ mod tests {
         let huge = chao_wang_jost_unseen(18_446_744_073_709_551_615.0, 1e12, 1.0);
         assert!(huge.is_finite() && huge >= 0.0, "{huge}");
         assert!(start.elapsed().as_secs() < 1);
+    }
+
+    /// The series in `A` agrees with the tail summed term by term (its complement, compensated, each
+    /// power from the logarithm), over
+    /// rows of 129 to 10^5 segments and `A N` from 1e-6 to the bound, the cancelling `A N` near
+    /// `e^-gamma` included.
+    #[test]
+    fn unseen_tail_near_one_agrees_with_the_sum() {
+        let summed = |n: f64, a: f64| {
+            // sum_{m>=1} x^m / (m + n) = x^(-n) (-ln A - sum_{r=1}^{n} x^r / r), compensated, each power
+            // from the logarithm (a power multiplied up term by term drifts by r roundings).
+            let ln_x = (-a).ln_1p();
+            let (mut partial, mut carry) = (0.0f64, 0.0f64);
+            for r in 1..=(n as u64) {
+                let power = (r as f64 * ln_x).exp();
+                let y = power / r as f64 - carry;
+                let t = partial + y;
+                carry = (t - partial) - y;
+                partial = t;
+            }
+            (-(a.ln()) - partial) * (-n * ln_x).exp()
+        };
+        let mut worst = 0.0f64;
+        for n in [128.0, 300.0, 1000.0, 12_345.0, 100_000.0] {
+            for an in [
+                1e-6,
+                1e-3,
+                0.1,
+                0.5,
+                0.561_459_483_566_885,
+                1.0,
+                2.0,
+                3.0,
+                3.99,
+            ] {
+                let a = an / (n + 1.0);
+                let (series, exact) = (unseen_tail_near_one(n, a), summed(n, a));
+                worst = worst.max(((series - exact) / exact).abs());
+            }
+        }
+        assert!(worst < 1e-12, "{worst}");
     }
 
     /// `e^c E1(c)` against tabulated values (Abramowitz and Stegun, table 5.1) and its large-c limit.
