@@ -510,6 +510,18 @@ mod tests {
         v
     }
 
+    /// `count` pair keys of patches below `patches`, from a 64-bit LCG at `rng`.
+    fn random_keys(rng: &mut u64, count: usize, patches: u32) -> Vec<u64> {
+        (0..count)
+            .map(|_| {
+                *rng = rng
+                    .wrapping_mul(6364136223846793005)
+                    .wrapping_add(1442695040888963407);
+                pair_key((*rng >> 33) as u32 % patches, (*rng >> 13) as u32 % patches)
+            })
+            .collect()
+    }
+
     #[test]
     fn dense_and_sparse_agree() {
         let keys: Vec<u64> = [(3, 1), (1, 3), (0, 0), (2, 5), (5, 2), (5, 2)]
@@ -525,16 +537,7 @@ mod tests {
         assert_eq!(entries(&dense), entries(&sparse));
 
         // Radix sort of packed keys equals a comparison sort.
-        let mut rng = 12345u64;
-        let mut many: Vec<u64> = (0..5000)
-            .map(|_| {
-                rng = rng
-                    .wrapping_mul(6364136223846793005)
-                    .wrapping_add(1442695040888963407);
-                let (a, b) = ((rng >> 33) as u32 % 3000, (rng >> 13) as u32 % 3000);
-                pair_key(a, b)
-            })
-            .collect();
+        let mut many = random_keys(&mut 12345, 5000, 3000);
         let mut expected = many.clone();
         expected.sort_unstable();
         sort_keys(3000, &mut many);
@@ -568,18 +571,7 @@ mod tests {
         let mut rng = 77u64;
         for patches in [300usize, DENSE_MAX_PATCHES + 1] {
             let parts: Vec<PairCounts> = (0..5)
-                .map(|_| {
-                    let mut keys: Vec<u64> = (0..4000)
-                        .map(|_| {
-                            rng = rng
-                                .wrapping_mul(6364136223846793005)
-                                .wrapping_add(1442695040888963407);
-                            let (a, b) = ((rng >> 33) as u32 % 300, (rng >> 13) as u32 % 300);
-                            pair_key(a, b)
-                        })
-                        .collect();
-                    PairCounts::from_keys(patches, &mut keys)
-                })
+                .map(|_| PairCounts::from_keys(patches, &mut random_keys(&mut rng, 4000, 300)))
                 .collect();
             let refs: Vec<&PairCounts> = parts.iter().collect();
             for first in 1..=parts.len() {
