@@ -232,10 +232,13 @@ def scx_matrix(csv_path, n):
     return F
 
 
-def run_scx(scx, scene, sampler, lines, seed, threads, work):
+def run_scx(scx, scene, series, lines, seed, threads, work):
+    """One scx run of `series`: a sampler, then `box` for lines through the bounding box."""
     out = os.path.join(work, "ff.csv")
+    sampler, *through = series.split()
     cmd = [scx, "analyze", scene, "--form-factors", out, "--lines", f"{lines:g}", "--threads", str(threads),
-           "--sampler", sampler, "--seed", str(seed), "--format", "json", "-q"]
+           "--sampler", sampler, "--lines-through", through[0] if through else "sphere", "--seed", str(seed),
+           "--format", "json", "-q"]
     t = time.perf_counter()
     res = subprocess.run(cmd, capture_output=True, text=True)
     wall = time.perf_counter() - t
@@ -334,6 +337,10 @@ def main():
     ap.add_argument("--budgets-raystrack", default="3e5,1e6,3e6,1e7,3e7", type=budgets)
     ap.add_argument("--budgets-independent", default="3e5,1e6,3e6,1e7,3e7", type=budgets)
     ap.add_argument("--budgets-sobol", default="3e5,1e6,3e6,1e7,3e7", type=budgets)
+    ap.add_argument("--budgets-independent-box", default="", type=budgets,
+                    help="scx --lines-through box (none by default)")
+    ap.add_argument("--budgets-sobol-box", default="", type=budgets,
+                    help="scx --sampler sobol --lines-through box (none by default)")
     ap.add_argument("--targets", default="0.01,0.005", type=budgets)
     ap.add_argument("--work", default=None)
     args = ap.parse_args()
@@ -385,7 +392,9 @@ def main():
                 sec, F, used = rs.solve(b, seed + 10)
                 runs.setdefault(("raystrack", "shifted Halton", b), []).append((sec, rel_error(F, exact), used))
                 log_run("raystrack", seed + 10, b, sec, runs[("raystrack", "shifted Halton", b)][-1][1])
-            for sampler, bs in (("independent", args.budgets_independent), ("sobol", args.budgets_sobol)):
+            for sampler, bs in (("independent", args.budgets_independent), ("sobol", args.budgets_sobol),
+                                ("independent box", args.budgets_independent_box),
+                                ("sobol box", args.budgets_sobol_box)):
                 for b in bs:
                     wall, inner, csv_path = run_scx(args.scx, scene, sampler, b, seed, args.threads, work)
                     F = scx_matrix(csv_path, n)

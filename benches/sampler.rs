@@ -1,7 +1,8 @@
 //! Do randomised quasi-Monte Carlo lines pay? For each scene, runs the whole analysis (`scx analyze`'s
 //! defaults: every measure, 16 groups, Embree single lines, 2 threads) with independent lines and with
-//! the Sobol' sampler, over the same seeds (seed outermost, so that a drift of the machine's speed falls
-//! on both alike), and prints per measure and sampler:
+//! the Sobol' sampler, each through the bounding sphere and through the bounding box
+//! (`--lines-through`), over the same seeds (seed outermost, so that a drift of the machine's speed falls
+//! on every series alike), and prints per measure and series:
 //!
 //! * the spread (sample standard deviation) of the estimates over the seeds at equal lines, with its
 //!   own relative uncertainty 1/sqrt(2(n-1)): the direct measure of the error;
@@ -9,7 +10,8 @@
 //! * the mean, and with an exact value (the calibration scenes: `@cube:N`, the regular solids) its
 //!   distance to it in standard errors of the mean, (mean - exact) / (spread / sqrt(n)): a bias shows
 //!   here, however small the spread;
-//! * the spread ratio independent / sobol, and the CPU-time ratio sobol / independent (CPU time of all
+//! * the spread ratio independent / this series, at equal lines and (`same cpu`, scaling the spreads as
+//!   1/sqrt(CPU time)) at equal CPU time, and the CPU-time ratio this / independent (CPU time of all
 //!   threads: robust when the machine is shared, but the runs of both samplers are interleaved, not
 //!   alone on it).
 //!
@@ -28,6 +30,7 @@ use scene_complexity::calibrate::{truth, Basis, CalibrationScene};
 use scene_complexity::internals::analysis::{analyze, Analysis};
 use scene_complexity::internals::measure::Measure;
 use scene_complexity::internals::run::{RunControl, RunSpec};
+use scene_complexity::internals::sample::bounds::LineBound;
 use scene_complexity::internals::sample::lines::Sampler;
 use scene_complexity::internals::scene::Scene;
 use scene_complexity::internals::scenes;
@@ -46,7 +49,13 @@ const FOLLOWED: [(&str, Measure); 7] = [
     ("I_s/I_s^c c", Measure::AccuracyCorrected),
 ];
 
-const SAMPLERS: [Sampler; 2] = [Sampler::Independent, Sampler::Sobol];
+/// The series compared: a label, the sampler and where the lines are drawn (`--lines-through`).
+const SAMPLERS: [(&str, Sampler, LineBound); 4] = [
+    ("independent", Sampler::Independent, LineBound::Sphere),
+    ("sobol", Sampler::Sobol, LineBound::Sphere),
+    ("indep. box", Sampler::Independent, LineBound::Box),
+    ("sobol box", Sampler::Sobol, LineBound::Box),
+];
 
 fn main() -> anyhow::Result<()> {
     let (specs, lines) = common::scenes_and_lines(1e6)?;
@@ -89,9 +98,10 @@ fn compare(spec: &str, lines: u64, seeds: u64) -> anyhow::Result<()> {
         })
         .collect();
     for seed in 1..=seeds {
-        for (s, &sampler) in SAMPLERS.iter().enumerate() {
+        for (s, &(_, sampler, bound)) in SAMPLERS.iter().enumerate() {
             let cfg = RunSpec {
                 sampler,
+                bound,
                 ..RunSpec::new(lines, seed)
             };
             let (w0, c0) = (Instant::now(), common::cpu_seconds());
@@ -162,7 +172,7 @@ fn frobenius_error(a: &Analysis, scene: &Scene, exact: &[Vec<f64>]) -> f64 {
 fn print_table(spec: &str, runs: &[Runs], exact: &[Option<f64>], seeds: u64) {
     let n = seeds as f64;
     println!(
-        "{:<12} {:<11} {:<11} {:>7} {:>15} {:>10} {:>6} {:>13} {:>8} {:>7}",
+        "{:<12} {:<11} {:<11} {:>7} {:>15} {:>10} {:>6} {:>13} {:>8} {:>7} {:>8}",
         "scene",
         "measure",
         "sampler",
@@ -172,11 +182,12 @@ fn print_table(spec: &str, runs: &[Runs], exact: &[Option<f64>], seeds: u64) {
         "sp/se",
         "mean",
         "z(mean)",
-        "ind/sob"
+        "ind/this",
+        "same cpu"
     );
     for (m, (name, ..)) in FOLLOWED.iter().enumerate() {
         let base = sample_sd(&runs[0].values[m]);
-        for (s, sampler) in SAMPLERS.iter().enumerate() {
+        for (s, (label, ..)) in SAMPLERS.iter().enumerate() {
             let r = &runs[s];
             let v = &r.values[m];
             let sd = sample_sd(v);
@@ -184,17 +195,18 @@ fn print_table(spec: &str, runs: &[Runs], exact: &[Option<f64>], seeds: u64) {
             let mean = v.iter().sum::<f64>() / n;
             let z = exact[m].map_or(f64::NAN, |x| (mean - x) / (sd / n.sqrt()));
             println!(
-                "{spec:<12} {name:<11} {:<11} {:>7.3} {:>10.3e} {:>3.0}% {rms:>10.3e} {:>6.2} {mean:>13.7} {z:>+8.1} {:>7.2}",
-                sampler.name(),
+                "{spec:<12} {name:<11} {:<11} {:>7.3} {:>10.3e} {:>3.0}% {rms:>10.3e} {:>6.2} {mean:>13.7} {z:>+8.1} {:>7.2} {:>8.2}",
+                label,
                 r.cpu / n,
                 sd,
                 100.0 / (2.0 * (n - 1.0)).sqrt(),
                 sd / rms,
                 base / sd,
+                base / sd * (runs[0].cpu / r.cpu).sqrt(),
             );
         }
     }
-    for (s, sampler) in SAMPLERS.iter().enumerate() {
+    for (s, (label, ..)) in SAMPLERS.iter().enumerate() {
         let r = &runs[s];
         let f = if r.f_errors.is_empty() {
             String::new()
@@ -204,7 +216,7 @@ fn print_table(spec: &str, runs: &[Runs], exact: &[Option<f64>], seeds: u64) {
         };
         println!(
             "{spec:<12} {:<11} cpu {:.3} s/run ({:.2}x independent), wall {:.3} s/run ({:.2}x){f}",
-            sampler.name(),
+            label,
             r.cpu / n,
             r.cpu / runs[0].cpu,
             r.wall / n,

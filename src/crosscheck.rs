@@ -203,7 +203,7 @@ pub fn compare_hits(
     let stream = LineStream::independent(cfg.lines, cfg.seed);
     let (parts, _) = map_batches(
         &stream,
-        scene.bounding_radius(),
+        scene,
         &all_batches(&stream),
         &|_| false,
         |buf: &mut Buffers, batch| {

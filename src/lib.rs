@@ -109,6 +109,7 @@ pub use run::{
     Scope, Shard, SpecDifference, SpecError, StartError, StopReason, Target, Tracing,
     DEFAULT_ESTIMATOR, DEFAULT_GROUPS,
 };
+pub use sample::bounds::{sphere_lines, LineBound};
 pub use sample::counts::PairCounts;
 pub use sample::lines::{BundleError, LineSource, Sampler, MAX_BUNDLE_GRID};
 pub use sample::tally::{Tally, Wanted};

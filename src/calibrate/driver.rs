@@ -100,6 +100,7 @@ pub fn run_spec(cell: &Cell, seed: u64) -> RunSpec {
         },
     };
     spec.sampler = cell.sampler;
+    spec.bound = cell.bound;
     spec.budget.target = cell.target.map(|t| Target {
         measure: t.measure,
         stderr: t.stderr,

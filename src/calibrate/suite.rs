@@ -9,6 +9,7 @@ use std::ops::Range;
 
 use super::scenes::CalibrationScene;
 use crate::measure::Measure;
+use crate::sample::bounds::LineBound;
 use crate::sample::lines::Sampler;
 use crate::scenes::solids::Solid;
 
@@ -48,6 +49,8 @@ pub struct Cell {
     pub target: Option<CellTarget>,
     /// How the runs draw their lines (`scx analyze --sampler`).
     pub sampler: Sampler,
+    /// Where the runs draw their lines (`scx analyze --lines-through`).
+    pub bound: LineBound,
 }
 
 impl Cell {
@@ -61,12 +64,18 @@ impl Cell {
             measures: CellMeasures::All,
             target: None,
             sampler: Sampler::Independent,
+            bound: LineBound::Sphere,
         }
     }
 
     /// The same cell with lines drawn by `sampler`.
     pub fn with_sampler(self, sampler: Sampler) -> Cell {
         Cell { sampler, ..self }
+    }
+
+    /// The same cell with lines drawn through `bound`.
+    pub fn with_bound(self, bound: LineBound) -> Cell {
+        Cell { bound, ..self }
     }
 
     /// The same cell with a precision target on `measure` (and `lines` as the cap).
@@ -90,8 +99,8 @@ impl Cell {
         self.first_seed..self.first_seed + self.seeds
     }
 
-    /// How its lines read in a table: the count, or the target and the cap; and the sampler when it is
-    /// not the default.
+    /// How its lines read in a table: the count, or the target and the cap; and the sampler and the
+    /// bound when they are not the defaults.
     pub fn lines_label(&self) -> String {
         let lines = match self.target {
             None => short_count(self.lines),
@@ -102,8 +111,12 @@ impl Cell {
                 short_count(self.lines)
             ),
         };
-        match self.sampler {
+        let lines = match self.sampler {
             Sampler::Independent => lines,
+            other => format!("{lines} {}", other.name()),
+        };
+        match self.bound {
+            LineBound::Sphere => lines,
             other => format!("{lines} {}", other.name()),
         }
     }

@@ -7,7 +7,7 @@ use std::time::Instant;
 use scene_complexity::calibrate::{
     self, report, suite, CalibrationScene, Cell, CellMeasures, CellReport, CellTarget, SuiteLevel,
 };
-use scene_complexity::{Measure, Sampler};
+use scene_complexity::{LineBound, Measure, Sampler};
 
 use super::args::{
     parse_count, parse_positive, parse_seed, parse_whole_in, target_measure_parser, ReportOutput,
@@ -55,6 +55,10 @@ pub struct CalibrateArgs {
     /// `sobol` (`scx analyze --sampler`).
     #[arg(long, default_value = "independent", value_parser = parse_sampler)]
     sampler: Sampler,
+    /// Where the runs draw their lines, for every cell: `sphere` or `box` (`scx analyze
+    /// --lines-through`).
+    #[arg(long, default_value = "sphere", value_parser = parse_bound)]
+    lines_through: LineBound,
     /// Print the cells and exit.
     #[arg(long)]
     list: bool,
@@ -97,12 +101,16 @@ fn parse_sampler(s: &str) -> Result<Sampler, String> {
     Sampler::from_name(s).ok_or_else(|| format!("`{s}`: expected independent or sobol"))
 }
 
+fn parse_bound(s: &str) -> Result<LineBound, String> {
+    LineBound::from_name(s).ok_or_else(|| format!("`{s}`: expected sphere or box"))
+}
+
 /// The cells the arguments ask for.
 fn cells(args: &CalibrateArgs) -> Vec<Cell> {
     if args.scene.is_empty() {
         return suite(args.suite.unwrap_or(SuiteLevel::Small))
             .into_iter()
-            .map(|c| c.with_sampler(args.sampler))
+            .map(|c| c.with_sampler(args.sampler).with_bound(args.lines_through))
             .collect();
     }
     let target = args.target_stderr.map(|stderr| CellTarget {
@@ -120,6 +128,7 @@ fn cells(args: &CalibrateArgs) -> Vec<Cell> {
                 measures: args.measures,
                 target,
                 sampler: args.sampler,
+                bound: args.lines_through,
             })
         })
         .collect()

@@ -11,11 +11,11 @@ use scene_complexity::report::{
 };
 use scene_complexity::Scene;
 use scene_complexity::VerdictRule;
+use scene_complexity::{sphere_lines, ErrorMethod, LineBound, Sampler, Shard, StopReason, Tracing};
 use scene_complexity::{
     Analysis, LinesAdvice, RadiosityOutcome, Reliability, SamplingReport, TargetOutcome, Verdict,
     COVERAGE_OK,
 };
-use scene_complexity::{ErrorMethod, Sampler, Shard, StopReason, Tracing};
 use scene_complexity::{Estimate, Family, Measure};
 
 use super::table::{fixed, Align, Table};
@@ -198,7 +198,7 @@ pub fn table(run: &RunInfo, a: &Analysis) -> String {
             (0, Sampler::Sobol) => " (sobol: randomised quasi-Monte Carlo)".to_string(),
             (0, Sampler::Independent) => String::new(),
             (grid, _) => format!(" in bundles of {grid} x {grid}"),
-        },
+        } + &through_the_box(scene, a),
         a.spec.seed,
         run.tracing.backend.name(),
         run.tracing.query,
@@ -351,6 +351,24 @@ pub fn table(run: &RunInfo, a: &Analysis) -> String {
              standard errors, or flagged where there is no jackknife (docs/sampling.md)."
         );
     }
+    if a.spec.bound == LineBound::Box {
+        let worth = sphere_lines(scene, a.spec.bound, a.lines) / a.lines.max(1) as f64;
+        let _ = writeln!(
+            s,
+            "lines through the box: each is worth {worth:.4} lines through the bounding sphere{}{}",
+            if a.estimate(Measure::MsePerLine).is_some() {
+                " (E(MSE) is per line through the sphere, as in the paper)"
+            } else {
+                ""
+            },
+            if worth < 1.0 {
+                "; on this scene the box is the larger container, so the sphere wastes fewer lines \
+                 (--lines-through sphere)."
+            } else {
+                "."
+            }
+        );
+    }
     if let Some(t) = &a.target {
         let _ = writeln!(s, "{}", target_text(t));
     }
@@ -480,5 +498,17 @@ fn stop_text(r: StopReason) -> &'static str {
         StopReason::Interrupted => {
             "interrupted (Ctrl-C): the report covers the lines gathered so far"
         }
+    }
+}
+
+/// For lines through the bounding box, what they are worth in lines through the sphere (the line
+/// count of the paper's runs and of runs without `--lines-through box`).
+fn through_the_box(scene: &Scene, a: &Analysis) -> String {
+    match a.spec.bound {
+        LineBound::Sphere => String::new(),
+        LineBound::Box => format!(
+            " through the bounding box (as many as {:.0} through the sphere)",
+            sphere_lines(scene, a.spec.bound, a.lines)
+        ),
     }
 }

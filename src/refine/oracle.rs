@@ -28,7 +28,7 @@ fn trace_segments<T: Default + Send>(
     let (per_batch, _) = map_traced_batches(
         &stream,
         tracer,
-        scene.bounding_radius(),
+        scene,
         &all_batches(&stream),
         &|_| false,
         |_: &mut (), batch, hits| {

@@ -5,7 +5,9 @@
 use rayon::prelude::*;
 
 use super::plan::BatchPlan;
+use crate::sample::bounds::{box_batch_lines, sobol_box_lines, LineBound, LineRegion};
 use crate::sample::lines::{sobol_lines, LineSource, Sampler};
+use crate::scene::Scene;
 use crate::trace::{Line, LineHits, RawHit, TraceError, Tracer};
 
 /// The lines of a run: its batch plan, where its lines come from, and the seed of their streams. A
@@ -19,6 +21,8 @@ pub struct LineStream {
     /// Independent lines, or one randomised Sobol' sequence per group (then `source` is
     /// [`LineSource::Independent`]: [`crate::run::RunSpec::check`]).
     pub sampler: Sampler,
+    /// Through the bounding sphere or the bounding box (then `source` is [`LineSource::Independent`]).
+    pub bound: LineBound,
     /// The run's standard-error groups: batch `b` belongs to group `b mod groups`.
     pub groups: u64,
     /// Seed of the streams.
@@ -33,28 +37,37 @@ impl LineStream {
             plan: BatchPlan::new(lines),
             source: LineSource::Independent,
             sampler: Sampler::Independent,
+            bound: LineBound::Sphere,
             groups: crate::run::DEFAULT_GROUPS as u64,
             seed,
         }
     }
 
-    /// Appends batch `batch`'s lines to `out` (tracing space, bounding radius `radius`). With the Sobol'
-    /// sampler, batch `b` is the `k`-th batch of group `g = b mod G` (`k = b / G`) and takes points
-    /// `k * batch_size ..` of that group's sequence: a group's lines are a prefix of one
-    /// low-discrepancy sequence, whichever batches a thread, shard or resume draws.
-    pub fn draw(&self, batch: u64, radius: f64, out: &mut Vec<Line>) {
+    /// Appends batch `batch`'s lines to `out` (tracing space), drawn through `region` (which must be
+    /// the scene's region for [`LineStream::bound`]). With the Sobol' sampler, batch `b` is the `k`-th
+    /// batch of group `g = b mod G` (`k = b / G`) and takes points `k * batch_size ..` of that group's
+    /// sequence: a group's lines are a prefix of one low-discrepancy sequence, whichever batches a
+    /// thread, shard or resume draws.
+    pub fn draw(&self, batch: u64, region: &LineRegion, out: &mut Vec<Line>) {
         let count = self.plan.batch_len(batch);
-        match self.sampler {
-            Sampler::Independent => {
+        let groups = self.groups.max(1);
+        let (group, k) = (batch % groups, batch / groups);
+        let first = k * self.plan.batch_size;
+        match (self.sampler, region) {
+            (Sampler::Independent, LineRegion::Sphere(radius)) => {
                 self.source
-                    .batch_lines(self.seed, batch, count, radius, out);
+                    .batch_lines(self.seed, batch, count, *radius, out);
             }
-            Sampler::Sobol => {
+            (Sampler::Sobol, LineRegion::Sphere(radius)) => {
                 debug_assert_eq!(self.source, LineSource::Independent, "checked by the spec");
-                let groups = self.groups.max(1);
-                let (group, k) = (batch % groups, batch / groups);
-                let first = k * self.plan.batch_size;
-                sobol_lines(self.seed, group, first, count, radius, out);
+                sobol_lines(self.seed, group, first, count, *radius, out);
+            }
+            (Sampler::Independent, LineRegion::Box(bounds)) => {
+                debug_assert_eq!(self.source, LineSource::Independent, "checked by the spec");
+                box_batch_lines(self.seed, batch, count, bounds, out);
+            }
+            (Sampler::Sobol, LineRegion::Box(bounds)) => {
+                sobol_box_lines(self.seed, group, first, count, bounds, out);
             }
         }
     }
@@ -80,15 +93,15 @@ pub fn all_batches(stream: &LineStream) -> Vec<u64> {
     (0..stream.plan.batches()).collect()
 }
 
-/// Draws the lines of `batches` and hands each batch to `visit` with a per-thread scratch `S`, in
-/// parallel; returns the results in batch order.
+/// Draws the lines of `batches` (through `scene`'s region for the stream's bound) and hands each batch
+/// to `visit` with a per-thread scratch `S`, in parallel; returns the results in batch order.
 ///
 /// `stop(b)` is asked before batch `b` starts; when it says yes the batch is skipped. Every batch that
 /// finished is kept (a stop keeps the work done, whichever batches it was); the flag says whether every
 /// batch ran.
 pub fn map_batches<S, T, E>(
     stream: &LineStream,
-    radius: f64,
+    scene: &Scene,
     batches: &[u64],
     stop: &(dyn Fn(u64) -> bool + Sync),
     visit: impl Fn(&mut S, Batch<'_>) -> Result<T, E> + Sync + Send,
@@ -98,6 +111,7 @@ where
     T: Send,
     E: Send,
 {
+    let region = LineRegion::of(scene, stream.bound);
     let per_batch: Vec<Option<(u64, T)>> = batches
         .par_iter()
         .copied()
@@ -108,7 +122,7 @@ where
                     return Ok(None);
                 }
                 lines.clear();
-                stream.draw(b, radius, lines);
+                stream.draw(b, &region, lines);
                 let batch = Batch {
                     index: b,
                     first_line: stream.plan.first_line(b),
@@ -143,7 +157,7 @@ impl TraceBuffers {
 pub fn map_traced_batches<S, T>(
     stream: &LineStream,
     tracer: &dyn Tracer,
-    radius: f64,
+    scene: &Scene,
     batches: &[u64],
     stop: &(dyn Fn(u64) -> bool + Sync),
     visit: impl Fn(&mut S, Batch<'_>, &LineHits) -> T + Sync + Send,
@@ -154,7 +168,7 @@ where
 {
     map_batches(
         stream,
-        radius,
+        scene,
         batches,
         stop,
         |(buffers, scratch): &mut (TraceBuffers, S), batch| {

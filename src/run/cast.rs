@@ -164,6 +164,7 @@ pub fn cast(
         plan,
         source: cfg.source,
         sampler: cfg.sampler,
+        bound: cfg.bound,
         groups: state.group_count(),
         seed: cfg.seed,
     };

@@ -14,6 +14,7 @@ use super::errors::ErrorMethod;
 use super::plan::BatchPlan;
 use crate::measure::estimators::EntropyEstimator;
 use crate::measure::radiosity::SolveOptions;
+use crate::sample::bounds::LineBound;
 use crate::sample::lines::{LineSource, Sampler};
 
 /// Default number of independent groups of lines behind every standard error.
@@ -70,6 +71,10 @@ pub struct RunSpec {
     /// which read as independent lines.
     #[serde(default)]
     pub sampler: Sampler,
+    /// Lines through the bounding sphere or the bounding box ([`LineBound`]; not with bundles, nor with
+    /// `enclose`). Absent from states saved before it existed, which read as the sphere.
+    #[serde(default)]
+    pub bound: LineBound,
     /// Groups for the standard errors ([`super::errors`]).
     pub groups: usize,
     /// Which measures to compute.
@@ -101,6 +106,7 @@ impl RunSpec {
             seed,
             source: LineSource::Independent,
             sampler: Sampler::Independent,
+            bound: LineBound::Sphere,
             groups: DEFAULT_GROUPS,
             measures: Measures::ALL,
             estimator: DEFAULT_ESTIMATOR,
@@ -112,10 +118,18 @@ impl RunSpec {
         }
     }
 
-    /// Whether the settings go together: the Sobol' sampler draws single lines, not bundles.
+    /// Whether the settings go together: the Sobol' sampler and lines through the box are single lines,
+    /// not bundles; the environment of `enclose` is the bounding sphere, which lines through the box do
+    /// not sample.
     pub fn check(&self) -> Result<(), SpecError> {
-        match (self.sampler, self.source) {
-            (Sampler::Sobol, LineSource::Bundles { grid }) => Err(SpecError::SobolBundles { grid }),
+        match (self.sampler, self.source, self.bound) {
+            (Sampler::Sobol, LineSource::Bundles { grid }, _) => {
+                Err(SpecError::SobolBundles { grid })
+            }
+            (_, LineSource::Bundles { grid }, LineBound::Box) => {
+                Err(SpecError::BoxBundles { grid })
+            }
+            (_, _, LineBound::Box) if self.enclose => Err(SpecError::BoxEnclose),
             _ => Ok(()),
         }
     }
@@ -264,6 +278,22 @@ pub enum SpecError {
         /// The bundle grid asked for.
         grid: u32,
     },
+    /// Lines through the bounding box with bundles.
+    #[error(
+        "lines through the bounding box are drawn one by one, each from a face of the box, and do not \
+         come in bundles (asked: bundles of {grid} x {grid}); use lines through the sphere for bundles"
+    )]
+    BoxBundles {
+        /// The bundle grid asked for.
+        grid: u32,
+    },
+    /// Lines through the bounding box with the environment patch.
+    #[error(
+        "--enclose makes the bounding sphere the environment patch, and its area is counted from the \
+         lines that meet the sphere but not the scene, which lines through the bounding box leave out; \
+         use lines through the sphere with --enclose"
+    )]
+    BoxEnclose,
 }
 
 /// Why a run cannot be continued to more lines.

@@ -40,7 +40,7 @@ impl TracedBatches {
         let (batches, complete) = map_traced_batches(
             stream,
             tracer,
-            scene.bounding_radius(),
+            scene,
             batches,
             stop,
             |_: &mut (), batch, hits| tally.batch(batch.lines, hits),

@@ -30,7 +30,8 @@ use std::fmt;
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[repr(C)]
 pub struct Line {
-    /// A point outside the bounding sphere, on the line.
+    /// A point on the line outside the scene: on (or just beyond) the bounding sphere or the bounding
+    /// box the run draws its lines through.
     pub origin: [f32; 3],
     /// Unit direction.
     pub dir: [f32; 3],

@@ -4,6 +4,7 @@
 mod support;
 
 // The library against independent truth.
+mod bounds;
 mod bundles;
 mod calibration;
 mod crosscheck;

@@ -9,6 +9,7 @@ use scene_complexity::internals::analysis::{analyze, AnalysisError, Verdict};
 use scene_complexity::internals::measure::estimators::EntropyEstimator;
 use scene_complexity::internals::measure::Measure;
 use scene_complexity::internals::run::{LineStream, Measures, RunControl, RunSpec};
+use scene_complexity::internals::sample::bounds::{LineBound, LineRegion};
 use scene_complexity::internals::sample::lines::{LineSource, Sampler};
 use scene_complexity::internals::scene::Scene;
 use scene_complexity::internals::scenes;
@@ -35,6 +36,7 @@ fn sobol_lines_hit_each_patch_as_often_as_crofton_says() {
         plan: spec.plan(),
         source: LineSource::Independent,
         sampler: Sampler::Sobol,
+        bound: LineBound::Sphere,
         groups: spec.group_count() as u64,
         seed: spec.seed,
     };
@@ -45,7 +47,7 @@ fn sobol_lines_hit_each_patch_as_often_as_crofton_says() {
         let (mut lines, mut raw, mut hits) = (Vec::new(), Vec::new(), LineHits::default());
         for b in 0..stream.plan.batches() {
             lines.clear();
-            stream.draw(b, 1.0, &mut lines);
+            stream.draw(b, &LineRegion::Sphere(1.0), &mut lines);
             tracer.all_hits(&lines, &mut raw, &mut hits).unwrap();
             let g = (b % groups as u64) as usize;
             lines_per_group[g] += lines.len() as f64;

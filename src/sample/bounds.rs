@@ -1,0 +1,374 @@
+//! Where a run's global lines are drawn: through the scene's bounding sphere (the paper's lines, sec.
+//! 2.1.1, [`super::lines`]) or through its bounding box (`--lines-through box`).
+//!
+//! **Lines through the box.** An oriented line that meets a convex body enters it at exactly one point,
+//! and the invariant density of lines, written at that entry point `x` of the body's surface, is
+//! `|cos theta| dA(x) d omega` (integral geometry; Santaló, *Integral Geometry and Geometric
+//! Probability*, ch. 12). So a line uniformly distributed among those that meet the box is: a face chosen
+//! in proportion to its area, a uniform point on it, and a direction cosine-distributed about the inward
+//! normal (a uniform point of the unit disc lifted to the hemisphere, Malley's method). These are the
+//! sphere's lines conditioned on meeting the box: every count of hits, segments and pairs, and every
+//! measure made from them, is the same in distribution per line that meets the scene, and the sphere's
+//! lines that miss the box (`1 - S_box / (4 pi R^2)` of them: 36% for a cube, two thirds and more for a
+//! flat scene) are never drawn. What changes is the meaning of a line count: `n` lines through the box
+//! are worth `n / p` lines through the sphere, `p = S_box / (4 pi R^2)` ([`BoundingBox::share_of_sphere`]).
+//! A box can also be the larger container: the octahedron's reaches out of its sphere (`p` = 1.9), and
+//! its lines then miss the scene more often than the sphere's.
+//!
+//! With the Sobol' sampler the first two coordinates of each point choose the face and the point on it,
+//! the last two the direction: where a scene's walls lie in the box's faces or parallel to them (rooms,
+//! `@cube:N`), the patches a line enters through are rectangles aligned with the sequence's axes, which a
+//! low-discrepancy sequence integrates far better than the curved regions of the sphere's
+//! parametrisation (docs/sampling.md).
+
+use rand::RngCore;
+
+use super::lines::{batch_rng, concentric_disc};
+use super::sobol::ScrambledSobol;
+use crate::geom::uniform01;
+use crate::scene::Scene;
+use crate::trace::Line;
+
+/// How far the box reaches beyond the scene on every side, in bounding radii: lines start this far
+/// from any surface (so f32 rounding never puts an origin on a triangle), and a flat scene still gets
+/// a box with six faces of positive area.
+const BOX_MARGIN: f64 = 1e-3;
+
+/// Where the lines of a run are drawn.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum LineBound {
+    /// Through the bounding sphere (the paper's global lines).
+    #[default]
+    Sphere,
+    /// Through the bounding box, grown by a thousandth of the bounding radius on every side: the
+    /// sphere's lines that meet it (module documentation).
+    Box,
+}
+
+impl LineBound {
+    /// Every bound with its name.
+    pub const NAMES: [(&'static str, LineBound); 2] =
+        [("sphere", LineBound::Sphere), ("box", LineBound::Box)];
+
+    /// The name used on the command line and in reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            LineBound::Sphere => "sphere",
+            LineBound::Box => "box",
+        }
+    }
+
+    /// Parses a name as printed by [`LineBound::name`].
+    pub fn from_name(name: &str) -> Option<Self> {
+        Self::NAMES
+            .iter()
+            .find(|(n, _)| *n == name)
+            .map(|&(_, b)| b)
+    }
+}
+
+/// An axis-aligned box that lines are drawn through, with its faces' areas.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BoundingBox {
+    lo: [f64; 3],
+    hi: [f64; 3],
+    /// The running sums of the faces' areas, in the order x-, x+, y-, y+, z-, z+.
+    cumulative: [f64; 6],
+}
+
+impl BoundingBox {
+    /// The box from `lo` to `hi` (every `lo[k] < hi[k]`).
+    pub fn new(lo: [f64; 3], hi: [f64; 3]) -> Self {
+        let side = |k: usize| hi[k] - lo[k];
+        let mut cumulative = [0.0; 6];
+        let mut sum = 0.0;
+        for (face, c) in cumulative.iter_mut().enumerate() {
+            let axis = face / 2;
+            sum += side((axis + 1) % 3) * side((axis + 2) % 3);
+            *c = sum;
+        }
+        BoundingBox { lo, hi, cumulative }
+    }
+
+    /// The box of `scene`'s triangles in tracing space, grown by [`BOX_MARGIN`] bounding radii.
+    pub fn of(scene: &Scene) -> Self {
+        let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+        for &v in scene.triangles.iter().flatten() {
+            for (k, &x) in scene.positions[v as usize].iter().enumerate() {
+                lo[k] = lo[k].min(f64::from(x));
+                hi[k] = hi[k].max(f64::from(x));
+            }
+        }
+        let grow = BOX_MARGIN * scene.bounding_radius();
+        if !lo[0].is_finite() {
+            // No triangle: any small box (its lines meet nothing).
+            (lo, hi) = ([0.0; 3], [0.0; 3]);
+        }
+        BoundingBox::new(lo.map(|x| x - grow), hi.map(|x| x + grow))
+    }
+
+    /// The box's surface area.
+    pub fn surface_area(&self) -> f64 {
+        self.cumulative[5]
+    }
+
+    /// The measure of the lines that meet the box relative to those that meet a sphere of radius
+    /// `radius`, `S_box / (4 pi R^2)` (Cauchy: the lines meeting a convex body are in proportion to its
+    /// surface area): the share of the sphere's lines that meet the box when the box is inside the
+    /// sphere, and more than 1 when it reaches out of it (an octahedron's box pokes out of its sphere).
+    /// Either way, with both containing the scene, `n` lines through the box meet the scene as often as
+    /// `n / share` through the sphere.
+    pub fn share_of_sphere(&self, radius: f64) -> f64 {
+        self.surface_area() / (4.0 * std::f64::consts::PI * radius * radius)
+    }
+
+    /// The line of the unit point `u`: `u[0]` chooses the face (in proportion to the faces' areas) and,
+    /// rescaled within the face's share, the first coordinate on it, `u[1]` the second; `(u[2], u[3])`
+    /// is mapped onto the unit disc (the concentric map) and lifted to the hemisphere about the face's
+    /// inward normal, which makes the direction cosine-distributed. The line starts on the face and
+    /// ends where it leaves the box.
+    pub fn line(&self, u: [f64; 4]) -> Line {
+        let total = self.surface_area();
+        let at = u[0] * total;
+        let face = self.cumulative.iter().take(5).filter(|&&c| c <= at).count();
+        let before = if face == 0 {
+            0.0
+        } else {
+            self.cumulative[face - 1]
+        };
+        let share = self.cumulative[face] - before;
+        let s = ((at - before) / share).clamp(0.0, 1.0);
+        let (axis, upper) = (face / 2, face % 2 == 1);
+        let (b, c) = ((axis + 1) % 3, (axis + 2) % 3);
+        let mut origin = [0.0; 3];
+        origin[axis] = if upper { self.hi[axis] } else { self.lo[axis] };
+        origin[b] = self.lo[b] + s * (self.hi[b] - self.lo[b]);
+        origin[c] = self.lo[c] + u[1] * (self.hi[c] - self.lo[c]);
+        let (dx, dy) = concentric_disc(2.0 * u[2] - 1.0, 2.0 * u[3] - 1.0);
+        let dz = (1.0 - dx * dx - dy * dy).max(0.0).sqrt();
+        let mut dir = [0.0; 3];
+        dir[axis] = if upper { -dz } else { dz };
+        dir[b] = dx;
+        dir[c] = dy;
+        Line {
+            origin: origin.map(|x| x as f32),
+            dir: dir.map(|x| x as f32),
+            t_max: self.exit(origin, dir) as f32,
+        }
+    }
+
+    /// Where the line from `origin` (on the box) along `dir` leaves the box: the least positive exit
+    /// through a face it heads towards.
+    fn exit(&self, origin: [f64; 3], dir: [f64; 3]) -> f64 {
+        (0..3)
+            .filter(|&k| dir[k] != 0.0)
+            .map(|k| {
+                let end = if dir[k] > 0.0 { self.hi[k] } else { self.lo[k] };
+                (end - origin[k]) / dir[k]
+            })
+            .filter(|t| *t > 0.0)
+            .fold(f64::INFINITY, f64::min)
+    }
+}
+
+/// Appends `count` independent lines through `bounds` to `out`, four draws of batch `batch`'s stream
+/// ([`batch_rng`]) per line: a batch's lines depend on `seed` and its index only.
+pub fn box_batch_lines(
+    seed: u64,
+    batch: u64,
+    count: usize,
+    bounds: &BoundingBox,
+    out: &mut Vec<Line>,
+) {
+    let mut rng = batch_rng(seed, batch);
+    out.reserve(count);
+    out.extend((0..count).map(|_| bounds.line(draw4(&mut rng))));
+}
+
+fn draw4(rng: &mut impl RngCore) -> [f64; 4] {
+    [(); 4].map(|_| uniform01(rng))
+}
+
+/// Appends the lines through `bounds` of points `first..first + count` of group `group`'s randomised
+/// Sobol' sequence (seed `seed`) to `out` (the points of [`super::lines::sobol_lines`]).
+pub fn sobol_box_lines(
+    seed: u64,
+    group: u64,
+    first: u64,
+    count: usize,
+    bounds: &BoundingBox,
+    out: &mut Vec<Line>,
+) {
+    out.reserve(count);
+    ScrambledSobol::new(seed, group).for_each_unit(first, count, |u| out.push(bounds.line(u)));
+}
+
+/// How many lines through `scene`'s bounding sphere `lines` lines drawn as `bound` says are worth: as
+/// many for the sphere, `lines / p` through the box ([`BoundingBox::share_of_sphere`]; fewer than
+/// `lines` when the box is the larger container).
+pub fn sphere_lines(scene: &Scene, bound: LineBound, lines: u64) -> f64 {
+    match bound {
+        LineBound::Sphere => lines as f64,
+        LineBound::Box => {
+            lines as f64 / BoundingBox::of(scene).share_of_sphere(scene.bounding_radius())
+        }
+    }
+}
+
+/// Where a run draws its lines: the bounding sphere's radius, or the bounding box.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum LineRegion {
+    /// Through the sphere of this radius about the origin.
+    Sphere(f64),
+    /// Through this box.
+    Box(BoundingBox),
+}
+
+impl LineRegion {
+    /// `scene`'s region for lines drawn as `bound` says.
+    pub fn of(scene: &Scene, bound: LineBound) -> Self {
+        match bound {
+            LineBound::Sphere => LineRegion::Sphere(scene.bounding_radius()),
+            LineBound::Box => LineRegion::Box(BoundingBox::of(scene)),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const LO: [f64; 3] = [-0.5, -1.0, 0.25];
+    const HI: [f64; 3] = [0.5, 1.0, 3.25];
+
+    /// 2^16 lines through the box `LO..HI` from both samplers (independent: 16 batches; Sobol': the first
+    /// points of group 0).
+    fn both_samplers() -> [(&'static str, Vec<Line>); 2] {
+        let b = BoundingBox::new(LO, HI);
+        let mut independent = Vec::new();
+        for batch in 0..16 {
+            box_batch_lines(5, batch, 4096, &b, &mut independent);
+        }
+        let mut sobol = Vec::new();
+        sobol_box_lines(5, 0, 0, 1 << 16, &b, &mut sobol);
+        [("independent", independent), ("sobol", sobol)]
+    }
+
+    fn on_the_surface(p: [f64; 3]) -> bool {
+        let inside = (0..3).all(|k| p[k] >= LO[k] - 1e-6 && p[k] <= HI[k] + 1e-6);
+        let on_a_face = (0..3).any(|k| (p[k] - LO[k]).abs() < 1e-6 || (p[k] - HI[k]).abs() < 1e-6);
+        inside && on_a_face
+    }
+
+    /// Mean and standard error of the mean.
+    fn mean_se(x: &[f64]) -> (f64, f64) {
+        let n = x.len() as f64;
+        let mean = x.iter().sum::<f64>() / n;
+        let var = x.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0);
+        (mean, (var / n).sqrt())
+    }
+
+    /// Every line starts on the box's surface, has a unit direction into the box, and ends on the
+    /// surface again; the chords' mean is Cauchy's 4 V / S for uniformly distributed lines meeting a
+    /// convex body (to 4 standard errors for independent lines; Sobol' lines, whose spread is not that
+    /// of independent draws, to 1%).
+    #[test]
+    fn lines_cross_the_box_with_cauchys_mean_chord() {
+        let side = |k: usize| HI[k] - LO[k];
+        let volume = side(0) * side(1) * side(2);
+        let area = 2.0 * (side(0) * side(1) + side(1) * side(2) + side(2) * side(0));
+        assert!((BoundingBox::new(LO, HI).surface_area() - area).abs() < 1e-12);
+        let cauchy = 4.0 * volume / area;
+        for (name, lines) in both_samplers() {
+            let mut chords = Vec::with_capacity(lines.len());
+            for l in &lines {
+                let o = l.origin.map(f64::from);
+                let d = l.dir.map(f64::from);
+                let norm = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+                assert!((norm - 1.0).abs() < 1e-6, "{name}: {l:?}");
+                assert!(on_the_surface(o), "{name}: origin {l:?}");
+                let t = f64::from(l.t_max);
+                let end = [0, 1, 2].map(|k| o[k] + t * d[k]);
+                assert!(on_the_surface(end), "{name}: end {end:?} of {l:?}");
+                let step = [0, 1, 2].map(|k| o[k] + 1e-3 * t * d[k]);
+                assert!(
+                    (0..3).all(|k| step[k] > LO[k] && step[k] < HI[k]),
+                    "{name}: {l:?} does not head into the box"
+                );
+                chords.push(t);
+            }
+            let (mean, se) = mean_se(&chords);
+            let tolerance = if name == "sobol" {
+                0.01 * cauchy
+            } else {
+                4.0 * se
+            };
+            assert!(
+                (mean - cauchy).abs() < tolerance,
+                "{name}: mean chord {mean} (se {se}), Cauchy {cauchy}"
+            );
+        }
+    }
+
+    /// The faces are entered in proportion to their areas, and the directions are cosine-distributed
+    /// about the inward normal: the cosine's mean is 2/3 and its square's 1/2.
+    #[test]
+    fn faces_by_area_and_directions_by_cosine() {
+        let side = |k: usize| HI[k] - LO[k];
+        let area = 2.0 * (side(0) * side(1) + side(1) * side(2) + side(2) * side(0));
+        for (name, lines) in both_samplers() {
+            let n = lines.len() as f64;
+            let mut per_axis = [0.0; 3];
+            let (mut cosines, mut squares) = (Vec::new(), Vec::new());
+            for l in &lines {
+                let o = l.origin.map(f64::from);
+                let axis = (0..3)
+                    .find(|&k| (o[k] - LO[k]).abs() < 1e-6 || (o[k] - HI[k]).abs() < 1e-6)
+                    .unwrap();
+                per_axis[axis] += 1.0;
+                let c = f64::from(l.dir[axis]).abs();
+                cosines.push(c);
+                squares.push(c * c);
+            }
+            for (axis, count) in per_axis.iter().enumerate() {
+                let p = 2.0 * side((axis + 1) % 3) * side((axis + 2) % 3) / area;
+                let se = (p * (1.0 - p) / n).sqrt();
+                assert!(
+                    (count / n - p).abs() < 4.5 * se,
+                    "{name}: axis {axis}: {count}"
+                );
+            }
+            for (x, exact) in [(&cosines, 2.0 / 3.0), (&squares, 0.5)] {
+                let (mean, se) = mean_se(x);
+                assert!(
+                    (mean - exact).abs() < 4.5 * se,
+                    "{name}: {mean} against {exact}"
+                );
+            }
+        }
+    }
+
+    /// A box's share of the lines through a sphere about it is its surface over the sphere's (a cube
+    /// inscribed in the unit sphere: 6 (2 / sqrt 3)^2 / (4 pi) = 2 / pi).
+    #[test]
+    fn an_inscribed_cube_meets_two_lines_in_pi() {
+        let h = 1.0 / 3f64.sqrt();
+        let cube = BoundingBox::new([-h; 3], [h; 3]);
+        let share = cube.share_of_sphere(1.0);
+        assert!(
+            (share - 2.0 / std::f64::consts::PI).abs() < 1e-12,
+            "{share}"
+        );
+    }
+
+    #[test]
+    fn bounds_have_names() {
+        for (name, b) in LineBound::NAMES {
+            assert_eq!(b.name(), name);
+            assert_eq!(LineBound::from_name(name), Some(b));
+        }
+        assert_eq!(LineBound::from_name("cube"), None);
+        assert_eq!(LineBound::default(), LineBound::Sphere);
+    }
+}
