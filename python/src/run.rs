@@ -300,7 +300,8 @@ fn optional_path(value: Option<&Bound<'_, PyAny>>, what: &str) -> PyResult<Optio
 #[pyo3(signature = (scene, lines=None, seed=None, *, threads=None, measures=None,
                     target_stderr=None, target_measure="mutual_information_corrected",
                     seconds=None, enclose=false, groups=None, estimator="chao-wang-jost",
-                    errors="groups", bundle=None, sampler="independent", per_patch=false, shard=None, save=None,
+                    errors="groups", bundle=None, sampler="independent", lines_through="sphere", per_patch=false,
+                    shard=None, save=None,
                     keep_state=true, progress=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn analyze(
@@ -319,6 +320,7 @@ pub fn analyze(
     errors: &str,
     bundle: Option<&Bound<'_, PyAny>>,
     sampler: &str,
+    lines_through: &str,
     per_patch: bool,
     shard: Option<&Bound<'_, PyAny>>,
     save: Option<&Bound<'_, PyAny>>,
@@ -381,6 +383,7 @@ pub fn analyze(
         estimator: args::estimator(estimator)?,
         errors: args::errors(errors)?,
         sampler: args::sampler(sampler)?,
+        bound: args::bound(lines_through)?,
         ..RunSpec::new(lines, seed)
     };
     spec.check().map_err(bad_argument)?;

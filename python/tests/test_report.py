@@ -160,6 +160,20 @@ def test_to_dict_of_a_sobol_run_is_the_json_of_scx_analyze():
     assert a.continuous_mutual_information.value != independent.continuous_mutual_information.value
 
 
+def test_to_dict_of_a_run_through_the_box_is_the_json_of_scx_analyze():
+    a = scx.analyze("@cube:4", lines=2e5, seed=3, sampler="sobol", lines_through="box", threads=1)
+    d = a.to_dict()
+    assert d["lines_through"] == "box"
+    # A cube's box meets 2/pi of its sphere's lines (less the box's margin): each is worth ~1.565.
+    assert d["sphere_lines"] == pytest.approx(2e5 * 1.5654, rel=1e-4)
+    cli = run_cli(
+        "analyze", "@cube:4", "--lines", "2e5", "--seed", "3", "--tracer", "rust", "--sampler", "sobol",
+        "--lines-through", "box",
+    )
+    assert without_process(d) == without_process(cli)
+    assert scx.analyze("@cube:4", lines=2e5, seed=3, threads=1).to_dict()["lines_through"] == "sphere"
+
+
 def test_an_enclosed_run_has_the_environment_as_its_last_patch(tmp_path):
     # An open box: the environment closes it, so every row of F (the environment's too) sums to 1 and
     # the per-patch terms, the environment's included, add up to the enclosed scene's measures.

@@ -23,7 +23,7 @@
 
 use rand::RngCore;
 
-use super::lines::{batch_rng, concentric_disc};
+use super::lines::{batch_rng, concentric_discs};
 use super::sobol::ScrambledSobol;
 use crate::geom::uniform01;
 use crate::scene::Scene;
@@ -125,12 +125,37 @@ impl BoundingBox {
 
     /// The line of the unit point `u`: `u[0]` chooses the face (in proportion to the faces' areas) and,
     /// rescaled within the face's share, the first coordinate on it, `u[1]` the second; `(u[2], u[3])`
-    /// is mapped onto the unit disc (the concentric map) and lifted to the hemisphere about the face's
-    /// inward normal, which makes the direction cosine-distributed. The line starts on the face and
-    /// ends where it leaves the box.
+    /// is mapped onto the unit disc (the concentric map, its sine and cosine the polynomials of
+    /// the sphere's Sobol' lines) and lifted to the hemisphere about the face's inward normal, which
+    /// makes the direction cosine-distributed. The line starts on the face and ends where it leaves
+    /// the box.
     pub fn line(&self, u: [f64; 4]) -> Line {
+        let (dx, dy) = concentric_discs(&[2.0 * u[2] - 1.0], &[2.0 * u[3] - 1.0]);
+        self.line_with_disc(u[0], u[1], (dx[0], dy[0]))
+    }
+
+    /// The lines of `units`, [`BoundingBox::line`] of each, the disc points made 16 at a time (their
+    /// polynomial chains overlap), appended to `out`.
+    pub fn lines(&self, units: &[[f64; 4]], out: &mut Vec<Line>) {
+        const N: usize = 16;
+        for chunk in units.chunks(N) {
+            let (mut a, mut b) = ([0.0; N], [0.0; N]);
+            for (k, u) in chunk.iter().enumerate() {
+                a[k] = 2.0 * u[2] - 1.0;
+                b[k] = 2.0 * u[3] - 1.0;
+            }
+            let (dx, dy) = concentric_discs(&a, &b);
+            for (k, u) in chunk.iter().enumerate() {
+                out.push(self.line_with_disc(u[0], u[1], (dx[k], dy[k])));
+            }
+        }
+    }
+
+    /// [`BoundingBox::line`] once its direction's disc point is known.
+    #[inline(always)]
+    fn line_with_disc(&self, u0: f64, u1: f64, (dx, dy): (f64, f64)) -> Line {
         let total = self.surface_area();
-        let at = u[0] * total;
+        let at = u0 * total;
         let face = self.cumulative.iter().take(5).filter(|&&c| c <= at).count();
         let before = if face == 0 {
             0.0
@@ -144,8 +169,7 @@ impl BoundingBox {
         let mut origin = [0.0; 3];
         origin[axis] = if upper { self.hi[axis] } else { self.lo[axis] };
         origin[b] = self.lo[b] + s * (self.hi[b] - self.lo[b]);
-        origin[c] = self.lo[c] + u[1] * (self.hi[c] - self.lo[c]);
-        let (dx, dy) = concentric_disc(2.0 * u[2] - 1.0, 2.0 * u[3] - 1.0);
+        origin[c] = self.lo[c] + u1 * (self.hi[c] - self.lo[c]);
         let dz = (1.0 - dx * dx - dy * dy).max(0.0).sqrt();
         let mut dir = [0.0; 3];
         dir[axis] = if upper { -dz } else { dz };
@@ -160,15 +184,18 @@ impl BoundingBox {
 
     /// Where the line from `origin` (on the box) along `dir` leaves the box: the least positive exit
     /// through a face it heads towards.
+    #[inline(always)]
     fn exit(&self, origin: [f64; 3], dir: [f64; 3]) -> f64 {
-        (0..3)
-            .filter(|&k| dir[k] != 0.0)
-            .map(|k| {
-                let end = if dir[k] > 0.0 { self.hi[k] } else { self.lo[k] };
-                (end - origin[k]) / dir[k]
-            })
-            .filter(|t| *t > 0.0)
-            .fold(f64::INFINITY, f64::min)
+        let mut t = f64::INFINITY;
+        for k in 0..3 {
+            let end = if dir[k] > 0.0 { self.hi[k] } else { self.lo[k] };
+            // A zero component gives an infinite or NaN parameter, which `min` passes over.
+            let at = (end - origin[k]) / dir[k];
+            if at > 0.0 {
+                t = t.min(at);
+            }
+        }
+        t
     }
 }
 
@@ -183,7 +210,8 @@ pub fn box_batch_lines(
 ) {
     let mut rng = batch_rng(seed, batch);
     out.reserve(count);
-    out.extend((0..count).map(|_| bounds.line(draw4(&mut rng))));
+    let units: Vec<[f64; 4]> = (0..count).map(|_| draw4(&mut rng)).collect();
+    bounds.lines(&units, out);
 }
 
 fn draw4(rng: &mut impl RngCore) -> [f64; 4] {
@@ -201,7 +229,9 @@ pub fn sobol_box_lines(
     out: &mut Vec<Line>,
 ) {
     out.reserve(count);
-    ScrambledSobol::new(seed, group).for_each_unit(first, count, |u| out.push(bounds.line(u)));
+    let mut units = Vec::with_capacity(count);
+    ScrambledSobol::new(seed, group).for_each_unit(first, count, |u| units.push(u));
+    bounds.lines(&units, out);
 }
 
 /// How many lines through `scene`'s bounding sphere `lines` lines drawn as `bound` says are worth: as
@@ -360,6 +390,37 @@ mod tests {
             (share - 2.0 / std::f64::consts::PI).abs() < 1e-12,
             "{share}"
         );
+    }
+
+    /// Lines made 16 at a time are [`BoundingBox::line`]'s one at a time, bit for bit: full and partial
+    /// chunks, the disc's centre and diagonals, the ends of [0, 1) and every face.
+    #[test]
+    fn lines_made_in_chunks_are_the_lines_made_one_by_one() {
+        let b = BoundingBox::new(LO, HI);
+        let mut rng = batch_rng(11, 0);
+        let mut units: Vec<[f64; 4]> = (0..5003).map(|_| draw4(&mut rng)).collect();
+        let below_one = 1.0 - f64::EPSILON / 2.0;
+        for edge in [0.0, 0.5, 0.25, 0.75, below_one] {
+            for face in 0..6 {
+                units.push([(face as f64 + 0.5) / 6.0, edge, edge, 0.5]);
+                units.push([(face as f64 + 0.5) / 6.0, edge, 0.5, edge]);
+                units.push([edge, 0.5, edge, 1.0 - edge]);
+            }
+        }
+        let mut chunked = Vec::new();
+        b.lines(&units, &mut chunked);
+        let one_by_one: Vec<Line> = units.iter().map(|&u| b.line(u)).collect();
+        assert_eq!(chunked.len(), one_by_one.len());
+        for (k, (x, y)) in chunked.iter().zip(&one_by_one).enumerate() {
+            let bits = |l: &Line| {
+                (
+                    l.origin.map(f32::to_bits),
+                    l.dir.map(f32::to_bits),
+                    l.t_max.to_bits(),
+                )
+            };
+            assert_eq!(bits(x), bits(y), "unit {k}: {:?}", units[k]);
+        }
     }
 
     #[test]

@@ -274,7 +274,7 @@ fn turns<const N: usize>(t: &[f64; N]) -> ([f64; N], [f64; N]) {
 
 /// [`concentric_disc_polynomial`] of each `(a[i], b[i])`.
 #[inline(always)]
-fn concentric_discs<const N: usize>(a: &[f64; N], b: &[f64; N]) -> ([f64; N], [f64; N]) {
+pub(super) fn concentric_discs<const N: usize>(a: &[f64; N], b: &[f64; N]) -> ([f64; N], [f64; N]) {
     use std::f64::consts::FRAC_PI_4;
     let (mut major, mut x) = ([0.0; N], [0.0; N]);
     let mut a_major = [false; N];
