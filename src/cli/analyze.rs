@@ -63,8 +63,9 @@ pub struct AnalyzeArgs {
     /// Where the lines are drawn: `sphere` (the paper's global lines, through the bounding sphere) or
     /// `box` (through the scene's bounding box: the sphere's lines that meet it, so no line is spent
     /// missing the box; with --sampler sobol, far smaller errors on scenes whose walls are parallel to
-    /// the box's faces). A line through the box is worth more than one through the sphere: the report
-    /// says how many. Not with --bundle or --enclose. docs/sampling.md.
+    /// the box's faces). A line count then counts lines through the box, each usually worth more than
+    /// one through the sphere: the report says how many, and when the sphere wastes fewer lines on the
+    /// scene. Not with --bundle or --enclose. docs/sampling.md.
     #[arg(long, default_value = "sphere", value_parser = parse_bound)]
     lines_through: LineBound,
     /// Close an open scene with a virtual, absorbing environment patch (the bounding sphere, facing

@@ -75,6 +75,50 @@ pub struct BoundingBox {
     hi: [f64; 3],
     /// The running sums of the faces' areas, in the order x-, x+, y-, y+, z-, z+.
     cumulative: [f64; 6],
+    /// The faces, in the same order.
+    faces: [Face; 6],
+}
+
+/// One face of a [`BoundingBox`], as whole vectors, so that a line is made without indexing by axis.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Face {
+    /// The running sum of the areas of the faces before it.
+    start: f64,
+    area: f64,
+    /// Its lower corner, and its two sides as vectors (along the next axis, then the one after).
+    corner: [f64; 3],
+    side_b: [f64; 3],
+    side_c: [f64; 3],
+    /// The inward normal, and the unit vectors of its two sides.
+    inward: [f64; 3],
+    unit_b: [f64; 3],
+    unit_c: [f64; 3],
+}
+
+impl Face {
+    fn new(face: usize, lo: [f64; 3], hi: [f64; 3], start: f64) -> Self {
+        let (axis, upper) = (face / 2, face % 2 == 1);
+        let (b, c) = ((axis + 1) % 3, (axis + 2) % 3);
+        let unit = |k: usize, length: f64| {
+            let mut v = [0.0; 3];
+            v[k] = length;
+            v
+        };
+        let mut corner = lo;
+        if upper {
+            corner[axis] = hi[axis];
+        }
+        Face {
+            start,
+            area: (hi[b] - lo[b]) * (hi[c] - lo[c]),
+            corner,
+            side_b: unit(b, hi[b] - lo[b]),
+            side_c: unit(c, hi[c] - lo[c]),
+            inward: unit(axis, if upper { -1.0 } else { 1.0 }),
+            unit_b: unit(b, 1.0),
+            unit_c: unit(c, 1.0),
+        }
+    }
 }
 
 impl BoundingBox {
@@ -83,12 +127,19 @@ impl BoundingBox {
         let side = |k: usize| hi[k] - lo[k];
         let mut cumulative = [0.0; 6];
         let mut sum = 0.0;
+        let mut faces = [Face::new(0, lo, hi, 0.0); 6];
         for (face, c) in cumulative.iter_mut().enumerate() {
             let axis = face / 2;
+            faces[face] = Face::new(face, lo, hi, sum);
             sum += side((axis + 1) % 3) * side((axis + 2) % 3);
             *c = sum;
         }
-        BoundingBox { lo, hi, cumulative }
+        BoundingBox {
+            lo,
+            hi,
+            cumulative,
+            faces,
+        }
     }
 
     /// The box of `scene`'s triangles in tracing space, grown by [`BOX_MARGIN`] bounding radii.
@@ -154,27 +205,15 @@ impl BoundingBox {
     /// [`BoundingBox::line`] once its direction's disc point is known.
     #[inline(always)]
     fn line_with_disc(&self, u0: f64, u1: f64, (dx, dy): (f64, f64)) -> Line {
-        let total = self.surface_area();
-        let at = u0 * total;
-        let face = self.cumulative.iter().take(5).filter(|&&c| c <= at).count();
-        let before = if face == 0 {
-            0.0
-        } else {
-            self.cumulative[face - 1]
-        };
-        let share = self.cumulative[face] - before;
-        let s = ((at - before) / share).clamp(0.0, 1.0);
-        let (axis, upper) = (face / 2, face % 2 == 1);
-        let (b, c) = ((axis + 1) % 3, (axis + 2) % 3);
-        let mut origin = [0.0; 3];
-        origin[axis] = if upper { self.hi[axis] } else { self.lo[axis] };
-        origin[b] = self.lo[b] + s * (self.hi[b] - self.lo[b]);
-        origin[c] = self.lo[c] + u1 * (self.hi[c] - self.lo[c]);
+        let at = u0 * self.surface_area();
+        let face = &self.faces[self.cumulative.iter().take(5).filter(|&&c| c <= at).count()];
+        let s = ((at - face.start) / face.area).clamp(0.0, 1.0);
+        let origin: [f64; 3] =
+            std::array::from_fn(|k| face.corner[k] + s * face.side_b[k] + u1 * face.side_c[k]);
         let dz = (1.0 - dx * dx - dy * dy).max(0.0).sqrt();
-        let mut dir = [0.0; 3];
-        dir[axis] = if upper { -dz } else { dz };
-        dir[b] = dx;
-        dir[c] = dy;
+        let dir: [f64; 3] = std::array::from_fn(|k| {
+            dz * face.inward[k] + dx * face.unit_b[k] + dy * face.unit_c[k]
+        });
         Line {
             origin: origin.map(|x| x as f32),
             dir: dir.map(|x| x as f32),
@@ -182,18 +221,16 @@ impl BoundingBox {
         }
     }
 
-    /// Where the line from `origin` (on the box) along `dir` leaves the box: the least positive exit
-    /// through a face it heads towards.
+    /// Where the line from `origin` (on the box) along `dir` leaves the box: the least exit parameter
+    /// through a face it heads towards, each chosen and bounded by selects rather than branches (a zero
+    /// component gives an infinite or NaN parameter, which counts as no exit).
     #[inline(always)]
     fn exit(&self, origin: [f64; 3], dir: [f64; 3]) -> f64 {
         let mut t = f64::INFINITY;
         for k in 0..3 {
             let end = if dir[k] > 0.0 { self.hi[k] } else { self.lo[k] };
-            // A zero component gives an infinite or NaN parameter, which `min` passes over.
             let at = (end - origin[k]) / dir[k];
-            if at > 0.0 {
-                t = t.min(at);
-            }
+            t = t.min(if at >= 0.0 { at } else { f64::INFINITY });
         }
         t
     }
@@ -247,12 +284,12 @@ pub fn sphere_lines(scene: &Scene, bound: LineBound, lines: u64) -> f64 {
 }
 
 /// Where a run draws its lines: the bounding sphere's radius, or the bounding box.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub enum LineRegion {
     /// Through the sphere of this radius about the origin.
     Sphere(f64),
-    /// Through this box.
-    Box(BoundingBox),
+    /// Through this box (boxed: its faces are prepared, about a kilobyte).
+    Box(std::boxed::Box<BoundingBox>),
 }
 
 impl LineRegion {
@@ -260,7 +297,7 @@ impl LineRegion {
     pub fn of(scene: &Scene, bound: LineBound) -> Self {
         match bound {
             LineBound::Sphere => LineRegion::Sphere(scene.bounding_radius()),
-            LineBound::Box => LineRegion::Box(BoundingBox::of(scene)),
+            LineBound::Box => LineRegion::Box(std::boxed::Box::new(BoundingBox::of(scene))),
         }
     }
 }
@@ -420,6 +457,63 @@ mod tests {
                 )
             };
             assert_eq!(bits(x), bits(y), "unit {k}: {:?}", units[k]);
+        }
+    }
+
+    /// The straightforward construction, coordinate by coordinate: the face by the running areas, the
+    /// origin and direction by axis index, the exit by the faces the line heads towards.
+    fn reference_line(b: &BoundingBox, u: [f64; 4]) -> ([f64; 3], [f64; 3], f64) {
+        let at = u[0] * b.surface_area();
+        let face = (0..5).filter(|&f| b.cumulative[f] <= at).count();
+        let before = if face == 0 {
+            0.0
+        } else {
+            b.cumulative[face - 1]
+        };
+        let s = ((at - before) / (b.cumulative[face] - before)).clamp(0.0, 1.0);
+        let (axis, upper) = (face / 2, face % 2 == 1);
+        let (j, k) = ((axis + 1) % 3, (axis + 2) % 3);
+        let mut origin = [0.0; 3];
+        origin[axis] = if upper { b.hi[axis] } else { b.lo[axis] };
+        origin[j] = b.lo[j] + s * (b.hi[j] - b.lo[j]);
+        origin[k] = b.lo[k] + u[1] * (b.hi[k] - b.lo[k]);
+        let (dx, dy) = concentric_discs(&[2.0 * u[2] - 1.0], &[2.0 * u[3] - 1.0]);
+        let (dx, dy) = (dx[0], dy[0]);
+        let dz = (1.0 - dx * dx - dy * dy).max(0.0).sqrt();
+        let mut dir = [0.0; 3];
+        dir[axis] = if upper { -dz } else { dz };
+        dir[j] = dx;
+        dir[k] = dy;
+        let t = (0..3)
+            .filter(|&a| dir[a] != 0.0)
+            .map(|a| ((if dir[a] > 0.0 { b.hi[a] } else { b.lo[a] }) - origin[a]) / dir[a])
+            .filter(|t| *t >= 0.0)
+            .fold(f64::INFINITY, f64::min);
+        (origin, dir, t)
+    }
+
+    /// [`BoundingBox::line`] (whole face vectors, exits by selects) is the reference construction:
+    /// equal origins, directions and exits, over random points and the special ones.
+    #[test]
+    fn lines_are_the_reference_construction() {
+        let b = BoundingBox::new(LO, HI);
+        let mut rng = batch_rng(12, 3);
+        let mut units: Vec<[f64; 4]> = (0..20_000).map(|_| draw4(&mut rng)).collect();
+        let below_one = 1.0 - f64::EPSILON / 2.0;
+        for edge in [0.0, 0.5, below_one] {
+            for face in 0..6 {
+                let u0 = (face as f64 + edge.min(0.999)) / 6.0;
+                units.push([u0, edge, edge, edge]);
+                units.push([u0, edge, 0.5, 0.0]);
+                units.push([u0, 1.0 - edge, 0.0, 0.5]);
+            }
+        }
+        for u in units {
+            let line = b.line(u);
+            let (origin, dir, t) = reference_line(&b, u);
+            assert_eq!(line.origin, origin.map(|x| x as f32), "{u:?}");
+            assert_eq!(line.dir, dir.map(|x| x as f32), "{u:?}");
+            assert_eq!(line.t_max, t as f32, "{u:?}");
         }
     }
 
