@@ -11,8 +11,11 @@ use scene_complexity::internals::sample::bounds::{LineBound, LineRegion};
 use scene_complexity::internals::sample::lines::{LineSource, Sampler};
 use scene_complexity::internals::scene::Scene;
 use scene_complexity::internals::scenes;
-use scene_complexity::internals::trace::{make_tracer, Backend, LineHits, Query};
-use support::{all_tracers, ff_parallel_rectangles, ff_perpendicular_rectangles};
+use scene_complexity::internals::trace::{make_tracer, Backend, Query};
+use support::{
+    ff_parallel_rectangles, ff_perpendicular_rectangles, hits_per_patch_match,
+    same_on_one_and_two_threads,
+};
 
 fn through_the_box(lines: u64, seed: u64, sampler: Sampler) -> RunSpec {
     RunSpec {
@@ -58,41 +61,13 @@ fn box_lines_hit_each_patch_as_often_as_crofton_says() {
             groups: spec.group_count() as u64,
             seed: spec.seed,
         };
-        let region = LineRegion::of(&scene, LineBound::Box);
-        let groups = spec.group_count();
-        for tracer in all_tracers(&scene) {
-            let mut per_patch = vec![vec![0.0f64; groups]; scene.patch_count()];
-            let mut lines_per_group = vec![0.0f64; groups];
-            let (mut lines, mut raw, mut hits) = (Vec::new(), Vec::new(), LineHits::default());
-            for b in 0..stream.plan.batches() {
-                lines.clear();
-                stream.draw(b, &region, &mut lines);
-                tracer.all_hits(&lines, &mut raw, &mut hits).unwrap();
-                let g = (b % groups as u64) as usize;
-                lines_per_group[g] += lines.len() as f64;
-                for h in &hits.hits {
-                    per_patch[scene.triangle_patch[h.triangle as usize] as usize][g] += 1.0;
-                }
-            }
-            for (p, counts) in per_patch.iter().enumerate() {
-                let shares: Vec<f64> = counts
-                    .iter()
-                    .zip(&lines_per_group)
-                    .map(|(c, n)| c / n)
-                    .collect();
-                let n = groups as f64;
-                let mean = shares.iter().sum::<f64>() / n;
-                let var = shares.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0);
-                let se = (var / n).sqrt();
-                let expected = 2.0 * scene.patches[p].area / surface;
-                assert!(
-                    (mean - expected).abs() < 4.5 * se,
-                    "{} {}: patch {p}: {mean} hits per line, Crofton {expected} (se {se})",
-                    sampler.name(),
-                    tracer.name()
-                );
-            }
-        }
+        hits_per_patch_match(
+            &scene,
+            &stream,
+            &LineRegion::of(&scene, LineBound::Box),
+            |p| 2.0 * scene.patches[p].area / surface,
+            sampler.name(),
+        );
     }
 }
 
@@ -137,29 +112,16 @@ fn box_runs_are_the_same_on_any_thread_count() {
             measures: Measures::ALL,
             ..through_the_box(150_000, 9, sampler)
         };
-        let on = |threads: usize| {
-            let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(threads)
-                .build()
-                .unwrap();
-            pool.install(|| {
-                analyze(&scene, tracer.as_ref(), &spec, &RunControl::default()).unwrap()
-            })
-        };
-        let (one, two) = (on(1), on(2));
-        for m in [
-            Measure::ContinuousMutualInformation,
-            Measure::MutualInformationCorrected,
-            Measure::MsePerLine,
-        ] {
-            let (a, b) = (one.estimate(m).unwrap(), two.estimate(m).unwrap());
-            assert_eq!(a.value.to_bits(), b.value.to_bits(), "{m:?}");
-            assert_eq!(
-                a.stderr.map(f64::to_bits),
-                b.stderr.map(f64::to_bits),
-                "{m:?}"
-            );
-        }
+        same_on_one_and_two_threads(
+            &scene,
+            tracer.as_ref(),
+            &spec,
+            &[
+                Measure::ContinuousMutualInformation,
+                Measure::MutualInformationCorrected,
+                Measure::MsePerLine,
+            ],
+        );
     }
 }
 
@@ -212,22 +174,8 @@ fn specs_without_a_bound_read_as_the_sphere() {
 #[cfg(feature = "cli")]
 #[test]
 fn box_runs_split_resumed_and_merged_are_the_single_run() {
-    use support::{json_of, scx};
-    const SESSION: [&str; 6] = [
-        "seconds",
-        "build_seconds",
-        "command_line",
-        "cpu",
-        "threads",
-        "shard",
-    ];
-    let strip = |v: &serde_json::Value| {
-        let mut v = v.clone();
-        for k in SESSION {
-            v.as_object_mut().unwrap().remove(k);
-        }
-        v
-    };
+    use support::{json_of, scx, without_session};
+    let strip = without_session;
     let dir = tempfile::tempdir().unwrap();
     let path = |name: &str| dir.path().join(name).to_str().unwrap().to_string();
     let run = |more: &[&str]| {

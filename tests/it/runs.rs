@@ -11,14 +11,7 @@ use std::path::Path;
 use std::process::{Command, Stdio};
 
 /// Fields that describe the session rather than the run.
-const SESSION: [&str; 6] = [
-    "seconds",
-    "build_seconds",
-    "command_line",
-    "cpu",
-    "threads",
-    "shard",
-];
+const SESSION: [&str; 6] = support::SESSION_FIELDS;
 
 fn json(out: &std::process::Output) -> serde_json::Value {
     serde_json::from_slice(&out.stdout).unwrap_or_else(|e| {

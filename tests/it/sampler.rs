@@ -13,8 +13,11 @@ use scene_complexity::internals::sample::bounds::{LineBound, LineRegion};
 use scene_complexity::internals::sample::lines::{LineSource, Sampler};
 use scene_complexity::internals::scene::Scene;
 use scene_complexity::internals::scenes;
-use scene_complexity::internals::trace::{make_tracer, Backend, LineHits, Query};
-use support::{all_tracers, ff_parallel_rectangles, ff_perpendicular_rectangles};
+use scene_complexity::internals::trace::{make_tracer, Backend, Query};
+use support::{
+    ff_parallel_rectangles, ff_perpendicular_rectangles, hits_per_patch_match,
+    same_on_one_and_two_threads,
+};
 
 fn sobol(lines: u64, seed: u64) -> RunSpec {
     RunSpec {
@@ -40,39 +43,13 @@ fn sobol_lines_hit_each_patch_as_often_as_crofton_says() {
         groups: spec.group_count() as u64,
         seed: spec.seed,
     };
-    let groups = spec.group_count();
-    for tracer in all_tracers(&scene) {
-        let mut per_patch = vec![vec![0.0f64; groups]; scene.patch_count()];
-        let mut lines_per_group = vec![0.0f64; groups];
-        let (mut lines, mut raw, mut hits) = (Vec::new(), Vec::new(), LineHits::default());
-        for b in 0..stream.plan.batches() {
-            lines.clear();
-            stream.draw(b, &LineRegion::Sphere(1.0), &mut lines);
-            tracer.all_hits(&lines, &mut raw, &mut hits).unwrap();
-            let g = (b % groups as u64) as usize;
-            lines_per_group[g] += lines.len() as f64;
-            for h in &hits.hits {
-                per_patch[scene.triangle_patch[h.triangle as usize] as usize][g] += 1.0;
-            }
-        }
-        for (p, counts) in per_patch.iter().enumerate() {
-            let shares: Vec<f64> = counts
-                .iter()
-                .zip(&lines_per_group)
-                .map(|(c, n)| c / n)
-                .collect();
-            let n = groups as f64;
-            let mean = shares.iter().sum::<f64>() / n;
-            let var = shares.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0);
-            let se = (var / n).sqrt();
-            let expected = scene.patches[p].area / (2.0 * std::f64::consts::PI);
-            assert!(
-                (mean - expected).abs() < 4.5 * se,
-                "{}: patch {p}: {mean} hits per line, Crofton {expected} (se {se})",
-                tracer.name()
-            );
-        }
-    }
+    hits_per_patch_match(
+        &scene,
+        &stream,
+        &LineRegion::Sphere(1.0),
+        |p| scene.patches[p].area / (2.0 * std::f64::consts::PI),
+        "sobol",
+    );
 }
 
 /// The unit cube's closed-form I_s (eq. 21 with the exact form factors of its six faces) and I_s^c of
@@ -207,28 +184,17 @@ fn sobol_runs_are_the_same_on_any_thread_count() {
     let scene = scenes::load("@cube:4").unwrap();
     let tracer = make_tracer(Backend::Rust, &scene, Query::Single).unwrap();
     let spec = sobol(150_000, 9);
-    let on = |threads: usize| {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap();
-        pool.install(|| analyze(&scene, tracer.as_ref(), &spec, &RunControl::default()).unwrap())
-    };
-    let (one, two) = (on(1), on(2));
-    for m in [
-        Measure::ContinuousMutualInformation,
-        Measure::MutualInformation,
-        Measure::MutualInformationCorrected,
-        Measure::MsePerLine,
-    ] {
-        let (a, b) = (one.estimate(m).unwrap(), two.estimate(m).unwrap());
-        assert_eq!(a.value.to_bits(), b.value.to_bits(), "{m:?}");
-        assert_eq!(
-            a.stderr.map(f64::to_bits),
-            b.stderr.map(f64::to_bits),
-            "{m:?}"
-        );
-    }
+    same_on_one_and_two_threads(
+        &scene,
+        tracer.as_ref(),
+        &spec,
+        &[
+            Measure::ContinuousMutualInformation,
+            Measure::MutualInformation,
+            Measure::MutualInformationCorrected,
+            Measure::MsePerLine,
+        ],
+    );
 }
 
 /// Sobol' lines and bundles do not go together: the run is refused before any line is cast.
@@ -267,24 +233,12 @@ fn specs_without_a_sampler_read_as_independent() {
 #[cfg(feature = "cli")]
 #[test]
 fn sobol_runs_split_resumed_and_merged_are_the_single_run() {
-    use support::{json_of, scx};
-    const SESSION: [&str; 6] = [
-        "seconds",
-        "build_seconds",
-        "command_line",
-        "cpu",
-        "threads",
-        "shard",
-    ];
+    use support::{json_of, scx, without_session};
     let same = |a: &serde_json::Value, b: &serde_json::Value, what: &str| {
-        let strip = |v: &serde_json::Value| {
-            let mut v = v.clone();
-            for k in SESSION {
-                v.as_object_mut().unwrap().remove(k);
-            }
-            v
-        };
-        assert!(strip(a) == strip(b), "{what}: reports differ");
+        assert!(
+            without_session(a) == without_session(b),
+            "{what}: reports differ"
+        );
     };
     let dir = tempfile::tempdir().unwrap();
     let path = |name: &str| dir.path().join(name).to_str().unwrap().to_string();

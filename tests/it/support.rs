@@ -280,3 +280,97 @@ pub fn count_entries(a: &Analysis) -> Vec<(u32, u32, u64)> {
         .for_each(|i, j, c| v.push((i, j, c)));
     v
 }
+
+/// Report fields that describe the session rather than the run (timings, command line, CPU, threads,
+/// shard): two reports of one run split, resumed or on other threads differ only in these.
+pub const SESSION_FIELDS: [&str; 6] = [
+    "seconds",
+    "build_seconds",
+    "command_line",
+    "cpu",
+    "threads",
+    "shard",
+];
+
+/// A JSON report without its [`SESSION_FIELDS`].
+pub fn without_session(v: &serde_json::Value) -> serde_json::Value {
+    let mut v = v.clone();
+    for k in SESSION_FIELDS {
+        v.as_object_mut().unwrap().remove(k);
+    }
+    v
+}
+
+/// Crofton through the tracers: over every batch of `stream` drawn through `region` and traced by each
+/// of `scene`'s tracers, the hits of each patch per line, mean of the stream's groups, are within 4.5
+/// standard errors of the groups of `expected(patch)`.
+pub fn hits_per_patch_match(
+    scene: &Scene,
+    stream: &scene_complexity::internals::run::LineStream,
+    region: &scene_complexity::internals::sample::bounds::LineRegion,
+    expected: impl Fn(usize) -> f64,
+    label: &str,
+) {
+    let groups = stream.groups as usize;
+    for tracer in all_tracers(scene) {
+        let mut per_patch = vec![vec![0.0f64; groups]; scene.patch_count()];
+        let mut lines_per_group = vec![0.0f64; groups];
+        let (mut lines, mut raw) = (Vec::new(), Vec::new());
+        let mut hits = scene_complexity::internals::trace::LineHits::default();
+        for b in 0..stream.plan.batches() {
+            lines.clear();
+            stream.draw(b, region, &mut lines);
+            tracer.all_hits(&lines, &mut raw, &mut hits).unwrap();
+            let g = (b % groups as u64) as usize;
+            lines_per_group[g] += lines.len() as f64;
+            for h in &hits.hits {
+                per_patch[scene.triangle_patch[h.triangle as usize] as usize][g] += 1.0;
+            }
+        }
+        for (p, counts) in per_patch.iter().enumerate() {
+            let shares: Vec<f64> = counts
+                .iter()
+                .zip(&lines_per_group)
+                .map(|(c, n)| c / n)
+                .collect();
+            let n = groups as f64;
+            let mean = shares.iter().sum::<f64>() / n;
+            let var = shares.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0);
+            let se = (var / n).sqrt();
+            let expected = expected(p);
+            assert!(
+                (mean - expected).abs() < 4.5 * se,
+                "{label} {}: patch {p}: {mean} hits per line, Crofton {expected} (se {se})",
+                tracer.name()
+            );
+        }
+    }
+}
+
+/// The same seed gives the same values and standard errors of `measures` on 1 and 2 threads, to the bit.
+pub fn same_on_one_and_two_threads(
+    scene: &Scene,
+    tracer: &dyn Tracer,
+    spec: &scene_complexity::internals::run::RunSpec,
+    measures: &[scene_complexity::internals::measure::Measure],
+) {
+    use scene_complexity::internals::analysis::analyze;
+    use scene_complexity::internals::run::RunControl;
+    let on = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| analyze(scene, tracer, spec, &RunControl::default()).unwrap())
+    };
+    let (one, two) = (on(1), on(2));
+    for &m in measures {
+        let (a, b) = (one.estimate(m).unwrap(), two.estimate(m).unwrap());
+        assert_eq!(a.value.to_bits(), b.value.to_bits(), "{m:?}");
+        assert_eq!(
+            a.stderr.map(f64::to_bits),
+            b.stderr.map(f64::to_bits),
+            "{m:?}"
+        );
+    }
+}
