@@ -15,8 +15,8 @@ use scene_complexity::internals::scene::Scene;
 use scene_complexity::internals::scenes;
 use scene_complexity::internals::trace::{make_tracer, Backend, Query};
 use support::{
-    ff_parallel_rectangles, ff_perpendicular_rectangles, hits_per_patch_match,
-    same_on_one_and_two_threads,
+    hits_per_patch_match, same_on_one_and_two_threads, unit_cube_matches_closed_forms,
+    unit_cube_mutual_information,
 };
 
 fn sobol(lines: u64, seed: u64) -> RunSpec {
@@ -58,10 +58,6 @@ fn sobol_lines_hit_each_patch_as_often_as_crofton_says() {
 fn unit_cube_measures_match_closed_forms_with_sobol_lines() {
     let scene = scenes::load("@cube").unwrap();
     let tracer = make_tracer(Backend::Rust, &scene, Query::Single).unwrap();
-    let f_par = ff_parallel_rectangles(1.0, 1.0, 1.0);
-    let f_perp = ff_perpendicular_rectangles(1.0, 1.0, 1.0);
-    let exact_is = f_par * (6.0 * f_par).log2() + 4.0 * f_perp * (6.0 * f_perp).log2();
-    let exact_isc = scene_complexity::calibrate::truth::cube_continuous_mutual_information();
     for seed in [3, 4] {
         let a = analyze(
             &scene,
@@ -70,18 +66,7 @@ fn unit_cube_measures_match_closed_forms_with_sobol_lines() {
             &RunControl::default(),
         )
         .unwrap();
-        for (measure, exact) in [
-            (Measure::MutualInformation, exact_is),
-            (Measure::ContinuousMutualInformation, exact_isc),
-        ] {
-            let e = a.estimate(measure).unwrap();
-            let se = e.stderr.unwrap();
-            assert!(
-                (e.value - exact).abs() < 4.5 * se + 1e-6,
-                "seed {seed}: {measure:?} = {} +- {se}, exact {exact}",
-                e.value
-            );
-        }
+        unit_cube_matches_closed_forms(&a, &format!("seed {seed}"));
     }
 }
 
@@ -95,9 +80,7 @@ fn unit_cube_measures_match_closed_forms_with_sobol_lines() {
 fn corrected_readings_of_sobol_runs_are_debiased() {
     let scene = scenes::load("@cube").unwrap();
     let tracer = make_tracer(Backend::Rust, &scene, Query::Single).unwrap();
-    let f_par = ff_parallel_rectangles(1.0, 1.0, 1.0);
-    let f_perp = ff_perpendicular_rectangles(1.0, 1.0, 1.0);
-    let exact = f_par * (6.0 * f_par).log2() + 4.0 * f_perp * (6.0 * f_perp).log2();
+    let exact = unit_cube_mutual_information();
     let runs: Vec<(f64, f64)> = (1..=12)
         .map(|seed| {
             let a = analyze(

@@ -374,3 +374,30 @@ pub fn same_on_one_and_two_threads(
         );
     }
 }
+
+/// The unit cube's closed-form I_s (eq. 21 with the exact form factors of its faces: one opposite face,
+/// four adjacent ones).
+pub fn unit_cube_mutual_information() -> f64 {
+    let f_par = ff_parallel_rectangles(1.0, 1.0, 1.0);
+    let f_perp = ff_perpendicular_rectangles(1.0, 1.0, 1.0);
+    f_par * (6.0 * f_par).log2() + 4.0 * f_perp * (6.0 * f_perp).log2()
+}
+
+/// A run of the unit cube reads its closed-form I_s and I_s^c (the calibration's exact value) within
+/// 4.5 of its standard errors (plus 1e-6).
+pub fn unit_cube_matches_closed_forms(a: &Analysis, label: &str) {
+    use scene_complexity::internals::measure::Measure;
+    let exact_isc = scene_complexity::calibrate::truth::cube_continuous_mutual_information();
+    for (measure, exact) in [
+        (Measure::MutualInformation, unit_cube_mutual_information()),
+        (Measure::ContinuousMutualInformation, exact_isc),
+    ] {
+        let e = a.estimate(measure).unwrap();
+        let se = e.stderr.unwrap();
+        assert!(
+            (e.value - exact).abs() < 4.5 * se + 1e-6,
+            "{label}: {measure:?} = {} +- {se}, exact {exact}",
+            e.value
+        );
+    }
+}
