@@ -4,8 +4,9 @@
 //! (`--lines-through`), over the same seeds (seed outermost, so that a drift of the machine's speed falls
 //! on every series alike), and prints per measure and series:
 //!
-//! * the spread (sample standard deviation) of the estimates over the seeds at equal lines, with its
-//!   own relative uncertainty 1/sqrt(2(n-1)): the direct measure of the error;
+//! * the spread (sample standard deviation) of the estimates over the seeds at equal lines (lines
+//!   through the sphere, as `--lines` counts them: through the box fewer are drawn, worth as many), with
+//!   its own relative uncertainty 1/sqrt(2(n-1)): the direct measure of the error;
 //! * the rms reported standard error, and spread / rms se (near 1 when the error bars are honest);
 //! * the mean, and with an exact value (the calibration scenes: `@cube:N`, the regular solids) its
 //!   distance to it in standard errors of the mean, (mean - exact) / (spread / sqrt(n)): a bias shows
@@ -29,7 +30,7 @@ use scene_complexity::calibrate::rectangles::{form_factor_row, AxisRect};
 use scene_complexity::calibrate::{truth, Basis, CalibrationScene};
 use scene_complexity::internals::analysis::{analyze, Analysis};
 use scene_complexity::internals::measure::Measure;
-use scene_complexity::internals::run::{RunControl, RunSpec};
+use scene_complexity::internals::run::{LinesThrough, RunControl, RunSpec};
 use scene_complexity::internals::sample::bounds::LineBound;
 use scene_complexity::internals::sample::lines::Sampler;
 use scene_complexity::internals::scene::Scene;
@@ -61,7 +62,7 @@ fn main() -> anyhow::Result<()> {
     let (specs, lines) = common::scenes_and_lines(1e6)?;
     let seeds: u64 = std::env::var("SCX_SAMPLER_SEEDS").map_or(Ok(30), |s| s.parse())?;
     let pool = rayon::ThreadPoolBuilder::new().num_threads(2).build()?;
-    println!("{lines} lines per run, 2 threads, Embree single lines, 16 groups, {seeds} seeds per sampler");
+    println!("{lines} lines per run (through the sphere, or worth as many through the box), 2 threads, Embree single lines, 16 groups, {seeds} seeds per sampler");
     for spec in &specs {
         pool.install(|| compare(spec, lines, seeds))?;
     }
@@ -99,11 +100,13 @@ fn compare(spec: &str, lines: u64, seeds: u64) -> anyhow::Result<()> {
         .collect();
     for seed in 1..=seeds {
         for (s, &(_, sampler, bound)) in SAMPLERS.iter().enumerate() {
+            // `lines` through the sphere, as `scx analyze --lines` counts them: through the box, as many
+            // as are worth that many.
             let cfg = RunSpec {
                 sampler,
-                bound,
                 ..RunSpec::new(lines, seed)
-            };
+            }
+            .through(&scene, LinesThrough::Bound(bound));
             let (w0, c0) = (Instant::now(), common::cpu_seconds());
             let a = analyze(&scene, tracer.as_ref(), &cfg, &RunControl::default())?;
             let r = &mut runs[s];

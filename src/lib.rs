@@ -104,12 +104,12 @@ pub use run::persist::{
     StateFile,
 };
 pub use run::{
-    remaining_lines, start, Budget, CastOptions, ErrorMethod, ExtendError, Measures, MergeError,
-    MissingLines, PersistError, RunControl, RunIdentity, RunSpec, RunState, SavedRun, SceneRef,
-    Scope, Shard, SpecDifference, SpecError, StartError, StopReason, Target, Tracing,
+    remaining_lines, start, Budget, CastOptions, ErrorMethod, ExtendError, LinesThrough, Measures,
+    MergeError, MissingLines, PersistError, RunControl, RunIdentity, RunSpec, RunState, SavedRun,
+    SceneRef, Scope, Shard, SpecDifference, SpecError, StartError, StopReason, Target, Tracing,
     DEFAULT_ESTIMATOR, DEFAULT_GROUPS,
 };
-pub use sample::bounds::{sphere_lines, LineBound};
+pub use sample::bounds::{lines_to_draw, sphere_lines, LineBound};
 pub use sample::counts::PairCounts;
 pub use sample::lines::{BundleError, LineSource, Sampler, MAX_BUNDLE_GRID};
 pub use sample::tally::{Tally, Wanted};

@@ -160,7 +160,7 @@ def analyze(
     errors: str = "groups",
     bundle: int = 0,
     sampler: str = "independent",
-    lines_through: str = "sphere",
+    lines_through: str = "auto",
     per_patch: bool = False,
     shard: Optional[Tuple[int, int]] = None,
     save: Optional[PathLike] = None,
@@ -176,8 +176,9 @@ def analyze(
 
     Args:
         scene: a :class:`Scene`, or a path or built-in name (``"@cube:10"``) read with :func:`load`.
-        lines: global lines to cast (``1e7`` is fine). Default 1e6, or no limit with ``seconds`` or
-            ``target_stderr`` (then ``lines`` only caps the run).
+        lines: global lines to cast (``1e7`` is fine), counted as lines through the bounding sphere
+            (``lines_through``). Default 1e6, or no limit with ``seconds`` or ``target_stderr`` (then
+            ``lines`` only caps the run).
         seed: seed of the line streams: the same seed gives the same lines and the same numbers.
         threads: worker threads; 0 for every core. The numbers do not depend on it.
         measures: which families to compute: a list of ``"discrete"``, ``"continuous"``,
@@ -197,11 +198,13 @@ def analyze(
         sampler: ``"independent"`` lines, or ``"sobol"``: randomised quasi-Monte Carlo lines (one
             scrambled Sobol' sequence per group), tighter for I_s^c, form factors and E(MSE); not with
             ``bundle`` (docs/sampling.md).
-        lines_through: ``"sphere"`` (the paper's global lines, through the bounding sphere) or ``"box"``:
-            through the scene's bounding box, the sphere's lines that meet it, so none is spent missing
-            it; with ``sampler="sobol"`` far tighter on scenes of axis-aligned walls. A line through the
-            box is worth more than one through the sphere (``to_dict()["sphere_lines"]``); not with
-            ``bundle`` or ``enclose`` (docs/sampling.md).
+        lines_through: ``"sphere"`` (the paper's global lines, through the bounding sphere), ``"box"``
+            (through the scene's bounding box, the sphere's lines that meet it, so none is spent missing
+            it; with ``sampler="sobol"`` far tighter on scenes of axis-aligned walls; not with ``bundle``
+            or ``enclose``), or ``"auto"``: the box for ``sampler="sobol"`` when the box is smaller than
+            the sphere, else the sphere. ``lines`` counts lines through the sphere either way: through
+            the box fewer are drawn (``to_dict()["lines"]``), worth as many (``["sphere_lines"]``)
+            (docs/sampling.md).
         per_patch: also share the measures out among the patches, for :meth:`Analysis.patches`,
             :func:`render` and the objects' shares (with ``enclose``, the environment is the last row) (memory grows with the patches times the groups).
         shard: ``(k, m)``: cast only shard k (from 1) of m of the run's batches; needs ``save``
@@ -266,7 +269,8 @@ def resume(
 
     Args:
         path: the state file.
-        lines: the line count to continue to (more than first asked is fine); default the run's own.
+        lines: the line count to continue to (more than first asked is fine; through the sphere, as
+            :func:`analyze` counts them); default the run's own.
         scene: the run's scene when it cannot be read from the name the state keeps: a :class:`Scene`
             (a scene built from arrays must be passed again) or a path; its fingerprint is checked.
         threads, per_patch, keep_state, progress: as for :func:`analyze`.

@@ -329,7 +329,7 @@ def analyze(
     errors: str = "groups",
     bundle: Optional[int] = None,
     sampler: str = "independent",
-    lines_through: str = "sphere",
+    lines_through: str = "auto",
     per_patch: bool = False,
     shard: Optional[Tuple[int, int]] = None,
     save: Optional[_Path] = None,

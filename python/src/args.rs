@@ -6,8 +6,8 @@ use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyFloat, PyInt, PyString};
 
 use scene_complexity::{
-    EntropyEstimator, ErrorMethod, LineBound, LineSource, Measure, Measures, ObjectSet, Planarity,
-    Reach, ReadPolicy, Sampler, SceneOptions, DEFAULT_PLANARITY, MAX_BUNDLE_GRID,
+    EntropyEstimator, ErrorMethod, LineSource, LinesThrough, Measure, Measures, ObjectSet,
+    Planarity, Reach, ReadPolicy, Sampler, SceneOptions, DEFAULT_PLANARITY, MAX_BUNDLE_GRID,
 };
 
 use crate::errors::bad_argument;
@@ -189,9 +189,9 @@ pub fn target_measure(key: &str) -> PyResult<Measure> {
 }
 
 /// Where the lines are drawn, by name (`scx analyze --lines-through`).
-pub fn bound(name: &str) -> PyResult<LineBound> {
-    LineBound::from_name(name).ok_or_else(|| {
-        let names: Vec<&str> = LineBound::NAMES.iter().map(|(n, _)| *n).collect();
+pub fn bound(name: &str) -> PyResult<LinesThrough> {
+    LinesThrough::from_name(name).ok_or_else(|| {
+        let names: Vec<&str> = LinesThrough::NAMES.iter().map(|(n, _)| *n).collect();
         bad_argument(format!(
             "lines_through: `{name}` is not one of {}",
             names.join(", ")

@@ -17,9 +17,9 @@ use pyo3::prelude::*;
 use pyo3::types::PyTuple;
 
 use scene_complexity::{
-    cast, finish, make_tracer, remaining_lines, start, Backend, Budget, CastOptions, Query,
-    RunControl, RunIdentity, RunSpec, RunState, SceneRef, Scope, Shard, StopReason, Target,
-    Tracing,
+    cast, finish, make_tracer, remaining_lines, start, Backend, Budget, CastOptions, LineBound,
+    LinesThrough, Query, RunControl, RunIdentity, RunSpec, RunState, SceneRef, Scope, Shard,
+    StopReason, Target, Tracing,
 };
 
 use crate::analysis::{Analysis, RunFacts};
@@ -300,7 +300,7 @@ fn optional_path(value: Option<&Bound<'_, PyAny>>, what: &str) -> PyResult<Optio
 #[pyo3(signature = (scene, lines=None, seed=None, *, threads=None, measures=None,
                     target_stderr=None, target_measure="mutual_information_corrected",
                     seconds=None, enclose=false, groups=None, estimator="chao-wang-jost",
-                    errors="groups", bundle=None, sampler="independent", lines_through="sphere", per_patch=false,
+                    errors="groups", bundle=None, sampler="independent", lines_through="auto", per_patch=false,
                     shard=None, save=None,
                     keep_state=true, progress=None))]
 #[allow(clippy::too_many_arguments)]
@@ -366,6 +366,7 @@ pub fn analyze(
             "a shard takes no seconds or target_stderr: every shard must cast its whole share",
         ));
     }
+    let through = args::bound(lines_through)?;
     // The command line's spec (src/cli/analyze.rs `spec_of` over `RunOptions::spec`).
     let spec = RunSpec {
         measures: args::measures(measures)?,
@@ -383,12 +384,17 @@ pub fn analyze(
         estimator: args::estimator(estimator)?,
         errors: args::errors(errors)?,
         sampler: args::sampler(sampler)?,
-        bound: args::bound(lines_through)?,
+        bound: match through {
+            // Set for the check's sake; `through` below settles it with the scene.
+            LinesThrough::Bound(b) => b,
+            LinesThrough::Auto => LineBound::Sphere,
+        },
         ..RunSpec::new(lines, seed)
     };
     spec.check().map_err(bad_argument)?;
-    let (state, identity) = {
+    let (state, identity, spec) = {
         let s = scene.get();
+        let spec = spec.through(&s.inner, through);
         let state = start(&s.inner, &spec).map_err(scene_error)?;
         let identity = RunIdentity::new(
             SceneRef::of(&s.inner.name, &s.reading, &s.inner),
@@ -396,7 +402,7 @@ pub fn analyze(
             shard,
             TRACING,
         );
-        (state, identity)
+        (state, identity, spec)
     };
     let session = Session {
         scene,
@@ -522,6 +528,7 @@ pub fn resume(
         check_per_patch(py, &shown, &identity, wanted, &without)?;
     }
     let mut state = saved.state;
+    let lines = lines.map(|n| identity.spec.lines_for(&lib_scene, n));
     if let Some(lines) = lines.filter(|&n| n != identity.spec.lines) {
         identity.spec = identity
             .spec

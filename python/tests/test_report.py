@@ -152,6 +152,8 @@ def test_form_factors_rows_sum_to_one_and_are_reciprocal():
 def test_to_dict_of_a_sobol_run_is_the_json_of_scx_analyze():
     a = scx.analyze("@cube:4", lines=2e5, seed=3, sampler="sobol", threads=1)
     assert a.to_dict()["sampler"] == "sobol"
+    # lines_through="auto": a cube's box is smaller than its sphere, so sobol lines go through the box.
+    assert a.to_dict()["lines_through"] == "box"
     cli = run_cli(
         "analyze", "@cube:4", "--lines", "2e5", "--seed", "3", "--tracer", "rust", "--sampler", "sobol"
     )
@@ -164,14 +166,21 @@ def test_to_dict_of_a_run_through_the_box_is_the_json_of_scx_analyze():
     a = scx.analyze("@cube:4", lines=2e5, seed=3, sampler="sobol", lines_through="box", threads=1)
     d = a.to_dict()
     assert d["lines_through"] == "box"
-    # A cube's box meets 2/pi of its sphere's lines (less the box's margin): each is worth ~1.565.
-    assert d["sphere_lines"] == pytest.approx(2e5 * 1.5654, rel=1e-4)
+    # lines counts lines through the sphere; a cube's box (half side 1/sqrt(3) in tracing space, grown
+    # by 1e-3) meets a share 6 h^2 / pi of them, and the fewest worth 2e5 are drawn.
+    h = 1 / np.sqrt(3) + 1e-3
+    assert abs(d["lines"] - 2e5 * 6 * h * h / np.pi) < 1.001
+    assert 2e5 <= d["sphere_lines"] <= 2e5 + 2
     cli = run_cli(
         "analyze", "@cube:4", "--lines", "2e5", "--seed", "3", "--tracer", "rust", "--sampler", "sobol",
         "--lines-through", "box",
     )
     assert without_process(d) == without_process(cli)
-    assert scx.analyze("@cube:4", lines=2e5, seed=3, threads=1).to_dict()["lines_through"] == "sphere"
+    for kwargs in ({}, {"sampler": "sobol", "lines_through": "sphere"}):
+        d = scx.analyze("@cube:4", lines=2e5, seed=3, threads=1, **kwargs).to_dict()
+        assert (d["lines_through"], d["lines"], d["sphere_lines"]) == ("sphere", 200000, 200000)
+    # The octahedron's box reaches out of its sphere: auto keeps the sphere.
+    assert scx.analyze("@octahedron", lines=1e4, sampler="sobol").to_dict()["lines_through"] == "sphere"
 
 
 def test_an_enclosed_run_has_the_environment_as_its_last_patch(tmp_path):

@@ -35,6 +35,7 @@ use crate::run::{
     BatchPlan, BatchSet, CastHooks, CastOptions, ErrorMethod, FinishedRun, RunControl, RunSpec,
     RunState, SpecError, StartError, StopReason, TargetReading,
 };
+use crate::sample::bounds::sphere_lines;
 use crate::sample::lines::Sampler;
 use crate::sample::tally::{ObjectSides, Tally, Wanted};
 use crate::scene::Scene;
@@ -426,7 +427,16 @@ fn judged_visibility(
 ) -> (VisibilityOfRun, bool) {
     let enclose = cfg.enclose && run.groups.iter().any(|t| t.counters.escapes > 0);
     let replication = replication(cfg, run, enclose);
-    let v = visibility_estimates(scene, run, cfg.estimator, enclose, replication, wanted);
+    let worth = sphere_lines(scene, cfg.bound, 1);
+    let v = visibility_estimates(
+        scene,
+        run,
+        cfg.estimator,
+        enclose,
+        replication,
+        wanted,
+        worth,
+    );
     (v, enclose)
 }
 

@@ -301,7 +301,8 @@ fn flag_above_continuous(
 /// What a run's verdicts are judged from besides its readings.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct RunFacts {
-    /// Lines cast.
+    /// Lines cast, counted as `--lines` counts them (through the bounding sphere): the unit of the lines
+    /// advice.
     pub lines: u64,
     /// Visible pairs.
     pub pairs: u64,

@@ -168,6 +168,7 @@ pub(super) fn visibility_estimates(
     enclose: bool,
     rep: Replication,
     wanted: Wanted,
+    worth: f64,
 ) -> VisibilityOfRun {
     let Replication {
         replicable,
@@ -243,19 +244,23 @@ pub(super) fn visibility_estimates(
         let scale2 = scene.normalization.scale.powi(2);
         environment_area = spread.batch_means(|g| Some(g.environment_area? * scale2));
     }
+    // The lines advice counts lines as `--lines` does, through the sphere: `worth` of them per line drawn.
     let lines = run.total.counters.lines;
+    let sphere_lines = (lines as f64 * worth).round() as u64;
     let sampling = all.sampling.map(|sampling| {
-        let lines_for_coverage = all.lines_factor.map(|k| lines_for(k, lines));
+        let lines_for_coverage = all.lines_factor.map(|k| lines_for(k, lines, worth));
         // From half the lines only when there is advice to check.
         let half = match all.lines_factor {
-            Some(k) if k > 1.0 => half_run_lines_for_coverage(scene, run, estimator, enclose),
+            Some(k) if k > 1.0 => {
+                half_run_lines_for_coverage(scene, run, estimator, enclose, worth)
+            }
             _ => HalfRun::NotComputed,
         };
-        SamplingReport::new(sampling, lines, lines_for_coverage, half)
+        SamplingReport::new(sampling, sphere_lines, lines_for_coverage, half)
     });
     let c = &run.total.counters;
     let facts = RunFacts {
-        lines,
+        lines: sphere_lines,
         pairs: c.pairs,
         // Enclosed, the escapes are pairs with the environment: only back sides still lose segments.
         open: c.absorbed > 0 || (c.escapes > 0 && !enclose),
@@ -287,9 +292,10 @@ fn plug_in_of(m: Measure) -> Option<Measure> {
     }
 }
 
-/// The lines in all for a factor `k` on a run of `lines` lines.
-fn lines_for(k: f64, lines: u64) -> u64 {
-    (k * lines as f64).ceil() as u64
+/// The lines in all for a factor `k` on a run of `lines` lines drawn, each worth `worth` lines through
+/// the sphere (1 for the sphere's own), in the sphere's lines.
+fn lines_for(k: f64, lines: u64, worth: f64) -> u64 {
+    (k * lines as f64 * worth).ceil() as u64
 }
 
 /// The lines for a coverage of [`COVERAGE_OK`] extrapolated from the first half of the groups alone (a
@@ -301,6 +307,7 @@ fn half_run_lines_for_coverage(
     run: &FinishedRun,
     estimator: EntropyEstimator,
     enclose: bool,
+    worth: f64,
 ) -> HalfRun {
     let (Some(counts), Some((first, rest))) = (
         run.first_half.as_ref(),
@@ -332,7 +339,7 @@ fn half_run_lines_for_coverage(
         lines_factor_for_coverage(a, &rows, COVERAGE_OK)
     };
     match factor {
-        Some(k) => HalfRun::Lines(lines_for(k, half.counters.lines)),
+        Some(k) => HalfRun::Lines(lines_for(k, half.counters.lines, worth)),
         None => HalfRun::BeyondReach,
     }
 }

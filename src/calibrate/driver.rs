@@ -83,13 +83,15 @@ pub fn run_seed(
     tracer: &dyn Tracer,
     seed: u64,
 ) -> Result<SeedReadings, AnalysisError> {
-    let analysis = analyze(scene, tracer, &run_spec(cell, seed), &RunControl::default())?;
+    let spec = run_spec(cell, seed, scene);
+    let analysis = analyze(scene, tracer, &spec, &RunControl::default())?;
     Ok(readings_of(&analysis))
 }
 
-/// The run of `cell` with `seed`: the cell's lines (a cap when it has a target), measures and target;
-/// everything else the defaults of `scx analyze`, so that the table judges what users get.
-pub fn run_spec(cell: &Cell, seed: u64) -> RunSpec {
+/// The run of `cell` with `seed` on `scene`: the cell's lines (a cap when it has a target; lines through
+/// the sphere, drawn where the cell says), measures and target; everything else the defaults of `scx
+/// analyze`, so that the table judges what users get.
+pub fn run_spec(cell: &Cell, seed: u64, scene: &Scene) -> RunSpec {
     let mut spec = RunSpec::new(cell.lines, seed);
     spec.measures = match cell.measures {
         CellMeasures::All => Measures::ALL,
@@ -100,12 +102,11 @@ pub fn run_spec(cell: &Cell, seed: u64) -> RunSpec {
         },
     };
     spec.sampler = cell.sampler;
-    spec.bound = cell.bound;
     spec.budget.target = cell.target.map(|t| Target {
         measure: t.measure,
         stderr: t.stderr,
     });
-    spec
+    spec.through(scene, cell.through)
 }
 
 /// The readings of a finished run: every measure with a value, its verdict, the groups behind the

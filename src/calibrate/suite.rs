@@ -9,7 +9,7 @@ use std::ops::Range;
 
 use super::scenes::CalibrationScene;
 use crate::measure::Measure;
-use crate::sample::bounds::LineBound;
+use crate::run::LinesThrough;
 use crate::sample::lines::Sampler;
 use crate::scenes::solids::Solid;
 
@@ -49,8 +49,9 @@ pub struct Cell {
     pub target: Option<CellTarget>,
     /// How the runs draw their lines (`scx analyze --sampler`).
     pub sampler: Sampler,
-    /// Where the runs draw their lines (`scx analyze --lines-through`).
-    pub bound: LineBound,
+    /// Where the runs draw their lines (`scx analyze --lines-through`), the line count read as lines
+    /// through the sphere, as `scx analyze --lines` reads it.
+    pub through: LinesThrough,
 }
 
 impl Cell {
@@ -64,7 +65,7 @@ impl Cell {
             measures: CellMeasures::All,
             target: None,
             sampler: Sampler::Independent,
-            bound: LineBound::Sphere,
+            through: LinesThrough::Auto,
         }
     }
 
@@ -73,9 +74,9 @@ impl Cell {
         Cell { sampler, ..self }
     }
 
-    /// The same cell with lines drawn through `bound`.
-    pub fn with_bound(self, bound: LineBound) -> Cell {
-        Cell { bound, ..self }
+    /// The same cell with lines drawn through `through`.
+    pub fn with_bound(self, through: LinesThrough) -> Cell {
+        Cell { through, ..self }
     }
 
     /// The same cell with a precision target on `measure` (and `lines` as the cap).
@@ -100,7 +101,8 @@ impl Cell {
     }
 
     /// How its lines read in a table: the count, or the target and the cap; and the sampler and the
-    /// bound when they are not the defaults.
+    /// bound when they are not the defaults (`auto`: through the box for the Sobol' sampler on a scene
+    /// whose box is smaller than its sphere).
     pub fn lines_label(&self) -> String {
         let lines = match self.target {
             None => short_count(self.lines),
@@ -115,8 +117,8 @@ impl Cell {
             Sampler::Independent => lines,
             other => format!("{lines} {}", other.name()),
         };
-        match self.bound {
-            LineBound::Sphere => lines,
+        match self.through {
+            LinesThrough::Auto => lines,
             other => format!("{lines} {}", other.name()),
         }
     }

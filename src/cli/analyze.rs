@@ -11,7 +11,9 @@ use scene_complexity::{
     remaining_lines, start, Budget, CastOptions, Measures, RunControl, RunIdentity, RunSpec,
     RunState, SceneRef, Scope, Shard, StopReason, Target,
 };
-use scene_complexity::{LineBound, LineSource, Sampler, MAX_BUNDLE_GRID};
+use scene_complexity::{
+    sphere_lines, LineBound, LineSource, LinesThrough, Sampler, MAX_BUNDLE_GRID,
+};
 
 use super::args::{
     parse_count, parse_positive, parse_seconds, parse_whole_in, target_measure_parser,
@@ -30,7 +32,9 @@ pub struct AnalyzeArgs {
     /// `@cube:10` (`scx scenes` lists them), or `-` for a scene in any of those formats on standard input. With --resume, the saved run's scene (given again, it must be the same).
     #[arg(required_unless_present = "resume")]
     scene: Option<String>,
-    /// Number of global lines (accepts `1e7`; default 1e6, or no limit with a budget).
+    /// Number of global lines (accepts `1e7`; default 1e6, or no limit with a budget), counted as lines
+    /// through the bounding sphere, the paper's unit: lines drawn through the box count for what they
+    /// are worth, so fewer are drawn (--lines-through).
     #[arg(long, value_parser = parse_count, allow_negative_numbers = true)]
     lines: Option<u64>,
     #[command(flatten)]
@@ -60,14 +64,14 @@ pub struct AnalyzeArgs {
     /// pays.
     #[arg(long, default_value = "independent", value_parser = parse_sampler)]
     sampler: Sampler,
-    /// Where the lines are drawn: `sphere` (the paper's global lines, through the bounding sphere) or
+    /// Where the lines are drawn: `sphere` (the paper's global lines, through the bounding sphere),
     /// `box` (through the scene's bounding box: the sphere's lines that meet it, so no line is spent
     /// missing the box; with --sampler sobol, far smaller errors on scenes whose walls are parallel to
-    /// the box's faces). A line count then counts lines through the box, each usually worth more than
-    /// one through the sphere: the report says how many, and when the sphere wastes fewer lines on the
-    /// scene. Not with --bundle or --enclose. docs/sampling.md.
-    #[arg(long, default_value = "sphere", value_parser = parse_bound)]
-    lines_through: LineBound,
+    /// the box's faces; not with --bundle or --enclose), or `auto`: the box for --sampler sobol when the
+    /// box is smaller than the sphere (rooms, most scenes built along the axes), else the sphere. The
+    /// report says which, how many lines were drawn and what they are worth. docs/sampling.md.
+    #[arg(long, default_value = "auto", value_parser = parse_bound)]
+    lines_through: LinesThrough,
     /// Close an open scene with a virtual, absorbing environment patch (the bounding sphere, facing
     /// inwards): escaping segments become pairs with it, rows of F sum to 1, and every visibility measure
     /// is that of the enclosed scene. Its area is counted: the part of the sphere that sees the scene's
@@ -172,11 +176,12 @@ fn parse_sampler(s: &str) -> Result<Sampler, String> {
     Sampler::from_name(s).ok_or_else(|| format!("`{s}`: expected independent or sobol"))
 }
 
-fn parse_bound(s: &str) -> Result<LineBound, String> {
-    LineBound::from_name(s).ok_or_else(|| format!("`{s}`: expected sphere or box"))
+fn parse_bound(s: &str) -> Result<LinesThrough, String> {
+    LinesThrough::from_name(s).ok_or_else(|| format!("`{s}`: expected auto, sphere or box"))
 }
 
-/// The spec of a new run from the arguments: the command line, parsed once.
+/// The spec of a new run from the arguments, the command line parsed once, before its scene is read:
+/// its bound and the lines it draws are settled with the scene ([`RunSpec::through`]).
 fn spec_of(args: &AnalyzeArgs) -> Result<RunSpec, Failure> {
     let measures = match &args.measures {
         None => Measures::ALL,
@@ -200,14 +205,15 @@ fn spec_of(args: &AnalyzeArgs) -> Result<RunSpec, Failure> {
             args.bundle
         )));
     }
-    if args.lines_through == LineBound::Box && args.bundle > 0 {
+    let through_box = args.lines_through == LinesThrough::Bound(LineBound::Box);
+    if through_box && args.bundle > 0 {
         return Err(Failure::bad_input(format!(
             "--lines-through box draws single lines, each from a face of the bounding box, and does \
              not take --bundle {}: drop one of them",
             args.bundle
         )));
     }
-    if args.lines_through == LineBound::Box && args.enclose {
+    if through_box && args.enclose {
         return Err(Failure::bad_input(
             "--enclose makes the bounding sphere the environment patch, whose area is counted from \
              the lines that miss the scene, and --lines-through box leaves most of those out: drop one \
@@ -225,7 +231,6 @@ fn spec_of(args: &AnalyzeArgs) -> Result<RunSpec, Failure> {
         budget,
         source: LineSource::bundles(args.bundle).map_err(Failure::bad_input)?,
         sampler: args.sampler,
-        bound: args.lines_through,
         enclose: args.enclose,
         per_patch: args.files.wants_per_patch(),
         ..args.run.spec(lines, args.run.seed.value)
@@ -257,6 +262,7 @@ fn new_run(args: &AnalyzeArgs, name: &str) -> Result<Prepared, Failure> {
         args.run.tracing(),
         args.run.threads.value,
     )?;
+    let spec = spec.through(&runner.scene, args.lines_through);
     let state = start(&runner.scene, &spec).map_err(Failure::bad_input)?;
     let identity = RunIdentity::new(
         SceneRef::of(name, &reading, &runner.scene),
@@ -304,11 +310,14 @@ fn resumed_run(args: &AnalyzeArgs, file: &Path) -> Result<Prepared, Failure> {
     args.files
         .check_saved(&shown, &identity, wanted, &without_sums)?;
     let mut state = saved.state;
-    if let Some(lines) = args.lines.filter(|&n| n != identity.spec.lines) {
-        identity.spec = identity
-            .spec
-            .extended_to(lines)
-            .map_err(|e| Failure::bad_input(format!("{shown}: {e}")))?;
+    let asked = args
+        .lines
+        .map(|n| identity.spec.lines_for(&runner.scene, n));
+    if let Some(lines) = asked.filter(|&n| n != identity.spec.lines) {
+        identity.spec = identity.spec.extended_to(lines).map_err(|e| {
+            let unit = drawn_lines_unit(&runner.scene, identity.spec.bound);
+            Failure::bad_input(format!("{shown}: {e}{unit}"))
+        })?;
         state = state.extend(identity.spec.plan());
     }
     Ok(Prepared {
@@ -317,6 +326,19 @@ fn resumed_run(args: &AnalyzeArgs, file: &Path) -> Result<Prepared, Failure> {
         state,
         seconds: saved.seconds,
     })
+}
+
+/// For a run drawn through the box, what its line counts in a message count: lines drawn, where
+/// `--lines` counts lines through the sphere.
+fn drawn_lines_unit(scene: &scene_complexity::Scene, bound: LineBound) -> String {
+    match bound {
+        LineBound::Sphere => String::new(),
+        LineBound::Box => format!(
+            " (lines drawn through the bounding box, each worth {:.4} through the sphere, the unit of \
+             --lines)",
+            sphere_lines(scene, bound, 1)
+        ),
+    }
 }
 
 pub use super::output::persist_failure;

@@ -7,7 +7,7 @@ use std::time::Instant;
 use scene_complexity::calibrate::{
     self, report, suite, CalibrationScene, Cell, CellMeasures, CellReport, CellTarget, SuiteLevel,
 };
-use scene_complexity::{LineBound, Measure, Sampler};
+use scene_complexity::{LinesThrough, Measure, Sampler};
 
 use super::args::{
     parse_count, parse_positive, parse_seed, parse_whole_in, target_measure_parser, ReportOutput,
@@ -55,10 +55,11 @@ pub struct CalibrateArgs {
     /// `sobol` (`scx analyze --sampler`).
     #[arg(long, default_value = "independent", value_parser = parse_sampler)]
     sampler: Sampler,
-    /// Where the runs draw their lines, for every cell: `sphere` or `box` (`scx analyze
-    /// --lines-through`).
-    #[arg(long, default_value = "sphere", value_parser = parse_bound)]
-    lines_through: LineBound,
+    /// Where the runs draw their lines, for every cell: `auto`, `sphere` or `box` (`scx analyze
+    /// --lines-through`; `auto` draws through the box for --sampler sobol when the box is smaller than
+    /// the sphere). Line counts are lines through the sphere, as `scx analyze --lines` counts them.
+    #[arg(long, default_value = "auto", value_parser = parse_bound)]
+    lines_through: LinesThrough,
     /// Print the cells and exit.
     #[arg(long)]
     list: bool,
@@ -101,8 +102,8 @@ fn parse_sampler(s: &str) -> Result<Sampler, String> {
     Sampler::from_name(s).ok_or_else(|| format!("`{s}`: expected independent or sobol"))
 }
 
-fn parse_bound(s: &str) -> Result<LineBound, String> {
-    LineBound::from_name(s).ok_or_else(|| format!("`{s}`: expected sphere or box"))
+fn parse_bound(s: &str) -> Result<LinesThrough, String> {
+    LinesThrough::from_name(s).ok_or_else(|| format!("`{s}`: expected auto, sphere or box"))
 }
 
 /// The cells the arguments ask for.
@@ -128,7 +129,7 @@ fn cells(args: &CalibrateArgs) -> Vec<Cell> {
                 measures: args.measures,
                 target,
                 sampler: args.sampler,
-                bound: args.lines_through,
+                through: args.lines_through,
             })
         })
         .collect()

@@ -192,7 +192,7 @@ pub fn table(run: &RunInfo, a: &Analysis) -> String {
     );
     let _ = writeln!(
         s,
-        "lines    {}{}  seed {}  tracer {} ({})  threads {}  {:.3} s  ({:.2} M lines/s)",
+        "lines    {}{}  seed {}  tracer {} ({})  threads {}  {:.3} s  ({:.2} M {}lines/s)",
         a.lines,
         match (bundle(a), a.spec.sampler) {
             (0, Sampler::Sobol) => " (sobol: randomised quasi-Monte Carlo)".to_string(),
@@ -204,7 +204,12 @@ pub fn table(run: &RunInfo, a: &Analysis) -> String {
         run.tracing.query,
         run.threads,
         a.seconds,
-        a.lines as f64 / a.seconds.max(1e-12) / 1e6
+        // Through the box, the rate of the sphere's lines they are worth: comparable across bounds.
+        sphere_lines(scene, a.spec.bound, a.lines) / a.seconds.max(1e-12) / 1e6,
+        match a.spec.bound {
+            LineBound::Sphere => "",
+            LineBound::Box => "sphere ",
+        }
     );
     let back_seen: u64 = a.orientation.iter().map(|o| o.back_seen).sum();
     let _ = writeln!(
@@ -355,7 +360,9 @@ pub fn table(run: &RunInfo, a: &Analysis) -> String {
         let worth = sphere_lines(scene, a.spec.bound, a.lines) / a.lines.max(1) as f64;
         let _ = writeln!(
             s,
-            "lines through the box: each is worth {worth:.4} lines through the bounding sphere{}{}",
+            "lines through the box: each is worth {worth:.4} lines through the bounding sphere, the unit \
+             of --lines, so {:.1}% as many are drawn{}{}",
+            100.0 / worth,
             if a.estimate(Measure::MsePerLine).is_some() {
                 " (E(MSE) is per line through the sphere, as in the paper)"
             } else {

@@ -14,8 +14,9 @@ use super::errors::ErrorMethod;
 use super::plan::BatchPlan;
 use crate::measure::estimators::EntropyEstimator;
 use crate::measure::radiosity::SolveOptions;
-use crate::sample::bounds::LineBound;
+use crate::sample::bounds::{box_is_smaller, lines_to_draw, LineBound};
 use crate::sample::lines::{LineSource, Sampler};
+use crate::scene::Scene;
 
 /// Default number of independent groups of lines behind every standard error.
 pub const DEFAULT_GROUPS: usize = 16;
@@ -50,6 +51,42 @@ impl Measures {
         continuous: true,
         radiosity: false,
     };
+}
+
+/// Where a run is asked to draw its lines (`--lines-through`): through a given bound, or `auto`, the
+/// bound chosen for the scene and the sampler ([`RunSpec::auto_bound`]). A spec holds the bound chosen.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum LinesThrough {
+    /// The bound [`RunSpec::auto_bound`] chooses.
+    #[default]
+    Auto,
+    /// This bound.
+    Bound(LineBound),
+}
+
+impl LinesThrough {
+    /// Every choice with its name.
+    pub const NAMES: [(&'static str, LinesThrough); 3] = [
+        ("auto", LinesThrough::Auto),
+        ("sphere", LinesThrough::Bound(LineBound::Sphere)),
+        ("box", LinesThrough::Bound(LineBound::Box)),
+    ];
+
+    /// The name used on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            LinesThrough::Auto => "auto",
+            LinesThrough::Bound(b) => b.name(),
+        }
+    }
+
+    /// Parses a name as printed by [`LinesThrough::name`].
+    pub fn from_name(name: &str) -> Option<Self> {
+        Self::NAMES
+            .iter()
+            .find(|(n, _)| *n == name)
+            .map(|&(_, t)| t)
+    }
 }
 
 /// A run: every setting that determines its numbers.
@@ -134,6 +171,41 @@ impl RunSpec {
         }
     }
 
+    /// The bound `--lines-through auto` chooses for `scene`: the box for the Sobol' sampler when the box
+    /// is the smaller container ([`box_is_smaller`]), where its lines cover the space of lines far more
+    /// evenly (docs/sampling.md, "Lines through the bounding box"); the sphere otherwise. For independent
+    /// lines the box would save only the lines that miss it, which cost little, and the sphere keeps the
+    /// paper's lines; bundles and the environment of `enclose` need the sphere.
+    pub fn auto_bound(&self, scene: &Scene) -> LineBound {
+        let sobol = self.sampler == Sampler::Sobol && self.source == LineSource::Independent;
+        if sobol && !self.enclose && box_is_smaller(scene) {
+            LineBound::Box
+        } else {
+            LineBound::Sphere
+        }
+    }
+
+    /// This spec for `scene`, its lines drawn through `through`, with its line count, given in lines
+    /// through the bounding sphere (the paper's unit, and `--lines`'s), turned into the lines to draw
+    /// ([`RunSpec::lines_for`]).
+    pub fn through(self, scene: &Scene, through: LinesThrough) -> RunSpec {
+        let bound = match through {
+            LinesThrough::Auto => self.auto_bound(scene),
+            LinesThrough::Bound(b) => b,
+        };
+        let placed = RunSpec { bound, ..self };
+        RunSpec {
+            lines: placed.lines_for(scene, self.lines),
+            ..placed
+        }
+    }
+
+    /// How many lines this run draws on `scene` to be worth `sphere_lines` lines through its bounding
+    /// sphere ([`lines_to_draw`]): as many through the sphere, fewer through a box smaller than it.
+    pub fn lines_for(&self, scene: &Scene, sphere_lines: u64) -> u64 {
+        lines_to_draw(scene, self.bound, sphere_lines)
+    }
+
     /// How the run's lines are cut into batches: fixed by the line count, or full batches when a budget
     /// may end the run anywhere.
     pub fn plan(&self) -> BatchPlan {
@@ -192,16 +264,21 @@ impl RunSpec {
     /// theirs)` in words (nested settings as `budget.target`); `None` when they can be combined. The
     /// line counts are compared too unless `lines_may_differ`.
     pub fn difference(&self, other: &RunSpec, lines_may_differ: bool) -> Option<SpecDifference> {
-        let keep_lines = |s: &RunSpec| RunSpec {
-            lines: if lines_may_differ { 0 } else { s.lines },
-            ..s.common()
-        };
-        let (ours, theirs) = (keep_lines(self), keep_lines(other));
-        if ours == theirs {
+        let (ours, theirs) = (self.common(), other.common());
+        let lines_differ = !lines_may_differ && self.lines != other.lines;
+        if ours == theirs && !lines_differ {
             return None;
         }
+        // The settings before the line count: a part drawn through another bound draws another number
+        // of lines too, and the bound is the cause to name.
         let as_json = |s: &RunSpec| serde_json::to_value(s).expect("a spec always serialises");
-        first_difference("", &as_json(&ours), &as_json(&theirs))
+        first_difference("", &as_json(&ours), &as_json(&theirs)).or_else(|| {
+            lines_differ.then(|| SpecDifference {
+                setting: "lines".to_string(),
+                ours: self.lines.to_string(),
+                theirs: other.lines.to_string(),
+            })
+        })
     }
 }
 

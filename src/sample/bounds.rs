@@ -283,6 +283,31 @@ pub fn sphere_lines(scene: &Scene, bound: LineBound, lines: u64) -> f64 {
     }
 }
 
+/// How many lines to draw as `bound` says for a run worth `sphere_lines` lines through `scene`'s
+/// bounding sphere: as many through the sphere; through the box the fewest whose worth
+/// ([`sphere_lines`]) is at least that many, `ceil(p * sphere_lines)` ([`BoundingBox::share_of_sphere`]),
+/// and at least one. A line count asked of a run (`--lines`) is read in the sphere's lines, the paper's
+/// unit, whatever the bound: the same count buys the same precision of the bound-free part of every
+/// estimate, and through a box smaller than the sphere it costs less.
+pub fn lines_to_draw(scene: &Scene, bound: LineBound, sphere_lines: u64) -> u64 {
+    match bound {
+        LineBound::Sphere => sphere_lines,
+        LineBound::Box => {
+            let p = BoundingBox::of(scene).share_of_sphere(scene.bounding_radius());
+            let drawn = (sphere_lines as f64 * p).ceil();
+            // Beyond 2^64 the f64 saturates on the cast; a run that long is capped anyway.
+            (drawn as u64).max(u64::from(sphere_lines > 0))
+        }
+    }
+}
+
+/// Whether lines through `scene`'s bounding box meet it more often than as many through its sphere: the
+/// box is the smaller container (`S_box < 4 pi R^2`), as for rooms and most scenes whose walls lie
+/// along the axes; an octahedron's box, or a room turned about two axes, is larger than its sphere.
+pub fn box_is_smaller(scene: &Scene) -> bool {
+    BoundingBox::of(scene).share_of_sphere(scene.bounding_radius()) < 1.0
+}
+
 /// Where a run draws its lines: the bounding sphere's radius, or the bounding box.
 #[derive(Clone, Debug, PartialEq)]
 pub enum LineRegion {

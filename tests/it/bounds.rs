@@ -6,8 +6,8 @@
 use crate::support;
 use scene_complexity::internals::analysis::{analyze, AnalysisError};
 use scene_complexity::internals::measure::Measure;
-use scene_complexity::internals::run::{LineStream, Measures, RunControl, RunSpec};
-use scene_complexity::internals::sample::bounds::{LineBound, LineRegion};
+use scene_complexity::internals::run::{LineStream, LinesThrough, Measures, RunControl, RunSpec};
+use scene_complexity::internals::sample::bounds::{sphere_lines, LineBound, LineRegion};
 use scene_complexity::internals::sample::lines::{LineSource, Sampler};
 use scene_complexity::internals::scene::Scene;
 use scene_complexity::internals::scenes;
@@ -127,6 +127,70 @@ fn box_lines_with_bundles_or_the_environment_are_refused() {
     }
 }
 
+/// `--lines-through auto` draws through the box only for the Sobol' sampler on a scene whose box is the
+/// smaller container (its surface below the unit sphere's 4 pi, Cauchy: fewer lines meet it), and
+/// keeps the sphere for independent lines, for the octahedron (its box reaches out of its sphere), and
+/// with the environment patch; a bound asked for is kept.
+#[test]
+fn auto_draws_through_the_box_only_for_sobol_on_a_smaller_box() {
+    let four_pi = 4.0 * std::f64::consts::PI;
+    let (cube, cornell, octahedron) = (
+        scenes::load("@cube:4").unwrap(),
+        scenes::load("@cornell").unwrap(),
+        scenes::load("@octahedron").unwrap(),
+    );
+    assert!(grown_box_surface(&cube) < four_pi && grown_box_surface(&cornell) < four_pi);
+    assert!(grown_box_surface(&octahedron) > four_pi);
+    let sobol = RunSpec {
+        sampler: Sampler::Sobol,
+        ..RunSpec::new(1_000_000, 1)
+    };
+    let auto =
+        |spec: &RunSpec, scene: &Scene| spec.clone().through(scene, LinesThrough::Auto).bound;
+    assert_eq!(auto(&sobol, &cube), LineBound::Box);
+    assert_eq!(auto(&sobol, &cornell), LineBound::Box);
+    assert_eq!(auto(&sobol, &octahedron), LineBound::Sphere);
+    assert_eq!(auto(&RunSpec::new(1_000_000, 1), &cube), LineBound::Sphere);
+    let enclosed = RunSpec {
+        enclose: true,
+        ..sobol.clone()
+    };
+    assert_eq!(auto(&enclosed, &cube), LineBound::Sphere);
+    for bound in [LineBound::Sphere, LineBound::Box] {
+        let kept = sobol
+            .clone()
+            .through(&octahedron, LinesThrough::Bound(bound));
+        assert_eq!(kept.bound, bound);
+    }
+}
+
+/// A line count is read as lines through the sphere: through the box the fewest lines worth as many
+/// are drawn, `ceil(n S_box / (4 pi))` (a share S_box / 4 pi of the sphere's lines meet the box, from
+/// the vertices' extent here), never worth fewer than asked; through the sphere, `n` itself.
+#[test]
+fn a_line_count_through_the_box_is_worth_as_many_through_the_sphere() {
+    for name in ["@cube:4", "@cornell", "@octahedron"] {
+        let scene = scenes::load(name).unwrap();
+        let share = grown_box_surface(&scene) / (4.0 * std::f64::consts::PI);
+        for n in [1u64, 7, 1000, 999_999, 1_000_000, 123_456_789] {
+            let boxed = RunSpec::new(n, 1).through(&scene, LinesThrough::Bound(LineBound::Box));
+            let ideal = n as f64 * share;
+            let drawn = boxed.lines as f64;
+            assert!(
+                drawn >= ideal - 1e-6 * ideal && drawn < ideal + 1.0 + 1e-6 * ideal,
+                "{name}: {n} -> {drawn} drawn, {ideal} ideal"
+            );
+            let worth = sphere_lines(&scene, LineBound::Box, boxed.lines);
+            assert!(
+                worth >= n as f64 * (1.0 - 1e-12),
+                "{name}: {n} -> worth {worth}"
+            );
+            let sphere = RunSpec::new(n, 1).through(&scene, LinesThrough::Bound(LineBound::Sphere));
+            assert_eq!(sphere.lines, n);
+        }
+    }
+}
+
 /// A state saved before the bound existed reads as lines through the sphere, and two specs that differ
 /// in it cannot be parts of one run, which the difference names.
 #[test]
@@ -177,13 +241,16 @@ fn box_runs_split_resumed_and_merged_are_the_single_run() {
     };
     let single = run(&["--lines", "7e5"]);
     assert_eq!(single["lines_through"], "box");
-    let worth = single["sphere_lines"].as_f64().unwrap() / 7e5;
+    // --lines counts lines through the sphere: the fewest through the box worth as many are drawn.
     let h = 1.0 / 3f64.sqrt() + 1e-3;
-    let expected = std::f64::consts::PI / (6.0 * h * h);
+    let share = 6.0 * h * h / std::f64::consts::PI;
+    let drawn = single["lines"].as_f64().unwrap();
     assert!(
-        (worth - expected).abs() < 1e-5,
-        "{worth} against {expected}"
+        (drawn - 7e5 * share).abs() < 1.0 + 1e-3,
+        "{drawn} lines drawn"
     );
+    let worth = single["sphere_lines"].as_f64().unwrap();
+    assert!((7e5..=7e5 + 2.0).contains(&worth), "worth {worth}");
     assert!(strip(&single) == strip(&run(&["--lines", "7e5", "--threads", "1"])));
     let (p1, p2) = (path("p1.scx"), path("p2.scx"));
     for (k, p) in [("1/2", &p1), ("2/2", &p2)] {
@@ -191,14 +258,15 @@ fn box_runs_split_resumed_and_merged_are_the_single_run() {
     }
     let merged = json_of(&scx(&["merge", &p2, &p1, "--format", "json"]));
     assert!(strip(&single) == strip(&merged), "2 shards merged");
+    // 4.5e5 through the sphere: over 2^18 drawn, full batches already.
     let short = path("short.scx");
-    run(&["--lines", "3e5", "--save", &short]);
+    run(&["--lines", "4.5e5", "--save", &short]);
     let resumed = json_of(&scx(&[
         "analyze", "--resume", &short, "--lines", "7e5", "--format", "json",
     ]));
     assert!(
         strip(&single) == strip(&resumed),
-        "3e5 lines resumed to 7e5"
+        "4.5e5 lines resumed to 7e5"
     );
     // A shard of the same run through the sphere is another run.
     let sphere = path("sphere.scx");
@@ -207,6 +275,8 @@ fn box_runs_split_resumed_and_merged_are_the_single_run() {
         "@cube:6",
         "--sampler",
         "sobol",
+        "--lines-through",
+        "sphere",
         "--tracer",
         "rust",
         "--lines",
@@ -241,4 +311,58 @@ fn box_runs_split_resumed_and_merged_are_the_single_run() {
             "{other:?}"
         );
     }
+}
+
+/// `scx analyze`: without `--lines-through`, `--sampler sobol` draws through the box of a cube (fewer
+/// lines, worth the `--lines` asked) and through the sphere of the octahedron; independent lines through
+/// the sphere, `--lines` of them.
+#[cfg(feature = "cli")]
+#[test]
+fn the_cli_chooses_the_bound_by_sampler_and_scene() {
+    use support::{json_of, scx};
+    let run = |scene: &str, more: &[&str]| {
+        let mut args = vec![
+            "analyze", scene, "--lines", "2e5", "--tracer", "rust", "--format", "json",
+        ];
+        args.extend(more);
+        json_of(&scx(&args))
+    };
+    let field = |v: &serde_json::Value, k: &str| v[k].as_f64().unwrap();
+    let cube = run("@cube:6", &["--sampler", "sobol"]);
+    assert_eq!(cube["lines_through"], "box");
+    assert!(field(&cube, "lines") < 2e5 * 0.7, "{}", cube["lines"]);
+    assert!((2e5..2e5 + 2.0).contains(&field(&cube, "sphere_lines")));
+    for (scene, more) in [
+        ("@octahedron", &["--sampler", "sobol"][..]),
+        ("@cube:6", &[][..]),
+    ] {
+        let v = run(scene, more);
+        assert_eq!(v["lines_through"], "sphere", "{scene} {more:?}");
+        assert_eq!((field(&v, "lines"), field(&v, "sphere_lines")), (2e5, 2e5));
+    }
+}
+
+/// The lines advice of a run through the box counts lines as `--lines` does, through the sphere: a run
+/// of `@cube:10` short of a coverage of 0.99 is advised about as many lines through either bound (the
+/// same distribution of counts per line that meets the scene), where advice in the lines drawn would
+/// be the box's share of it, 0.64.
+#[test]
+fn the_lines_advice_of_a_box_run_counts_the_spheres_lines() {
+    let scene = scenes::load("@cube:10").unwrap();
+    let tracer = make_tracer(Backend::Rust, &scene, Query::Single).unwrap();
+    let advice = |bound: LineBound| -> f64 {
+        (1..=3)
+            .map(|seed| {
+                let spec = RunSpec {
+                    measures: Measures::VISIBILITY,
+                    ..RunSpec::new(200_000, seed)
+                }
+                .through(&scene, LinesThrough::Bound(bound));
+                let a = analyze(&scene, tracer.as_ref(), &spec, &RunControl::default()).unwrap();
+                a.sampling.unwrap().lines_for_coverage.unwrap() as f64
+            })
+            .sum()
+    };
+    let ratio = advice(LineBound::Box) / advice(LineBound::Sphere);
+    assert!((0.85..1.15).contains(&ratio), "box / sphere advice {ratio}");
 }

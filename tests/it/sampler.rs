@@ -230,6 +230,8 @@ fn sobol_runs_split_resumed_and_merged_are_the_single_run() {
         "@cube:6",
         "--sampler",
         "sobol",
+        "--lines-through",
+        "sphere",
         "--tracer",
         "rust",
         "--format",
