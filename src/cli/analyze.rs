@@ -448,8 +448,13 @@ pub fn run(args: &AnalyzeArgs) -> Result<Exit, Failure> {
     };
     let total = (!cfg.budget.is_open_ended()).then(|| remaining_lines(&state, scope));
     let control = &runner.control;
+    // The bar counts the lines drawn: through the box, fewer than --lines asked, and it says so.
+    let label = match cfg.bound {
+        LineBound::Sphere => "",
+        LineBound::Box => "drawn through the box",
+    };
     let stop_reason = runner
-        .in_pool(total, "", || {
+        .in_pool(total, label, || {
             cast(
                 &runner.scene,
                 runner.tracer(),

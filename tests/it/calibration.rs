@@ -291,3 +291,26 @@ fn the_command_prints_the_table_and_writes_csv() {
     assert_eq!(bad.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&bad.stderr).contains("exact values"));
 }
+
+/// A cell's runs are `scx analyze`'s: its lines are the sphere's, and with the Sobol' sampler `auto`
+/// draws them through the box of a cube (the fewest worth as many), independent lines and a cell that
+/// asks for the sphere through the sphere.
+#[test]
+fn a_cells_runs_draw_their_lines_as_scx_analyze_does() {
+    use scene_complexity::calibrate::driver::run_spec;
+    use scene_complexity::calibrate::suite::Cell;
+    use scene_complexity::{lines_to_draw, LineBound, LinesThrough, Sampler};
+    let scene = CalibrationScene::parse("@cube:4").unwrap();
+    let built = scene_complexity::internals::scenes::load("@cube:4").unwrap();
+    let cell = Cell::new(scene, 100_000, 3);
+    let sobol = run_spec(&cell.with_sampler(Sampler::Sobol), 1, &built);
+    assert_eq!(sobol.bound, LineBound::Box);
+    assert_eq!(sobol.lines, lines_to_draw(&built, LineBound::Box, 100_000));
+    assert!((63_000..64_500).contains(&sobol.lines), "{}", sobol.lines);
+    let sphere = cell
+        .with_sampler(Sampler::Sobol)
+        .with_bound(LinesThrough::Bound(LineBound::Sphere));
+    for spec in [run_spec(&cell, 1, &built), run_spec(&sphere, 1, &built)] {
+        assert_eq!((spec.bound, spec.lines), (LineBound::Sphere, 100_000));
+    }
+}
