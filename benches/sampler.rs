@@ -1,8 +1,8 @@
 //! Do randomised quasi-Monte Carlo lines pay? For each scene, runs the whole analysis (`scx analyze`'s
 //! defaults: every measure, 16 groups, Embree single lines, 2 threads) with independent lines and with
-//! the Sobol' sampler, each through the bounding sphere and through the bounding box
-//! (`--lines-through`), over the same seeds (seed outermost, so that a drift of the machine's speed falls
-//! on every series alike), and prints per measure and series:
+//! the Sobol' sampler, each through the bounding sphere and through the bounding box, and the Sobol'
+//! sampler through the bounding polytope (`--lines-through`), over the same seeds (seed outermost, so
+//! that a drift of the machine's speed falls on every series alike), and prints per measure and series:
 //!
 //! * the spread (sample standard deviation) of the estimates over the seeds at equal lines (lines
 //!   through the sphere, as `--lines` counts them: through the box fewer are drawn, worth as many), with
@@ -51,11 +51,12 @@ const FOLLOWED: [(&str, Measure); 7] = [
 ];
 
 /// The series compared: a label, the sampler and where the lines are drawn (`--lines-through`).
-const SAMPLERS: [(&str, Sampler, LineBound); 4] = [
+const SAMPLERS: [(&str, Sampler, LineBound); 5] = [
     ("independent", Sampler::Independent, LineBound::Sphere),
     ("sobol", Sampler::Sobol, LineBound::Sphere),
     ("indep. box", Sampler::Independent, LineBound::Box),
     ("sobol box", Sampler::Sobol, LineBound::Box),
+    ("sobol poly.", Sampler::Sobol, LineBound::Polytope),
 ];
 
 fn main() -> anyhow::Result<()> {

@@ -200,9 +200,11 @@ def analyze(
             ``bundle`` (docs/sampling.md).
         lines_through: ``"sphere"`` (the paper's global lines, through the bounding sphere), ``"box"``
             (through the scene's bounding box, the sphere's lines that meet it, so none is spent missing
-            it; with ``sampler="sobol"`` far tighter on scenes of axis-aligned walls; not with ``bundle``
-            or ``enclose``), or ``"auto"``: the box for ``sampler="sobol"`` when the box is smaller than
-            the sphere, else the sphere. ``lines`` counts lines through the sphere either way: through
+            it; with ``sampler="sobol"`` far tighter on scenes of axis-aligned walls), ``"polytope"``
+            (through the box with its edges and corners cut off; with ``sampler="sobol"`` far tighter on
+            solids whose faces it shares, such as the octahedron) (neither with ``bundle`` or
+            ``enclose``), or ``"auto"``: for ``sampler="sobol"`` the box when it is smaller than the
+            sphere, else the polytope when the scene lies mostly in its faces, else the sphere. ``lines`` counts lines through the sphere either way: through
             the box fewer are drawn (``to_dict()["lines"]``), worth as many (``["sphere_lines"]``)
             (docs/sampling.md).
         per_patch: also share the measures out among the patches, for :meth:`Analysis.patches`,

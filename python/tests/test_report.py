@@ -179,8 +179,10 @@ def test_to_dict_of_a_run_through_the_box_is_the_json_of_scx_analyze():
     for kwargs in ({}, {"sampler": "sobol", "lines_through": "sphere"}):
         d = scx.analyze("@cube:4", lines=2e5, seed=3, threads=1, **kwargs).to_dict()
         assert (d["lines_through"], d["lines"], d["sphere_lines"]) == ("sphere", 200000, 200000)
-    # The octahedron's box reaches out of its sphere: auto keeps the sphere.
-    assert scx.analyze("@octahedron", lines=1e4, sampler="sobol").to_dict()["lines_through"] == "sphere"
+    # The octahedron is its own bounding polytope: auto draws through it; the icosahedron's faces lie in
+    # none of the polytope's planes: auto keeps the sphere.
+    for name, through in (("@octahedron", "polytope"), ("@icosahedron", "sphere")):
+        assert scx.analyze(name, lines=1e4, sampler="sobol").to_dict()["lines_through"] == through
 
 
 def test_an_enclosed_run_has_the_environment_as_its_last_patch(tmp_path):

@@ -67,9 +67,13 @@ pub struct AnalyzeArgs {
     /// Where the lines are drawn: `sphere` (the paper's global lines, through the bounding sphere),
     /// `box` (through the scene's bounding box: the sphere's lines that meet it, so no line is spent
     /// missing the box; with --sampler sobol, far smaller errors on scenes whose walls are parallel to
-    /// the box's faces; not with --bundle or --enclose), or `auto`: the box for --sampler sobol when the
-    /// box is smaller than the sphere (rooms, most scenes built along the axes), else the sphere. The
-    /// report says which, how many lines were drawn and what they are worth. docs/sampling.md.
+    /// the box's faces), `polytope` (through the box with its edges and corners cut off at 45 degrees:
+    /// with --sampler sobol, far smaller errors on solids whose faces it shares, such as the
+    /// octahedron), or `auto`: for --sampler sobol the box when it is smaller than the sphere (rooms,
+    /// most scenes built along the axes), else the polytope when the scene lies mostly in its faces,
+    /// else the sphere; the sphere for independent lines. Box and polytope not with --bundle or
+    /// --enclose. The report says which, how many lines were drawn and what they are worth.
+    /// docs/sampling.md.
     #[arg(long, default_value = "auto", value_parser = parse_bound)]
     lines_through: LinesThrough,
     /// Close an open scene with a virtual, absorbing environment patch (the bounding sphere, facing
@@ -177,7 +181,8 @@ fn parse_sampler(s: &str) -> Result<Sampler, String> {
 }
 
 fn parse_bound(s: &str) -> Result<LinesThrough, String> {
-    LinesThrough::from_name(s).ok_or_else(|| format!("`{s}`: expected auto, sphere or box"))
+    LinesThrough::from_name(s)
+        .ok_or_else(|| format!("`{s}`: expected auto, sphere, box or polytope"))
 }
 
 /// The spec of a new run from the arguments, the command line parsed once, before its scene is read:
@@ -205,21 +210,23 @@ fn spec_of(args: &AnalyzeArgs) -> Result<RunSpec, Failure> {
             args.bundle
         )));
     }
-    let through_box = args.lines_through == LinesThrough::Bound(LineBound::Box);
-    if through_box && args.bundle > 0 {
+    let container = match args.lines_through {
+        LinesThrough::Bound(b) if b != LineBound::Sphere => Some(b.name()),
+        _ => None,
+    };
+    if let (Some(name), true) = (container, args.bundle > 0) {
         return Err(Failure::bad_input(format!(
-            "--lines-through box draws single lines, each from a face of the bounding box, and does \
-             not take --bundle {}: drop one of them",
+            "--lines-through {name} draws single lines, each from a face of the bounding {name}, and \
+             does not take --bundle {}: drop one of them",
             args.bundle
         )));
     }
-    if through_box && args.enclose {
-        return Err(Failure::bad_input(
+    if let (Some(name), true) = (container, args.enclose) {
+        return Err(Failure::bad_input(format!(
             "--enclose makes the bounding sphere the environment patch, whose area is counted from \
-             the lines that miss the scene, and --lines-through box leaves most of those out: drop one \
-             of them"
-                .to_string(),
-        ));
+             the lines that miss the scene, and --lines-through {name} leaves most of those out: drop \
+             one of them"
+        )));
     }
     let lines = args.lines.unwrap_or(if budget.is_open_ended() {
         1_000_000_000_000
@@ -328,14 +335,15 @@ fn resumed_run(args: &AnalyzeArgs, file: &Path) -> Result<Prepared, Failure> {
     })
 }
 
-/// For a run drawn through the box, what its line counts in a message count: lines drawn, where
-/// `--lines` counts lines through the sphere.
+/// For a run drawn through the box or the polytope, what its line counts in a message count: lines
+/// drawn, where `--lines` counts lines through the sphere.
 fn drawn_lines_unit(scene: &scene_complexity::Scene, bound: LineBound) -> String {
     match bound {
         LineBound::Sphere => String::new(),
-        LineBound::Box => format!(
-            " (lines drawn through the bounding box, each worth {:.4} through the sphere, the unit of \
+        LineBound::Box | LineBound::Polytope => format!(
+            " (lines drawn through the bounding {}, each worth {:.4} through the sphere, the unit of \
              --lines)",
+            bound.name(),
             sphere_lines(scene, bound, 1)
         ),
     }
@@ -448,10 +456,11 @@ pub fn run(args: &AnalyzeArgs) -> Result<Exit, Failure> {
     };
     let total = (!cfg.budget.is_open_ended()).then(|| remaining_lines(&state, scope));
     let control = &runner.control;
-    // The bar counts the lines drawn: through the box, fewer than --lines asked, and it says so.
+    // The bar counts the lines drawn: through a container, fewer than --lines asked, and it says so.
     let label = match cfg.bound {
         LineBound::Sphere => "",
         LineBound::Box => "drawn through the box",
+        LineBound::Polytope => "drawn through the polytope",
     };
     let stop_reason = runner
         .in_pool(total, label, || {

@@ -55,9 +55,10 @@ pub struct CalibrateArgs {
     /// `sobol` (`scx analyze --sampler`).
     #[arg(long, default_value = "independent", value_parser = parse_sampler)]
     sampler: Sampler,
-    /// Where the runs draw their lines, for every cell: `auto`, `sphere` or `box` (`scx analyze
-    /// --lines-through`; `auto` draws through the box for --sampler sobol when the box is smaller than
-    /// the sphere). Line counts are lines through the sphere, as `scx analyze --lines` counts them.
+    /// Where the runs draw their lines, for every cell: `auto`, `sphere`, `box` or `polytope` (`scx
+    /// analyze --lines-through`; `auto` draws through the box or the polytope for --sampler sobol where
+    /// it is the tighter container). Line counts are lines through the sphere, as `scx analyze --lines`
+    /// counts them.
     #[arg(long, default_value = "auto", value_parser = parse_bound)]
     lines_through: LinesThrough,
     /// Print the cells and exit.
@@ -103,7 +104,8 @@ fn parse_sampler(s: &str) -> Result<Sampler, String> {
 }
 
 fn parse_bound(s: &str) -> Result<LinesThrough, String> {
-    LinesThrough::from_name(s).ok_or_else(|| format!("`{s}`: expected auto, sphere or box"))
+    LinesThrough::from_name(s)
+        .ok_or_else(|| format!("`{s}`: expected auto, sphere, box or polytope"))
 }
 
 /// The cells the arguments ask for.

@@ -204,11 +204,11 @@ pub fn table(run: &RunInfo, a: &Analysis) -> String {
         run.tracing.query,
         run.threads,
         a.seconds,
-        // Through the box, the rate of the sphere's lines they are worth: comparable across bounds.
+        // Through a container, the rate of the sphere's lines they are worth: comparable across bounds.
         sphere_lines(scene, a.spec.bound, a.lines) / a.seconds.max(1e-12) / 1e6,
         match a.spec.bound {
             LineBound::Sphere => "",
-            LineBound::Box => "sphere ",
+            LineBound::Box | LineBound::Polytope => "sphere ",
         }
     );
     let back_seen: u64 = a.orientation.iter().map(|o| o.back_seen).sum();
@@ -356,12 +356,13 @@ pub fn table(run: &RunInfo, a: &Analysis) -> String {
              standard errors, or flagged where there is no jackknife (docs/sampling.md)."
         );
     }
-    if a.spec.bound == LineBound::Box {
+    if a.spec.bound != LineBound::Sphere {
+        let name = a.spec.bound.name();
         let worth = sphere_lines(scene, a.spec.bound, a.lines) / a.lines.max(1) as f64;
         let _ = writeln!(
             s,
-            "lines through the box: each is worth {worth:.4} lines through the bounding sphere, the unit \
-             of --lines, so {:.1}% as many are drawn{}{}",
+            "lines through the {name}: each is worth {worth:.4} lines through the bounding sphere, the \
+             unit of --lines, so {:.1}% as many are drawn{}{}",
             100.0 / worth,
             if a.estimate(Measure::MsePerLine).is_some() {
                 " (E(MSE) is per line through the sphere, as in the paper)"
@@ -369,10 +370,12 @@ pub fn table(run: &RunInfo, a: &Analysis) -> String {
                 ""
             },
             if worth < 1.0 {
-                "; on this scene the box is the larger container, so the sphere wastes fewer lines \
-                 (--lines-through sphere)."
+                format!(
+                    "; on this scene the {name} is the larger container, so the sphere wastes fewer \
+                     lines (--lines-through sphere)."
+                )
             } else {
-                "."
+                ".".to_string()
             }
         );
     }
@@ -508,14 +511,15 @@ fn stop_text(r: StopReason) -> &'static str {
     }
 }
 
-/// For lines through the bounding box, what they are worth in lines through the sphere (the line
-/// count of the paper's runs and of runs without `--lines-through box`).
+/// For lines through the bounding box or polytope, what they are worth in lines through the sphere
+/// (the unit of `--lines` and of the paper's runs).
 fn through_the_box(scene: &Scene, a: &Analysis) -> String {
     match a.spec.bound {
         LineBound::Sphere => String::new(),
-        LineBound::Box => format!(
-            " through the bounding box (as many as {:.0} through the sphere)",
-            sphere_lines(scene, a.spec.bound, a.lines)
+        bound => format!(
+            " through the bounding {} (as many as {:.0} through the sphere)",
+            bound.name(),
+            sphere_lines(scene, bound, a.lines)
         ),
     }
 }

@@ -5,7 +5,7 @@
 use rayon::prelude::*;
 
 use super::plan::BatchPlan;
-use crate::sample::bounds::{box_batch_lines, sobol_box_lines, LineBound, LineRegion};
+use crate::sample::bounds::{batch_lines_through, sobol_lines_through, LineBound, LineRegion};
 use crate::sample::lines::{sobol_lines, LineSource, Sampler};
 use crate::scene::Scene;
 use crate::trace::{Line, LineHits, RawHit, TraceError, Tracer};
@@ -21,7 +21,8 @@ pub struct LineStream {
     /// Independent lines, or one randomised Sobol' sequence per group (then `source` is
     /// [`LineSource::Independent`]: [`crate::run::RunSpec::check`]).
     pub sampler: Sampler,
-    /// Through the bounding sphere or the bounding box (then `source` is [`LineSource::Independent`]).
+    /// Through the bounding sphere, box or polytope (with the last two, `source` is
+    /// [`LineSource::Independent`]).
     pub bound: LineBound,
     /// The run's standard-error groups: batch `b` belongs to group `b mod groups`.
     pub groups: u64,
@@ -64,10 +65,17 @@ impl LineStream {
             }
             (Sampler::Independent, LineRegion::Box(bounds)) => {
                 debug_assert_eq!(self.source, LineSource::Independent, "checked by the spec");
-                box_batch_lines(self.seed, batch, count, bounds, out);
+                batch_lines_through(self.seed, batch, count, bounds.as_ref(), out);
             }
             (Sampler::Sobol, LineRegion::Box(bounds)) => {
-                sobol_box_lines(self.seed, group, first, count, bounds, out);
+                sobol_lines_through(self.seed, group, first, count, bounds.as_ref(), out);
+            }
+            (Sampler::Independent, LineRegion::Polytope(bounds)) => {
+                debug_assert_eq!(self.source, LineSource::Independent, "checked by the spec");
+                batch_lines_through(self.seed, batch, count, bounds.as_ref(), out);
+            }
+            (Sampler::Sobol, LineRegion::Polytope(bounds)) => {
+                sobol_lines_through(self.seed, group, first, count, bounds.as_ref(), out);
             }
         }
     }

@@ -14,7 +14,7 @@ use super::errors::ErrorMethod;
 use super::plan::BatchPlan;
 use crate::measure::estimators::EntropyEstimator;
 use crate::measure::radiosity::SolveOptions;
-use crate::sample::bounds::{box_is_smaller, lines_to_draw, LineBound};
+use crate::sample::bounds::{lines_to_draw, tightest_container, LineBound};
 use crate::sample::lines::{LineSource, Sampler};
 use crate::scene::Scene;
 
@@ -66,10 +66,11 @@ pub enum LinesThrough {
 
 impl LinesThrough {
     /// Every choice with its name.
-    pub const NAMES: [(&'static str, LinesThrough); 3] = [
+    pub const NAMES: [(&'static str, LinesThrough); 4] = [
         ("auto", LinesThrough::Auto),
         ("sphere", LinesThrough::Bound(LineBound::Sphere)),
         ("box", LinesThrough::Bound(LineBound::Box)),
+        ("polytope", LinesThrough::Bound(LineBound::Polytope)),
     ];
 
     /// The name used on the command line.
@@ -163,23 +164,26 @@ impl RunSpec {
             (Sampler::Sobol, LineSource::Bundles { grid }, _) => {
                 Err(SpecError::SobolBundles { grid })
             }
-            (_, LineSource::Bundles { grid }, LineBound::Box) => {
-                Err(SpecError::BoxBundles { grid })
+            (_, LineSource::Bundles { grid }, bound) if bound != LineBound::Sphere => {
+                Err(SpecError::BoxBundles { grid, bound })
             }
-            (_, _, LineBound::Box) if self.enclose => Err(SpecError::BoxEnclose),
+            (_, _, bound) if bound != LineBound::Sphere && self.enclose => {
+                Err(SpecError::BoxEnclose { bound })
+            }
             _ => Ok(()),
         }
     }
 
-    /// The bound `--lines-through auto` chooses for `scene`: the box for the Sobol' sampler when the box
-    /// is the smaller container ([`box_is_smaller`]), where its lines cover the space of lines far more
-    /// evenly (docs/sampling.md, "Lines through the bounding box"); the sphere otherwise. For independent
-    /// lines the box would save only the lines that miss it, which cost little, and the sphere keeps the
+    /// The bound `--lines-through auto` chooses for `scene`: for the Sobol' sampler, the tightest
+    /// container of the scene ([`tightest_container`]: the box for rooms, the polytope for solids and
+    /// objects, the sphere when neither is smaller), whose lines cover the space of lines far more evenly
+    /// (docs/sampling.md, "Lines through the bounding box"); the sphere otherwise. For independent lines
+    /// a container would save only the lines that miss it, which cost little, and the sphere keeps the
     /// paper's lines; bundles and the environment of `enclose` need the sphere.
     pub fn auto_bound(&self, scene: &Scene) -> LineBound {
         let sobol = self.sampler == Sampler::Sobol && self.source == LineSource::Independent;
-        if sobol && !self.enclose && box_is_smaller(scene) {
-            LineBound::Box
+        if sobol && !self.enclose {
+            tightest_container(scene)
         } else {
             LineBound::Sphere
         }
@@ -355,22 +359,29 @@ pub enum SpecError {
         /// The bundle grid asked for.
         grid: u32,
     },
-    /// Lines through the bounding box with bundles.
+    /// Lines through the bounding box or polytope with bundles.
     #[error(
-        "lines through the bounding box are drawn one by one, each from a face of the box, and do not \
-         come in bundles (asked: bundles of {grid} x {grid}); use lines through the sphere for bundles"
+        "lines through the bounding {} are drawn one by one, each from a face of it, and do not \
+         come in bundles (asked: bundles of {grid} x {grid}); use lines through the sphere for bundles",
+        .bound.name()
     )]
     BoxBundles {
         /// The bundle grid asked for.
         grid: u32,
+        /// Where the lines were to be drawn.
+        bound: LineBound,
     },
-    /// Lines through the bounding box with the environment patch.
+    /// Lines through the bounding box or polytope with the environment patch.
     #[error(
         "--enclose makes the bounding sphere the environment patch, and its area is counted from the \
-         lines that meet the sphere but not the scene, which lines through the bounding box leave out; \
-         use lines through the sphere with --enclose"
+         lines that meet the sphere but not the scene, which lines through the bounding {} leave out; \
+         use lines through the sphere with --enclose",
+        .bound.name()
     )]
-    BoxEnclose,
+    BoxEnclose {
+        /// Where the lines were to be drawn.
+        bound: LineBound,
+    },
 }
 
 /// Why a run cannot be continued to more lines.

@@ -24,6 +24,7 @@
 use rand::RngCore;
 
 use super::lines::{batch_rng, concentric_discs};
+use super::polytope::{share_of_area_on_faces, BoundingPolytope, CONTAINER_MARGIN};
 use super::sobol::ScrambledSobol;
 use crate::geom::uniform01;
 use crate::scene::Scene;
@@ -32,7 +33,7 @@ use crate::trace::Line;
 /// How far the box reaches beyond the scene on every side, in bounding radii: lines start this far
 /// from any surface (so f32 rounding never puts an origin on a triangle), and a flat scene still gets
 /// a box with six faces of positive area.
-const BOX_MARGIN: f64 = 1e-3;
+const BOX_MARGIN: f64 = CONTAINER_MARGIN;
 
 /// Where the lines of a run are drawn.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
@@ -44,18 +45,25 @@ pub enum LineBound {
     /// Through the bounding box, grown by a thousandth of the bounding radius on every side: the
     /// sphere's lines that meet it (module documentation).
     Box,
+    /// Through the bounding polytope ([`super::polytope`]: the box with its edges and corners cut
+    /// off), grown as the box is: the sphere's lines that meet it.
+    Polytope,
 }
 
 impl LineBound {
     /// Every bound with its name.
-    pub const NAMES: [(&'static str, LineBound); 2] =
-        [("sphere", LineBound::Sphere), ("box", LineBound::Box)];
+    pub const NAMES: [(&'static str, LineBound); 3] = [
+        ("sphere", LineBound::Sphere),
+        ("box", LineBound::Box),
+        ("polytope", LineBound::Polytope),
+    ];
 
     /// The name used on the command line and in reports.
     pub fn name(self) -> &'static str {
         match self {
             LineBound::Sphere => "sphere",
             LineBound::Box => "box",
+            LineBound::Polytope => "polytope",
         }
     }
 
@@ -236,13 +244,32 @@ impl BoundingBox {
     }
 }
 
+/// A convex region whose lines are made from points of the unit 4-cube: a face (by area) and a point on
+/// it from the first two coordinates, a cosine-distributed direction into the region from the last two.
+pub trait UnitLines {
+    /// The lines of `units`, appended to `out`.
+    fn lines(&self, units: &[[f64; 4]], out: &mut Vec<Line>);
+}
+
+impl UnitLines for BoundingBox {
+    fn lines(&self, units: &[[f64; 4]], out: &mut Vec<Line>) {
+        BoundingBox::lines(self, units, out);
+    }
+}
+
+impl UnitLines for BoundingPolytope {
+    fn lines(&self, units: &[[f64; 4]], out: &mut Vec<Line>) {
+        BoundingPolytope::lines(self, units, out);
+    }
+}
+
 /// Appends `count` independent lines through `bounds` to `out`, four draws of batch `batch`'s stream
 /// ([`batch_rng`]) per line: a batch's lines depend on `seed` and its index only.
-pub fn box_batch_lines(
+pub fn batch_lines_through(
     seed: u64,
     batch: u64,
     count: usize,
-    bounds: &BoundingBox,
+    bounds: &impl UnitLines,
     out: &mut Vec<Line>,
 ) {
     let mut rng = batch_rng(seed, batch);
@@ -257,12 +284,12 @@ fn draw4(rng: &mut impl RngCore) -> [f64; 4] {
 
 /// Appends the lines through `bounds` of points `first..first + count` of group `group`'s randomised
 /// Sobol' sequence (seed `seed`) to `out` (the points of [`super::lines::sobol_lines`]).
-pub fn sobol_box_lines(
+pub fn sobol_lines_through(
     seed: u64,
     group: u64,
     first: u64,
     count: usize,
-    bounds: &BoundingBox,
+    bounds: &impl UnitLines,
     out: &mut Vec<Line>,
 ) {
     out.reserve(count);
@@ -275,11 +302,17 @@ pub fn sobol_box_lines(
 /// many for the sphere, `lines / p` through the box ([`BoundingBox::share_of_sphere`]; fewer than
 /// `lines` when the box is the larger container).
 pub fn sphere_lines(scene: &Scene, bound: LineBound, lines: u64) -> f64 {
+    lines as f64 / share_of_sphere(scene, bound)
+}
+
+/// The measure of the lines drawn as `bound` says relative to those through `scene`'s bounding sphere:
+/// 1 for the sphere, `S / (4 pi R^2)` for the box or the polytope (Cauchy).
+pub fn share_of_sphere(scene: &Scene, bound: LineBound) -> f64 {
+    let radius = scene.bounding_radius();
     match bound {
-        LineBound::Sphere => lines as f64,
-        LineBound::Box => {
-            lines as f64 / BoundingBox::of(scene).share_of_sphere(scene.bounding_radius())
-        }
+        LineBound::Sphere => 1.0,
+        LineBound::Box => BoundingBox::of(scene).share_of_sphere(radius),
+        LineBound::Polytope => BoundingPolytope::of(scene).share_of_sphere(radius),
     }
 }
 
@@ -292,21 +325,40 @@ pub fn sphere_lines(scene: &Scene, bound: LineBound, lines: u64) -> f64 {
 pub fn lines_to_draw(scene: &Scene, bound: LineBound, sphere_lines: u64) -> u64 {
     match bound {
         LineBound::Sphere => sphere_lines,
-        LineBound::Box => {
-            let p = BoundingBox::of(scene).share_of_sphere(scene.bounding_radius());
-            let drawn = (sphere_lines as f64 * p).ceil();
+        LineBound::Box | LineBound::Polytope => {
+            let drawn = (sphere_lines as f64 * share_of_sphere(scene, bound)).ceil();
             // Beyond 2^64 the f64 saturates on the cast; a run that long is capped anyway.
             (drawn as u64).max(u64::from(sphere_lines > 0))
         }
     }
 }
 
-/// Whether lines through `scene`'s bounding box meet it more often than as many through its sphere: the
-/// box is the smaller container (`S_box < 4 pi R^2`), as for rooms and most scenes whose walls lie
-/// along the axes; an octahedron's box, or a room turned about two axes, is larger than its sphere.
-pub fn box_is_smaller(scene: &Scene) -> bool {
-    BoundingBox::of(scene).share_of_sphere(scene.bounding_radius()) < 1.0
+/// The container the Sobol' sampler draws through on `scene` (`--lines-through auto`), by what was
+/// measured (docs/sampling.md): the box when it is smaller than the sphere and within
+/// [`BOX_PREFERENCE`] of the polytope (rooms: its rectangular faces align the walls with the sequence's
+/// axes); else the polytope when it is smaller than the sphere and at least [`ON_FACES`] of the scene's
+/// area lies in its faces' planes (solids such as the octahedron, whose faces it shares); else the
+/// sphere (through which `sobol` gained more on curved objects and on solids or rooms turned off the
+/// polytope's directions).
+pub fn tightest_container(scene: &Scene) -> LineBound {
+    let boxed = share_of_sphere(scene, LineBound::Box);
+    let polytope = share_of_sphere(scene, LineBound::Polytope);
+    if boxed < 1.0 && boxed <= BOX_PREFERENCE * polytope {
+        LineBound::Box
+    } else if polytope < 1.0 && share_of_area_on_faces(scene) >= ON_FACES {
+        LineBound::Polytope
+    } else {
+        LineBound::Sphere
+    }
 }
+
+/// The share of a scene's area in the planes of its polytope's faces from which `auto` draws through
+/// the polytope.
+pub const ON_FACES: f64 = 0.5;
+
+/// How much larger than the polytope the box may be and still be preferred (a room's box is its
+/// polytope; an octahedron's box is 3.5 times its polytope).
+pub const BOX_PREFERENCE: f64 = 1.1;
 
 /// Where a run draws its lines: the bounding sphere's radius, or the bounding box.
 #[derive(Clone, Debug, PartialEq)]
@@ -315,6 +367,8 @@ pub enum LineRegion {
     Sphere(f64),
     /// Through this box (boxed: its faces are prepared, about a kilobyte).
     Box(std::boxed::Box<BoundingBox>),
+    /// Through this polytope.
+    Polytope(std::boxed::Box<BoundingPolytope>),
 }
 
 impl LineRegion {
@@ -323,6 +377,9 @@ impl LineRegion {
         match bound {
             LineBound::Sphere => LineRegion::Sphere(scene.bounding_radius()),
             LineBound::Box => LineRegion::Box(std::boxed::Box::new(BoundingBox::of(scene))),
+            LineBound::Polytope => {
+                LineRegion::Polytope(std::boxed::Box::new(BoundingPolytope::of(scene)))
+            }
         }
     }
 }
@@ -340,10 +397,10 @@ mod tests {
         let b = BoundingBox::new(LO, HI);
         let mut independent = Vec::new();
         for batch in 0..16 {
-            box_batch_lines(5, batch, 4096, &b, &mut independent);
+            batch_lines_through(5, batch, 4096, &b, &mut independent);
         }
         let mut sobol = Vec::new();
-        sobol_box_lines(5, 0, 0, 1 << 16, &b, &mut sobol);
+        sobol_lines_through(5, 0, 0, 1 << 16, &b, &mut sobol);
         [("independent", independent), ("sobol", sobol)]
     }
 

@@ -17,6 +17,7 @@ pub mod lines;
 mod order;
 pub mod pairs;
 pub mod patch_counts;
+pub mod polytope;
 pub mod sobol;
 pub mod sparse;
 pub mod tally;

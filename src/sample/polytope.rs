@@ -1,0 +1,461 @@
+//! The scene's bounding polytope (`--lines-through polytope`): the convex polytope bounded by the
+//! 26 planes that touch the scene across 13 directions, the 3 axes, the 6 diagonals of the axis
+//! planes and the 4 diagonals of space (a 26-DOP: the bounding box with its edges and corners cut
+//! off). It hugs convex solids and objects in open space far closer than the box or the sphere: the
+//! octahedron's is the octahedron itself, while its box reaches out of its sphere.
+//!
+//! Its lines are drawn as the box's are ([`super::bounds`]): an oriented line meeting a convex body
+//! enters it at one point, where the invariant density of lines is `|cos theta| dA d omega`, so a
+//! face triangle chosen in proportion to its area, a uniform point on it and a cosine-distributed
+//! direction into the polytope give the sphere's lines that meet the polytope, each traced along
+//! its whole chord of the bounding sphere (which holds every scene point the line crosses). The
+//! point on a triangle is `a + sqrt(s) ((1 - t) (b - a) + t (c - a))`: each of the triangle's edges
+//! is a line `s = 1`, `t = 0` or `t = 1` of the unit square, so the logarithmic singularity of eq.
+//! (27) along the lines through an edge of a solid lies along the axes of a Sobol' point set, as it
+//! does for the box's faces.
+//!
+//! `--lines-through auto` draws through it, for the Sobol' sampler, only where most of the scene's
+//! area lies in its faces' planes ([`share_of_area_on_faces`]): on curved objects, and on solids or
+//! rooms turned off its 13 directions, the Sobol' lines through the sphere measured better.
+
+use super::lines::concentric_discs;
+use crate::scene::Scene;
+use crate::trace::Line;
+
+/// How far the box and the polytope reach beyond the scene, in bounding radii: a flat scene still
+/// gets a container of positive volume, and the box's lines start off every surface.
+pub(super) const CONTAINER_MARGIN: f64 = 1e-3;
+
+/// The traced chord reaches this factor beyond the bounding sphere (as the sphere's own lines do),
+/// so that f32 rounding never clips a vertex lying on the sphere.
+const CHORD_REACH: f64 = 1.001;
+
+/// The 13 directions of the bounding planes (unit vectors): the axes, the diagonals of the axis
+/// planes, the diagonals of space.
+fn directions() -> [[f64; 3]; 13] {
+    let (h, t) = (std::f64::consts::FRAC_1_SQRT_2, 1.0 / 3f64.sqrt());
+    [
+        [1.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [0.0, 0.0, 1.0],
+        [h, h, 0.0],
+        [h, -h, 0.0],
+        [h, 0.0, h],
+        [h, 0.0, -h],
+        [0.0, h, h],
+        [0.0, h, -h],
+        [t, t, t],
+        [t, t, -t],
+        [t, -t, t],
+        [-t, t, t],
+    ]
+}
+
+/// A half-space `normal . x <= offset` (`normal` a unit vector pointing out of the polytope).
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Plane {
+    normal: [f64; 3],
+    offset: f64,
+}
+
+/// One triangle of the polytope's surface, with what drawing a line through it needs.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct FaceTriangle {
+    /// The running sum of the areas of the triangles before it.
+    start: f64,
+    area: f64,
+    /// Its corner `a` and the edges `b - a`, `c - a`.
+    a: [f64; 3],
+    ab: [f64; 3],
+    ac: [f64; 3],
+    /// The inward normal, and two unit vectors across the face, orthogonal to it and each other.
+    inward: [f64; 3],
+    across_b: [f64; 3],
+    across_c: [f64; 3],
+}
+
+/// The bounding polytope of a scene, as the triangles of its faces.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BoundingPolytope {
+    triangles: Vec<FaceTriangle>,
+    area: f64,
+    /// The radius of the sphere whose chords are traced.
+    reach: f64,
+}
+
+fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+fn scaled(a: [f64; 3], s: f64) -> [f64; 3] {
+    a.map(|x| x * s)
+}
+
+fn unit(a: [f64; 3]) -> [f64; 3] {
+    scaled(a, 1.0 / dot(a, a).sqrt())
+}
+
+/// The part of the convex polygon `poly` where `plane` holds (Sutherland and Hodgman).
+fn clipped(poly: &[[f64; 3]], plane: &Plane) -> Vec<[f64; 3]> {
+    let side = |p: [f64; 3]| dot(plane.normal, p) - plane.offset;
+    let mut out = Vec::with_capacity(poly.len() + 1);
+    for (k, &p) in poly.iter().enumerate() {
+        let q = poly[(k + 1) % poly.len()];
+        let (sp, sq) = (side(p), side(q));
+        if sp <= 0.0 {
+            out.push(p);
+        }
+        if (sp < 0.0 && sq > 0.0) || (sp > 0.0 && sq < 0.0) {
+            let t = sp / (sp - sq);
+            out.push(std::array::from_fn(|i| p[i] + t * (q[i] - p[i])));
+        }
+    }
+    out
+}
+
+/// The 26 planes touching `points` (pointing out of them), each moved out by `margin`.
+fn support_planes(points: impl Iterator<Item = [f64; 3]> + Clone, margin: f64) -> Vec<Plane> {
+    let mut planes = Vec::with_capacity(26);
+    for d in directions() {
+        let (lo, hi) = points
+            .clone()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| {
+                let x = dot(d, p);
+                (lo.min(x), hi.max(x))
+            });
+        let (lo, hi) = if lo.is_finite() { (lo, hi) } else { (0.0, 0.0) };
+        planes.push(Plane {
+            normal: d,
+            offset: hi + margin,
+        });
+        planes.push(Plane {
+            normal: scaled(d, -1.0),
+            offset: -lo + margin,
+        });
+    }
+    planes
+}
+
+/// The vertices of `scene`'s triangles in tracing space.
+fn scene_points(scene: &Scene) -> impl Iterator<Item = [f64; 3]> + Clone + '_ {
+    scene
+        .triangles
+        .iter()
+        .flatten()
+        .map(|&v| scene.positions[v as usize].map(f64::from))
+}
+
+/// The share of `scene`'s area that lies in the planes of its polytope's faces (its triangles with
+/// every corner within a millionth of the bounding radius of one of them): 1 for the octahedron and
+/// the tetrahedron, whose faces are among the polytope's, 0 for the icosahedron or a curved object.
+/// Where it is high the Sobol' sampler gains through the polytope as it does through the box of a
+/// room ([`super::bounds::tightest_container`]).
+pub fn share_of_area_on_faces(scene: &Scene) -> f64 {
+    let planes = support_planes(scene_points(scene), 0.0);
+    let tolerance = 1e-6 * scene.bounding_radius();
+    let (mut on, mut all) = (0.0, 0.0);
+    for t in &scene.triangles {
+        let [a, b, c] = t.map(|v| scene.positions[v as usize].map(f64::from));
+        let area = 0.5 * dot(cross(sub(b, a), sub(c, a)), cross(sub(b, a), sub(c, a))).sqrt();
+        all += area;
+        let in_plane = |p: &Plane| {
+            [a, b, c]
+                .iter()
+                .all(|&v| dot(p.normal, v) >= p.offset - tolerance)
+        };
+        if planes.iter().any(in_plane) {
+            on += area;
+        }
+    }
+    if all > 0.0 {
+        on / all
+    } else {
+        0.0
+    }
+}
+
+/// `poly` without its repeated corners and the corners on a straight edge (touching planes leave
+/// such corners behind), so that a face is fanned into as few triangles as it has true corners less
+/// two.
+fn without_straight_corners(poly: Vec<[f64; 3]>, scale: f64) -> Vec<[f64; 3]> {
+    let mut corners = poly;
+    let tiny = 1e-12 * scale * scale;
+    let mut k = 0;
+    while corners.len() >= 3 && k < corners.len() {
+        let n = corners.len();
+        let (prev, here, next) = (corners[(k + n - 1) % n], corners[k], corners[(k + 1) % n]);
+        let turn = cross(sub(here, prev), sub(next, here));
+        if dot(turn, turn).sqrt() <= tiny {
+            corners.remove(k);
+            k = k.saturating_sub(1);
+        } else {
+            k += 1;
+        }
+    }
+    corners
+}
+
+impl BoundingPolytope {
+    /// The polytope of the points `points` (tracing space), each plane moved out by `margin`, whose
+    /// lines are traced along their chords of the sphere of radius `radius` about the origin (which
+    /// must hold the points).
+    pub fn of_points(
+        points: impl Iterator<Item = [f64; 3]> + Clone,
+        margin: f64,
+        radius: f64,
+    ) -> Self {
+        let planes = support_planes(points, margin);
+        // Every face lies within the cube of side 4 radii about the origin.
+        let extent = 4.0 * radius.max(margin);
+        let mut triangles = Vec::new();
+        let mut area = 0.0;
+        for (k, plane) in planes.iter().enumerate() {
+            let n = plane.normal;
+            let helper = if n[0].abs() < 0.9 {
+                [1.0, 0.0, 0.0]
+            } else {
+                [0.0, 1.0, 0.0]
+            };
+            let (u, v) = (unit(cross(n, helper)), cross(n, unit(cross(n, helper))));
+            let centre = scaled(n, plane.offset);
+            let corner = |a: f64, b: f64| -> [f64; 3] {
+                std::array::from_fn(|i| centre[i] + extent * (a * u[i] + b * v[i]))
+            };
+            let mut face = vec![
+                corner(-1.0, -1.0),
+                corner(1.0, -1.0),
+                corner(1.0, 1.0),
+                corner(-1.0, 1.0),
+            ];
+            for (j, other) in planes.iter().enumerate() {
+                if j != k && face.len() >= 3 {
+                    face = clipped(&face, other);
+                }
+            }
+            let face = without_straight_corners(face, extent);
+            for w in 1..face.len().saturating_sub(1) {
+                let (a, b, c) = (face[0], face[w], face[w + 1]);
+                let (ab, ac) = (sub(b, a), sub(c, a));
+                let t_area = 0.5 * dot(cross(ab, ac), cross(ab, ac)).sqrt();
+                if t_area <= 1e-10 * radius * radius {
+                    continue;
+                }
+                let inward = scaled(n, -1.0);
+                let across_b = unit(ab);
+                triangles.push(FaceTriangle {
+                    start: area,
+                    area: t_area,
+                    a,
+                    ab,
+                    ac,
+                    inward,
+                    across_b,
+                    across_c: cross(inward, across_b),
+                });
+                area += t_area;
+            }
+        }
+        BoundingPolytope {
+            triangles,
+            area,
+            reach: CHORD_REACH * radius,
+        }
+    }
+
+    /// `scene`'s polytope in tracing space, its planes moved out by [`CONTAINER_MARGIN`] bounding
+    /// radii, as the box is grown.
+    pub fn of(scene: &Scene) -> Self {
+        let radius = scene.bounding_radius();
+        Self::of_points(scene_points(scene), CONTAINER_MARGIN * radius, radius)
+    }
+
+    /// The polytope's surface area.
+    pub fn surface_area(&self) -> f64 {
+        self.area
+    }
+
+    /// `S / (4 pi R^2)` for the sphere of radius `radius`: the share of that sphere's lines that
+    /// meet the polytope when the polytope is inside the sphere (Cauchy), more than 1 when it
+    /// reaches out of it ([`super::bounds::BoundingBox::share_of_sphere`]).
+    pub fn share_of_sphere(&self, radius: f64) -> f64 {
+        self.area / (4.0 * std::f64::consts::PI * radius * radius)
+    }
+
+    /// The triangles' count (every face of positive area, fanned into triangles).
+    pub fn triangle_count(&self) -> usize {
+        self.triangles.len()
+    }
+
+    /// The line of the unit point `u`: `u[0]` chooses the triangle (in proportion to the areas)
+    /// and, rescaled within its share, the distance from the triangle's first corner (as `sqrt`),
+    /// `u[1]` the way across; `(u[2], u[3])` the direction, as the box's lines do
+    /// ([`super::bounds::BoundingBox::line`]). The line is traced along its chord of the sphere of
+    /// the polytope's reach.
+    pub fn line(&self, u: [f64; 4]) -> Line {
+        let mut out = Vec::with_capacity(1);
+        self.lines(&[u], &mut out);
+        out[0]
+    }
+
+    /// The lines of `units`, [`BoundingPolytope::line`] of each, appended to `out`.
+    pub fn lines(&self, units: &[[f64; 4]], out: &mut Vec<Line>) {
+        const N: usize = 16;
+        for chunk in units.chunks(N) {
+            let (mut a, mut b) = ([0.0; N], [0.0; N]);
+            for (k, u) in chunk.iter().enumerate() {
+                a[k] = 2.0 * u[2] - 1.0;
+                b[k] = 2.0 * u[3] - 1.0;
+            }
+            let (dx, dy) = concentric_discs(&a, &b);
+            for (k, u) in chunk.iter().enumerate() {
+                out.push(self.line_with_disc(u[0], u[1], (dx[k], dy[k])));
+            }
+        }
+    }
+
+    fn line_with_disc(&self, u0: f64, u1: f64, (dx, dy): (f64, f64)) -> Line {
+        let at = u0 * self.area;
+        let k = self
+            .triangles
+            .partition_point(|t| t.start + t.area <= at)
+            .min(self.triangles.len().saturating_sub(1));
+        let Some(t) = self.triangles.get(k) else {
+            return Line {
+                origin: [0.0; 3],
+                dir: [0.0, 0.0, 1.0],
+                t_max: 0.0,
+            };
+        };
+        let s = ((at - t.start) / t.area).clamp(0.0, 1.0).sqrt();
+        let entry: [f64; 3] =
+            std::array::from_fn(|i| t.a[i] + s * ((1.0 - u1) * t.ab[i] + u1 * t.ac[i]));
+        let dz = (1.0 - dx * dx - dy * dy).max(0.0).sqrt();
+        let dir: [f64; 3] =
+            std::array::from_fn(|i| dz * t.inward[i] + dx * t.across_b[i] + dy * t.across_c[i]);
+        self.chord(entry, dir)
+    }
+
+    /// The line through `entry` along the unit `dir`, from where it enters the sphere of the
+    /// polytope's reach to where it leaves it (a line that misses that sphere meets no scene point:
+    /// an empty segment).
+    fn chord(&self, entry: [f64; 3], dir: [f64; 3]) -> Line {
+        let b = dot(entry, dir);
+        let disc = b * b - (dot(entry, entry) - self.reach * self.reach);
+        if disc <= 0.0 {
+            return Line {
+                origin: entry.map(|x| x as f32),
+                dir: dir.map(|x| x as f32),
+                t_max: 0.0,
+            };
+        }
+        let half = disc.sqrt();
+        let t_in = -b - half;
+        Line {
+            origin: std::array::from_fn(|i| (entry[i] + t_in * dir[i]) as f32),
+            dir: dir.map(|x| x as f32),
+            t_max: (2.0 * half) as f32,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn octahedron() -> Vec<[f64; 3]> {
+        vec![
+            [1.0, 0.0, 0.0],
+            [-1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.0, -1.0, 0.0],
+            [0.0, 0.0, 1.0],
+            [0.0, 0.0, -1.0],
+        ]
+    }
+
+    /// The octahedron's polytope is the octahedron (8 equilateral faces of side sqrt 2, area 4 sqrt
+    /// 3); the cube's is the cube (area 24 for side 2), its diagonal planes touching it at edges
+    /// and corners.
+    #[test]
+    fn the_polytope_of_an_octahedron_or_a_cube_is_itself() {
+        let p = BoundingPolytope::of_points(octahedron().into_iter(), 0.0, 1.0);
+        assert!(
+            (p.surface_area() - 4.0 * 3f64.sqrt()).abs() < 1e-9,
+            "{}",
+            p.surface_area()
+        );
+        assert_eq!(p.triangle_count(), 8);
+        let corners: Vec<[f64; 3]> = (0..8)
+            .map(|k| [0, 1, 2].map(|i| if k >> i & 1 == 1 { 1.0 } else { -1.0 }))
+            .collect();
+        let c = BoundingPolytope::of_points(corners.into_iter(), 0.0, 3f64.sqrt());
+        assert!(
+            (c.surface_area() - 24.0).abs() < 1e-9,
+            "{}",
+            c.surface_area()
+        );
+    }
+
+    /// Lines through the octahedron's polytope enter its faces as often as their areas say, with
+    /// the cosine about the inward normal averaging 2/3 (the density `|cos| dA d omega`); every
+    /// chord passes through the octahedron, from outside the unit sphere to outside it.
+    #[test]
+    fn its_lines_meet_it_with_the_invariant_density() {
+        let p = BoundingPolytope::of_points(octahedron().into_iter(), 0.0, 1.0);
+        let n = 1 << 16;
+        let mut cos_sum = 0.0;
+        let mut seen = [0u32; 8];
+        let mut rng = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = || {
+            rng ^= rng << 13;
+            rng ^= rng >> 7;
+            rng ^= rng << 17;
+            (rng >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for _ in 0..n {
+            let u = [next(), next(), next(), next()];
+            let line = p.line(u);
+            let d = line.dir.map(f64::from);
+            let o = line.origin.map(f64::from);
+            assert!(dot(o, o) > 1.0 && line.t_max > 0.0);
+            // The entry face: the octant of the entry point, whose outward normal is (+-1, +-1, +-1).
+            let (t_in, face) = (0..8)
+                .map(|k| {
+                    let nrm = [0, 1, 2].map(|i| if k >> i & 1 == 1 { -1.0 } else { 1.0 });
+                    let denom = dot(nrm, d);
+                    ((1.0 - dot(nrm, o)) / denom, k, denom)
+                })
+                .filter(|&(_, _, denom)| denom < 0.0)
+                .map(|(t, k, _)| (t, k))
+                .fold((f64::NEG_INFINITY, 0), |a, b| if b.0 > a.0 { b } else { a });
+            assert!(t_in > 0.0 && t_in < f64::from(line.t_max));
+            seen[face] += 1;
+            let nrm = [0, 1, 2].map(|i| if face >> i & 1 == 1 { -1.0 } else { 1.0 });
+            cos_sum += -dot(nrm, d) / 3f64.sqrt();
+        }
+        let expected = f64::from(n) / 8.0;
+        for s in seen {
+            assert!(
+                (f64::from(s) - expected).abs() < 4.5 * (expected * 7.0 / 8.0).sqrt(),
+                "{seen:?}"
+            );
+        }
+        let mean_cos = cos_sum / f64::from(n);
+        assert!(
+            (mean_cos - 2.0 / 3.0).abs() < 4.5 * (1.0 / 18.0 / f64::from(n)).sqrt(),
+            "{mean_cos}"
+        );
+    }
+}
