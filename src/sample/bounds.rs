@@ -1,5 +1,7 @@
 //! Where a run's global lines are drawn: through the scene's bounding sphere (the paper's lines, sec.
-//! 2.1.1, [`super::lines`]) or through its bounding box (`--lines-through box`).
+//! 2.1.1, [`super::lines`]), through its bounding box (`--lines-through box`, here) or through its
+//! bounding polytope (`--lines-through polytope`, [`super::polytope`]), and which of them `auto` takes
+//! ([`tightest_container`]).
 //!
 //! **Lines through the box.** An oriented line that meets a convex body enters it at exactly one point,
 //! and the invariant density of lines, written at that entry point `x` of the body's surface, is
@@ -299,8 +301,8 @@ pub fn sobol_lines_through(
 }
 
 /// How many lines through `scene`'s bounding sphere `lines` lines drawn as `bound` says are worth: as
-/// many for the sphere, `lines / p` through the box ([`BoundingBox::share_of_sphere`]; fewer than
-/// `lines` when the box is the larger container).
+/// many for the sphere, `lines / p` through the box or the polytope ([`share_of_sphere`]; fewer than
+/// `lines` when it is the larger container).
 pub fn sphere_lines(scene: &Scene, bound: LineBound, lines: u64) -> f64 {
     lines as f64 / share_of_sphere(scene, bound)
 }
