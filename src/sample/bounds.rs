@@ -25,7 +25,7 @@
 
 use rand::RngCore;
 
-use super::lines::{batch_rng, concentric_discs};
+use super::lines::{batch_rng, concentric_discs, lines_with_discs};
 use super::polytope::{share_of_area_on_faces, BoundingPolytope, CONTAINER_MARGIN};
 use super::sobol::ScrambledSobol;
 use crate::geom::uniform01;
@@ -198,18 +198,7 @@ impl BoundingBox {
     /// The lines of `units`, [`BoundingBox::line`] of each, the disc points made 16 at a time (their
     /// polynomial chains overlap), appended to `out`.
     pub fn lines(&self, units: &[[f64; 4]], out: &mut Vec<Line>) {
-        const N: usize = 16;
-        for chunk in units.chunks(N) {
-            let (mut a, mut b) = ([0.0; N], [0.0; N]);
-            for (k, u) in chunk.iter().enumerate() {
-                a[k] = 2.0 * u[2] - 1.0;
-                b[k] = 2.0 * u[3] - 1.0;
-            }
-            let (dx, dy) = concentric_discs(&a, &b);
-            for (k, u) in chunk.iter().enumerate() {
-                out.push(self.line_with_disc(u[0], u[1], (dx[k], dy[k])));
-            }
-        }
+        lines_with_discs(units, out, |u0, u1, disc| self.line_with_disc(u0, u1, disc));
     }
 
     /// [`BoundingBox::line`] once its direction's disc point is known.

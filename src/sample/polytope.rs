@@ -18,7 +18,8 @@
 //! area lies in its faces' planes ([`share_of_area_on_faces`]): on curved objects, and on solids or
 //! rooms turned off its 13 directions, the Sobol' lines through the sphere measured better.
 
-use super::lines::concentric_discs;
+use super::lines::lines_with_discs;
+use crate::geom::DVec3;
 use crate::scene::Scene;
 use crate::trace::Line;
 
@@ -32,29 +33,29 @@ const CHORD_REACH: f64 = 1.001;
 
 /// The 13 directions of the bounding planes (unit vectors): the axes, the diagonals of the axis
 /// planes, the diagonals of space.
-fn directions() -> [[f64; 3]; 13] {
+fn directions() -> [DVec3; 13] {
     let (h, t) = (std::f64::consts::FRAC_1_SQRT_2, 1.0 / 3f64.sqrt());
     [
-        [1.0, 0.0, 0.0],
-        [0.0, 1.0, 0.0],
-        [0.0, 0.0, 1.0],
-        [h, h, 0.0],
-        [h, -h, 0.0],
-        [h, 0.0, h],
-        [h, 0.0, -h],
-        [0.0, h, h],
-        [0.0, h, -h],
-        [t, t, t],
-        [t, t, -t],
-        [t, -t, t],
-        [-t, t, t],
+        DVec3::new(1.0, 0.0, 0.0),
+        DVec3::new(0.0, 1.0, 0.0),
+        DVec3::new(0.0, 0.0, 1.0),
+        DVec3::new(h, h, 0.0),
+        DVec3::new(h, -h, 0.0),
+        DVec3::new(h, 0.0, h),
+        DVec3::new(h, 0.0, -h),
+        DVec3::new(0.0, h, h),
+        DVec3::new(0.0, h, -h),
+        DVec3::new(t, t, t),
+        DVec3::new(t, t, -t),
+        DVec3::new(t, -t, t),
+        DVec3::new(-t, t, t),
     ]
 }
 
 /// A half-space `normal . x <= offset` (`normal` a unit vector pointing out of the polytope).
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct Plane {
-    normal: [f64; 3],
+    normal: DVec3,
     offset: f64,
 }
 
@@ -65,13 +66,13 @@ struct FaceTriangle {
     start: f64,
     area: f64,
     /// Its corner `a` and the edges `b - a`, `c - a`.
-    a: [f64; 3],
-    ab: [f64; 3],
-    ac: [f64; 3],
+    a: DVec3,
+    ab: DVec3,
+    ac: DVec3,
     /// The inward normal, and two unit vectors across the face, orthogonal to it and each other.
-    inward: [f64; 3],
-    across_b: [f64; 3],
-    across_c: [f64; 3],
+    inward: DVec3,
+    across_b: DVec3,
+    across_c: DVec3,
 }
 
 /// The bounding polytope of a scene, as the triangles of its faces.
@@ -83,33 +84,9 @@ pub struct BoundingPolytope {
     reach: f64,
 }
 
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-
-fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-fn scaled(a: [f64; 3], s: f64) -> [f64; 3] {
-    a.map(|x| x * s)
-}
-
-fn unit(a: [f64; 3]) -> [f64; 3] {
-    scaled(a, 1.0 / dot(a, a).sqrt())
-}
-
 /// The part of the convex polygon `poly` where `plane` holds (Sutherland and Hodgman).
-fn clipped(poly: &[[f64; 3]], plane: &Plane) -> Vec<[f64; 3]> {
-    let side = |p: [f64; 3]| dot(plane.normal, p) - plane.offset;
+fn clipped(poly: &[DVec3], plane: &Plane) -> Vec<DVec3> {
+    let side = |p: DVec3| plane.normal.dot(p) - plane.offset;
     let mut out = Vec::with_capacity(poly.len() + 1);
     for (k, &p) in poly.iter().enumerate() {
         let q = poly[(k + 1) % poly.len()];
@@ -119,20 +96,20 @@ fn clipped(poly: &[[f64; 3]], plane: &Plane) -> Vec<[f64; 3]> {
         }
         if (sp < 0.0 && sq > 0.0) || (sp > 0.0 && sq < 0.0) {
             let t = sp / (sp - sq);
-            out.push(std::array::from_fn(|i| p[i] + t * (q[i] - p[i])));
+            out.push(p + (q - p) * t);
         }
     }
     out
 }
 
 /// The 26 planes touching `points` (pointing out of them), each moved out by `margin`.
-fn support_planes(points: impl Iterator<Item = [f64; 3]> + Clone, margin: f64) -> Vec<Plane> {
+fn support_planes(points: impl Iterator<Item = DVec3> + Clone, margin: f64) -> Vec<Plane> {
     let mut planes = Vec::with_capacity(26);
     for d in directions() {
         let (lo, hi) = points
             .clone()
             .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| {
-                let x = dot(d, p);
+                let x = d.dot(p);
                 (lo.min(x), hi.max(x))
             });
         let (lo, hi) = if lo.is_finite() { (lo, hi) } else { (0.0, 0.0) };
@@ -141,7 +118,7 @@ fn support_planes(points: impl Iterator<Item = [f64; 3]> + Clone, margin: f64) -
             offset: hi + margin,
         });
         planes.push(Plane {
-            normal: scaled(d, -1.0),
+            normal: -d,
             offset: -lo + margin,
         });
     }
@@ -149,12 +126,12 @@ fn support_planes(points: impl Iterator<Item = [f64; 3]> + Clone, margin: f64) -
 }
 
 /// The vertices of `scene`'s triangles in tracing space.
-fn scene_points(scene: &Scene) -> impl Iterator<Item = [f64; 3]> + Clone + '_ {
+fn scene_points(scene: &Scene) -> impl Iterator<Item = DVec3> + Clone + '_ {
     scene
         .triangles
         .iter()
         .flatten()
-        .map(|&v| scene.positions[v as usize].map(f64::from))
+        .map(|&v| DVec3::from(scene.positions[v as usize].map(f64::from)))
 }
 
 /// The share of `scene`'s area that lies in the planes of its polytope's faces (its triangles with
@@ -167,13 +144,14 @@ pub fn share_of_area_on_faces(scene: &Scene) -> f64 {
     let tolerance = 1e-6 * scene.bounding_radius();
     let (mut on, mut all) = (0.0, 0.0);
     for t in &scene.triangles {
-        let [a, b, c] = t.map(|v| scene.positions[v as usize].map(f64::from));
-        let area = 0.5 * dot(cross(sub(b, a), sub(c, a)), cross(sub(b, a), sub(c, a))).sqrt();
+        let corners = t.map(|v| DVec3::from(scene.positions[v as usize].map(f64::from)));
+        let [a, b, c] = corners;
+        let area = 0.5 * (b - a).cross(c - a).length();
         all += area;
         let in_plane = |p: &Plane| {
-            [a, b, c]
+            corners
                 .iter()
-                .all(|&v| dot(p.normal, v) >= p.offset - tolerance)
+                .all(|&v| p.normal.dot(v) >= p.offset - tolerance)
         };
         if planes.iter().any(in_plane) {
             on += area;
@@ -189,15 +167,14 @@ pub fn share_of_area_on_faces(scene: &Scene) -> f64 {
 /// `poly` without its repeated corners and the corners on a straight edge (touching planes leave
 /// such corners behind), so that a face is fanned into as few triangles as it has true corners less
 /// two.
-fn without_straight_corners(poly: Vec<[f64; 3]>, scale: f64) -> Vec<[f64; 3]> {
+fn without_straight_corners(poly: Vec<DVec3>, scale: f64) -> Vec<DVec3> {
     let mut corners = poly;
     let tiny = 1e-12 * scale * scale;
     let mut k = 0;
     while corners.len() >= 3 && k < corners.len() {
         let n = corners.len();
         let (prev, here, next) = (corners[(k + n - 1) % n], corners[k], corners[(k + 1) % n]);
-        let turn = cross(sub(here, prev), sub(next, here));
-        if dot(turn, turn).sqrt() <= tiny {
+        if (here - prev).cross(next - here).length() <= tiny {
             corners.remove(k);
             k = k.saturating_sub(1);
         } else {
@@ -212,7 +189,7 @@ impl BoundingPolytope {
     /// lines are traced along their chords of the sphere of radius `radius` about the origin (which
     /// must hold the points).
     pub fn of_points(
-        points: impl Iterator<Item = [f64; 3]> + Clone,
+        points: impl Iterator<Item = DVec3> + Clone,
         margin: f64,
         radius: f64,
     ) -> Self {
@@ -223,16 +200,11 @@ impl BoundingPolytope {
         let mut area = 0.0;
         for (k, plane) in planes.iter().enumerate() {
             let n = plane.normal;
-            let helper = if n[0].abs() < 0.9 {
-                [1.0, 0.0, 0.0]
-            } else {
-                [0.0, 1.0, 0.0]
-            };
-            let (u, v) = (unit(cross(n, helper)), cross(n, unit(cross(n, helper))));
-            let centre = scaled(n, plane.offset);
-            let corner = |a: f64, b: f64| -> [f64; 3] {
-                std::array::from_fn(|i| centre[i] + extent * (a * u[i] + b * v[i]))
-            };
+            let helper = if n.x.abs() < 0.9 { DVec3::X } else { DVec3::Y };
+            let u = n.cross(helper).normalize();
+            let v = n.cross(u);
+            let centre = n * plane.offset;
+            let corner = |a: f64, b: f64| centre + (u * a + v * b) * extent;
             let mut face = vec![
                 corner(-1.0, -1.0),
                 corner(1.0, -1.0),
@@ -247,13 +219,12 @@ impl BoundingPolytope {
             let face = without_straight_corners(face, extent);
             for w in 1..face.len().saturating_sub(1) {
                 let (a, b, c) = (face[0], face[w], face[w + 1]);
-                let (ab, ac) = (sub(b, a), sub(c, a));
-                let t_area = 0.5 * dot(cross(ab, ac), cross(ab, ac)).sqrt();
+                let (ab, ac) = (b - a, c - a);
+                let t_area = 0.5 * ab.cross(ac).length();
                 if t_area <= 1e-10 * radius * radius {
                     continue;
                 }
-                let inward = scaled(n, -1.0);
-                let across_b = unit(ab);
+                let (inward, across_b) = (-n, ab.normalize());
                 triangles.push(FaceTriangle {
                     start: area,
                     area: t_area,
@@ -262,7 +233,7 @@ impl BoundingPolytope {
                     ac,
                     inward,
                     across_b,
-                    across_c: cross(inward, across_b),
+                    across_c: inward.cross(across_b),
                 });
                 area += t_area;
             }
@@ -311,18 +282,7 @@ impl BoundingPolytope {
 
     /// The lines of `units`, [`BoundingPolytope::line`] of each, appended to `out`.
     pub fn lines(&self, units: &[[f64; 4]], out: &mut Vec<Line>) {
-        const N: usize = 16;
-        for chunk in units.chunks(N) {
-            let (mut a, mut b) = ([0.0; N], [0.0; N]);
-            for (k, u) in chunk.iter().enumerate() {
-                a[k] = 2.0 * u[2] - 1.0;
-                b[k] = 2.0 * u[3] - 1.0;
-            }
-            let (dx, dy) = concentric_discs(&a, &b);
-            for (k, u) in chunk.iter().enumerate() {
-                out.push(self.line_with_disc(u[0], u[1], (dx[k], dy[k])));
-            }
-        }
+        lines_with_discs(units, out, |u0, u1, disc| self.line_with_disc(u0, u1, disc));
     }
 
     fn line_with_disc(&self, u0: f64, u1: f64, (dx, dy): (f64, f64)) -> Line {
@@ -339,32 +299,30 @@ impl BoundingPolytope {
             };
         };
         let s = ((at - t.start) / t.area).clamp(0.0, 1.0).sqrt();
-        let entry: [f64; 3] =
-            std::array::from_fn(|i| t.a[i] + s * ((1.0 - u1) * t.ab[i] + u1 * t.ac[i]));
+        let entry = t.a + (t.ab * (1.0 - u1) + t.ac * u1) * s;
         let dz = (1.0 - dx * dx - dy * dy).max(0.0).sqrt();
-        let dir: [f64; 3] =
-            std::array::from_fn(|i| dz * t.inward[i] + dx * t.across_b[i] + dy * t.across_c[i]);
+        let dir = t.inward * dz + t.across_b * dx + t.across_c * dy;
         self.chord(entry, dir)
     }
 
     /// The line through `entry` along the unit `dir`, from where it enters the sphere of the
     /// polytope's reach to where it leaves it (a line that misses that sphere meets no scene point:
     /// an empty segment).
-    fn chord(&self, entry: [f64; 3], dir: [f64; 3]) -> Line {
-        let b = dot(entry, dir);
-        let disc = b * b - (dot(entry, entry) - self.reach * self.reach);
+    fn chord(&self, entry: DVec3, dir: DVec3) -> Line {
+        let b = entry.dot(dir);
+        let disc = b * b - (entry.dot(entry) - self.reach * self.reach);
+        let f32s = |v: DVec3| v.to_array().map(|x| x as f32);
         if disc <= 0.0 {
             return Line {
-                origin: entry.map(|x| x as f32),
-                dir: dir.map(|x| x as f32),
+                origin: f32s(entry),
+                dir: f32s(dir),
                 t_max: 0.0,
             };
         }
         let half = disc.sqrt();
-        let t_in = -b - half;
         Line {
-            origin: std::array::from_fn(|i| (entry[i] + t_in * dir[i]) as f32),
-            dir: dir.map(|x| x as f32),
+            origin: f32s(entry + dir * (-b - half)),
+            dir: f32s(dir),
             t_max: (2.0 * half) as f32,
         }
     }
@@ -374,15 +332,21 @@ impl BoundingPolytope {
 mod tests {
     use super::*;
 
-    fn octahedron() -> Vec<[f64; 3]> {
+    fn octahedron() -> Vec<DVec3> {
         vec![
-            [1.0, 0.0, 0.0],
-            [-1.0, 0.0, 0.0],
-            [0.0, 1.0, 0.0],
-            [0.0, -1.0, 0.0],
-            [0.0, 0.0, 1.0],
-            [0.0, 0.0, -1.0],
+            DVec3::X,
+            -DVec3::X,
+            DVec3::Y,
+            -DVec3::Y,
+            DVec3::Z,
+            -DVec3::Z,
         ]
+    }
+
+    /// The outward normal (+-1, +-1, +-1) of the octahedron's face in octant `k` (bit i: axis i
+    /// negative), unnormalised: the face is `normal . x = 1`.
+    fn octant_normal(k: usize) -> DVec3 {
+        DVec3::from([0, 1, 2].map(|i| if k >> i & 1 == 1 { -1.0 } else { 1.0 }))
     }
 
     /// The octahedron's polytope is the octahedron (8 equilateral faces of side sqrt 2, area 4 sqrt
@@ -397,8 +361,8 @@ mod tests {
             p.surface_area()
         );
         assert_eq!(p.triangle_count(), 8);
-        let corners: Vec<[f64; 3]> = (0..8)
-            .map(|k| [0, 1, 2].map(|i| if k >> i & 1 == 1 { 1.0 } else { -1.0 }))
+        let corners: Vec<DVec3> = (0..8)
+            .map(|k| DVec3::from([0, 1, 2].map(|i| if k >> i & 1 == 1 { 1.0 } else { -1.0 })))
             .collect();
         let c = BoundingPolytope::of_points(corners.into_iter(), 0.0, 3f64.sqrt());
         assert!(
@@ -427,23 +391,22 @@ mod tests {
         for _ in 0..n {
             let u = [next(), next(), next(), next()];
             let line = p.line(u);
-            let d = line.dir.map(f64::from);
-            let o = line.origin.map(f64::from);
-            assert!(dot(o, o) > 1.0 && line.t_max > 0.0);
+            let d = DVec3::from(line.dir.map(f64::from));
+            let o = DVec3::from(line.origin.map(f64::from));
+            assert!(o.length() > 1.0 && line.t_max > 0.0);
             // The entry face: the octant of the entry point, whose outward normal is (+-1, +-1, +-1).
             let (t_in, face) = (0..8)
                 .map(|k| {
-                    let nrm = [0, 1, 2].map(|i| if k >> i & 1 == 1 { -1.0 } else { 1.0 });
-                    let denom = dot(nrm, d);
-                    ((1.0 - dot(nrm, o)) / denom, k, denom)
+                    let nrm = octant_normal(k);
+                    let denom = nrm.dot(d);
+                    ((1.0 - nrm.dot(o)) / denom, k, denom)
                 })
                 .filter(|&(_, _, denom)| denom < 0.0)
                 .map(|(t, k, _)| (t, k))
                 .fold((f64::NEG_INFINITY, 0), |a, b| if b.0 > a.0 { b } else { a });
             assert!(t_in > 0.0 && t_in < f64::from(line.t_max));
             seen[face] += 1;
-            let nrm = [0, 1, 2].map(|i| if face >> i & 1 == 1 { -1.0 } else { 1.0 });
-            cos_sum += -dot(nrm, d) / 3f64.sqrt();
+            cos_sum += -octant_normal(face).dot(d) / 3f64.sqrt();
         }
         let expected = f64::from(n) / 8.0;
         for s in seen {

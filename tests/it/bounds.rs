@@ -6,8 +6,8 @@
 use crate::support;
 use scene_complexity::internals::analysis::{analyze, AnalysisError};
 use scene_complexity::internals::measure::Measure;
-use scene_complexity::internals::run::{LineStream, LinesThrough, Measures, RunControl, RunSpec};
-use scene_complexity::internals::sample::bounds::{sphere_lines, LineBound, LineRegion};
+use scene_complexity::internals::run::{LinesThrough, Measures, RunControl, RunSpec};
+use scene_complexity::internals::sample::bounds::{sphere_lines, LineBound};
 use scene_complexity::internals::sample::lines::{LineSource, Sampler};
 use scene_complexity::internals::scene::Scene;
 use scene_complexity::internals::scenes;
@@ -50,18 +50,9 @@ fn box_lines_hit_each_patch_as_often_as_crofton_says() {
     let surface = grown_box_surface(&scene);
     for sampler in SAMPLERS {
         let spec = through_the_box(1 << 19, 2024, sampler);
-        let stream = LineStream {
-            plan: spec.plan(),
-            source: LineSource::Independent,
-            sampler,
-            bound: LineBound::Box,
-            groups: spec.group_count() as u64,
-            seed: spec.seed,
-        };
         hits_per_patch_match(
             &scene,
-            &stream,
-            &LineRegion::of(&scene, LineBound::Box),
+            &spec,
             |p| 2.0 * scene.patches[p].area / surface,
             sampler.name(),
         );
@@ -387,7 +378,6 @@ fn the_lines_advice_of_a_box_run_counts_the_spheres_lines() {
 fn polytope_lines_meet_crofton_and_the_octahedrons_exact_measure() {
     use scene_complexity::calibrate::{truth, Basis, CalibrationScene};
     let scene: Scene = scenes::load("@octahedron").unwrap();
-    let region = LineRegion::of(&scene, LineBound::Polytope);
     let share =
         scene_complexity::internals::sample::bounds::share_of_sphere(&scene, LineBound::Polytope);
     let surface = share * 4.0 * std::f64::consts::PI;
@@ -408,18 +398,9 @@ fn polytope_lines_meet_crofton_and_the_octahedrons_exact_measure() {
             measures: Measures::VISIBILITY,
             ..RunSpec::new(1 << 18, 2024)
         };
-        let stream = LineStream {
-            plan: spec.plan(),
-            source: LineSource::Independent,
-            sampler,
-            bound: LineBound::Polytope,
-            groups: spec.group_count() as u64,
-            seed: spec.seed,
-        };
         hits_per_patch_match(
             &scene,
-            &stream,
-            &region,
+            &spec,
             |p| 2.0 * scene.patches[p].area / surface,
             sampler.name(),
         );

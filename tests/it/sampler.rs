@@ -8,8 +8,7 @@ use crate::support;
 use scene_complexity::internals::analysis::{analyze, AnalysisError, Verdict};
 use scene_complexity::internals::measure::estimators::EntropyEstimator;
 use scene_complexity::internals::measure::Measure;
-use scene_complexity::internals::run::{LineStream, Measures, RunControl, RunSpec};
-use scene_complexity::internals::sample::bounds::{LineBound, LineRegion};
+use scene_complexity::internals::run::{Measures, RunControl, RunSpec};
 use scene_complexity::internals::sample::lines::{LineSource, Sampler};
 use scene_complexity::internals::scene::Scene;
 use scene_complexity::internals::scenes;
@@ -35,18 +34,9 @@ fn sobol(lines: u64, seed: u64) -> RunSpec {
 fn sobol_lines_hit_each_patch_as_often_as_crofton_says() {
     let scene: Scene = scenes::load("@cube:2").unwrap();
     let spec = sobol(1 << 20, 2024);
-    let stream = LineStream {
-        plan: spec.plan(),
-        source: LineSource::Independent,
-        sampler: Sampler::Sobol,
-        bound: LineBound::Sphere,
-        groups: spec.group_count() as u64,
-        seed: spec.seed,
-    };
     hits_per_patch_match(
         &scene,
-        &stream,
-        &LineRegion::Sphere(1.0),
+        &spec,
         |p| scene.patches[p].area / (2.0 * std::f64::consts::PI),
         "sobol",
     );

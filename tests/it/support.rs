@@ -301,16 +301,25 @@ pub fn without_session(v: &serde_json::Value) -> serde_json::Value {
     v
 }
 
-/// Crofton through the tracers: over every batch of `stream` drawn through `region` and traced by each
-/// of `scene`'s tracers, the hits of each patch per line, mean of the stream's groups, are within 4.5
-/// standard errors of the groups of `expected(patch)`.
+/// Crofton through the tracers: over every batch of the lines of `spec` (its plan, sampler, bound,
+/// groups and seed) drawn through `scene`'s region for its bound and traced by each of `scene`'s
+/// tracers, the hits of each patch per line, mean of the groups, are within 4.5 standard errors of the
+/// groups of `expected(patch)`.
 pub fn hits_per_patch_match(
     scene: &Scene,
-    stream: &scene_complexity::internals::run::LineStream,
-    region: &scene_complexity::internals::sample::bounds::LineRegion,
+    spec: &scene_complexity::internals::run::RunSpec,
     expected: impl Fn(usize) -> f64,
     label: &str,
 ) {
+    let stream = &scene_complexity::internals::run::LineStream {
+        plan: spec.plan(),
+        source: spec.source,
+        sampler: spec.sampler,
+        bound: spec.bound,
+        groups: spec.group_count() as u64,
+        seed: spec.seed,
+    };
+    let region = &scene_complexity::internals::sample::bounds::LineRegion::of(scene, spec.bound);
     let groups = stream.groups as usize;
     for tracer in all_tracers(scene) {
         let mut per_patch = vec![vec![0.0f64; groups]; scene.patch_count()];
