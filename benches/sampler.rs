@@ -20,7 +20,9 @@
 //! `|F - F_exact| / |F_exact|` against the closed forms, per run, its mean over the seeds.
 //!
 //! `cargo bench --bench sampler [-- SCENE... [LINES]]`, default `@cube:30 @cubes512` and 10^6 lines;
-//! `SCX_SAMPLER_SEEDS=N` seeds (default 30).
+//! `SCX_SAMPLER_SEEDS=N` seeds (default 30); `SCX_SAMPLER_MEASURES=continuous` runs I_s^c alone
+//! (`scx analyze --measures continuous`: no pair is counted, the runs `--sampler auto` draws with Sobol'
+//! lines).
 
 mod common;
 
@@ -30,7 +32,7 @@ use scene_complexity::calibrate::rectangles::{form_factor_row, AxisRect};
 use scene_complexity::calibrate::{truth, Basis, CalibrationScene};
 use scene_complexity::internals::analysis::{analyze, Analysis};
 use scene_complexity::internals::measure::Measure;
-use scene_complexity::internals::run::{LinesThrough, RunControl, RunSpec};
+use scene_complexity::internals::run::{LinesThrough, Measures, RunControl, RunSpec};
 use scene_complexity::internals::sample::bounds::LineBound;
 use scene_complexity::internals::sample::lines::Sampler;
 use scene_complexity::internals::scene::Scene;
@@ -62,10 +64,19 @@ const SAMPLERS: [(&str, Sampler, LineBound); 5] = [
 fn main() -> anyhow::Result<()> {
     let (specs, lines) = common::scenes_and_lines(1e6)?;
     let seeds: u64 = std::env::var("SCX_SAMPLER_SEEDS").map_or(Ok(30), |s| s.parse())?;
+    let measures = match std::env::var("SCX_SAMPLER_MEASURES").as_deref() {
+        Ok("continuous") => Measures {
+            discrete: false,
+            continuous: true,
+            radiosity: false,
+        },
+        Ok(other) => anyhow::bail!("SCX_SAMPLER_MEASURES: `{other}` is not `continuous`"),
+        Err(_) => Measures::ALL,
+    };
     let pool = rayon::ThreadPoolBuilder::new().num_threads(2).build()?;
     println!("{lines} lines per run (through the sphere, or worth as many through the box), 2 threads, Embree single lines, 16 groups, {seeds} seeds per sampler");
     for spec in &specs {
-        pool.install(|| compare(spec, lines, seeds))?;
+        pool.install(|| compare(spec, lines, seeds, measures))?;
     }
     Ok(())
 }
@@ -82,7 +93,7 @@ struct Runs {
     f_errors: Vec<f64>,
 }
 
-fn compare(spec: &str, lines: u64, seeds: u64) -> anyhow::Result<()> {
+fn compare(spec: &str, lines: u64, seeds: u64, measures: Measures) -> anyhow::Result<()> {
     let scene = scenes::load(spec)?;
     let tracer = make_tracer(Backend::Embree, &scene, Query::Single)
         .or_else(|_| make_tracer(Backend::Rust, &scene, Query::Single))?;
@@ -105,6 +116,7 @@ fn compare(spec: &str, lines: u64, seeds: u64) -> anyhow::Result<()> {
             // as are worth that many.
             let cfg = RunSpec {
                 sampler,
+                measures,
                 ..RunSpec::new(lines, seed)
             }
             .through(&scene, LinesThrough::Bound(bound));
@@ -190,6 +202,10 @@ fn print_table(spec: &str, runs: &[Runs], exact: &[Option<f64>], seeds: u64) {
         "same cpu"
     );
     for (m, (name, ..)) in FOLLOWED.iter().enumerate() {
+        // A measure the runs did not compute (`SCX_SAMPLER_MEASURES`) has no row.
+        if runs.iter().all(|r| r.values[m].iter().all(|v| v.is_nan())) {
+            continue;
+        }
         let base = sample_sd(&runs[0].values[m]);
         for (s, (label, ..)) in SAMPLERS.iter().enumerate() {
             let r = &runs[s];

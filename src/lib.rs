@@ -105,9 +105,9 @@ pub use run::persist::{
 };
 pub use run::{
     remaining_lines, start, Budget, CastOptions, ErrorMethod, ExtendError, LinesThrough, Measures,
-    MergeError, MissingLines, PersistError, RunControl, RunIdentity, RunSpec, RunState, SavedRun,
-    SceneRef, Scope, Shard, SpecDifference, SpecError, StartError, StopReason, Target, Tracing,
-    DEFAULT_ESTIMATOR, DEFAULT_GROUPS,
+    MergeError, MissingLines, PersistError, RunControl, RunIdentity, RunSpec, RunState,
+    SamplerChoice, SavedRun, SceneRef, Scope, Shard, SpecDifference, SpecError, StartError,
+    StopReason, Target, Tracing, DEFAULT_ESTIMATOR, DEFAULT_GROUPS,
 };
 pub use sample::bounds::{lines_to_draw, sphere_lines, LineBound};
 pub use sample::counts::PairCounts;

@@ -159,7 +159,7 @@ def analyze(
     estimator: str = "chao-wang-jost",
     errors: str = "groups",
     bundle: int = 0,
-    sampler: str = "independent",
+    sampler: str = "auto",
     lines_through: str = "auto",
     per_patch: bool = False,
     shard: Optional[Tuple[int, int]] = None,
@@ -195,9 +195,10 @@ def analyze(
         errors: standard errors of the count-based measures: ``"groups"`` (batch means) or
             ``"jackknife"``.
         bundle: cast bundles of ``bundle x bundle`` parallel lines; 0 for independent lines.
-        sampler: ``"independent"`` lines, or ``"sobol"``: randomised quasi-Monte Carlo lines (one
+        sampler: ``"independent"`` lines, ``"sobol"``: randomised quasi-Monte Carlo lines (one
             scrambled Sobol' sequence per group), tighter for I_s^c, form factors and E(MSE); not with
-            ``bundle`` (docs/sampling.md).
+            ``bundle`` (docs/sampling.md); or ``"auto"``: ``"sobol"`` for a run that counts no patch
+            pairs (``measures=["continuous"]`` without ``per_patch``), ``"independent"`` otherwise.
         lines_through: ``"sphere"`` (the paper's global lines, through the bounding sphere), ``"box"``
             (through the scene's bounding box, the sphere's lines that meet it, so none is spent missing
             it; with ``sampler="sobol"`` far tighter on scenes of axis-aligned walls), ``"polytope"``

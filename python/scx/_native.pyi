@@ -328,7 +328,7 @@ def analyze(
     estimator: str = "chao-wang-jost",
     errors: str = "groups",
     bundle: Optional[int] = None,
-    sampler: str = "independent",
+    sampler: str = "auto",
     lines_through: str = "auto",
     per_patch: bool = False,
     shard: Optional[Tuple[int, int]] = None,

@@ -7,7 +7,7 @@ use pyo3::types::{PyBool, PyFloat, PyInt, PyString};
 
 use scene_complexity::{
     EntropyEstimator, ErrorMethod, LineSource, LinesThrough, Measure, Measures, ObjectSet,
-    Planarity, Reach, ReadPolicy, Sampler, SceneOptions, DEFAULT_PLANARITY, MAX_BUNDLE_GRID,
+    Planarity, Reach, ReadPolicy, SamplerChoice, SceneOptions, DEFAULT_PLANARITY, MAX_BUNDLE_GRID,
 };
 
 use crate::errors::bad_argument;
@@ -199,10 +199,10 @@ pub fn bound(name: &str) -> PyResult<LinesThrough> {
     })
 }
 
-/// A line sampler by name (`scx analyze --sampler`).
-pub fn sampler(name: &str) -> PyResult<Sampler> {
-    Sampler::from_name(name).ok_or_else(|| {
-        let names: Vec<&str> = Sampler::NAMES.iter().map(|(n, _)| *n).collect();
+/// A line sampler by name, or `auto` (`scx analyze --sampler`).
+pub fn sampler(name: &str) -> PyResult<SamplerChoice> {
+    SamplerChoice::from_name(name).ok_or_else(|| {
+        let names: Vec<&str> = SamplerChoice::NAMES.iter().map(|(n, _)| *n).collect();
         bad_argument(format!(
             "sampler: `{name}` is not one of {}",
             names.join(", ")

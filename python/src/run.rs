@@ -300,7 +300,7 @@ fn optional_path(value: Option<&Bound<'_, PyAny>>, what: &str) -> PyResult<Optio
 #[pyo3(signature = (scene, lines=None, seed=None, *, threads=None, measures=None,
                     target_stderr=None, target_measure="mutual_information_corrected",
                     seconds=None, enclose=false, groups=None, estimator="chao-wang-jost",
-                    errors="groups", bundle=None, sampler="independent", lines_through="auto", per_patch=false,
+                    errors="groups", bundle=None, sampler="auto", lines_through="auto", per_patch=false,
                     shard=None, save=None,
                     keep_state=true, progress=None))]
 #[allow(clippy::too_many_arguments)]
@@ -383,14 +383,14 @@ pub fn analyze(
         },
         estimator: args::estimator(estimator)?,
         errors: args::errors(errors)?,
-        sampler: args::sampler(sampler)?,
         bound: match through {
             // Set for the check's sake; `through` below settles it with the scene.
             LinesThrough::Bound(b) => b,
             LinesThrough::Auto => LineBound::Sphere,
         },
         ..RunSpec::new(lines, seed)
-    };
+    }
+    .drawn_by(args::sampler(sampler)?);
     spec.check().map_err(bad_argument)?;
     let (state, identity, spec) = {
         let s = scene.get();

@@ -105,7 +105,7 @@ def test_bad_files_and_built_ins(tmp_path):
         ({"bundle": 10_000}, "bundle"),
         ({"shard": (1, 2)}, "shard needs save=PATH"),
         ({"shard": (3, 2), "save": "x.scx"}, "the shard k must be a whole number from 1 to 2"),
-        ({"sampler": "halton"}, "sampler: `halton` is not one of independent, sobol"),
+        ({"sampler": "halton"}, "sampler: `halton` is not one of auto, independent, sobol"),
         ({"sampler": "sobol", "bundle": 4}, "does not take bundles"),
         ({"lines_through": "cube"}, "lines_through: `cube` is not one of auto, sphere, box, polytope"),
         ({"lines_through": "box", "bundle": 4}, "do not come in bundles"),

@@ -185,6 +185,20 @@ def test_to_dict_of_a_run_through_the_box_is_the_json_of_scx_analyze():
         assert scx.analyze(name, lines=1e4, sampler="sobol").to_dict()["lines_through"] == through
 
 
+def test_the_default_sampler_draws_sobol_lines_for_i_s_c_alone():
+    # sampler="auto" (the default): Sobol' lines through the box for a run of I_s^c alone, the same
+    # numbers as the command line's default; independent lines for every run that counts patch pairs.
+    alone = scx.analyze("@cube:4", lines=2e5, seed=3, threads=1, measures=["continuous"]).to_dict()
+    assert (alone["sampler"], alone["lines_through"]) == ("sobol", "box")
+    cli = run_cli(
+        "analyze", "@cube:4", "--lines", "2e5", "--seed", "3", "--tracer", "rust", "--measures", "continuous"
+    )
+    assert without_process(alone) == without_process(cli)
+    for kwargs in ({}, {"measures": ["continuous"], "sampler": "independent"}):
+        d = scx.analyze("@cube:4", lines=2e5, seed=3, threads=1, **kwargs).to_dict()
+        assert (d["sampler"], d["lines_through"]) == ("independent", "sphere")
+
+
 def test_an_enclosed_run_has_the_environment_as_its_last_patch(tmp_path):
     # An open box: the environment closes it, so every row of F (the environment's too) sums to 1 and
     # the per-patch terms, the environment's included, add up to the enclosed scene's measures.

@@ -9,7 +9,7 @@ use scene_complexity::Query;
 use scene_complexity::{cast, finish};
 use scene_complexity::{
     remaining_lines, start, Budget, CastOptions, Measures, RunControl, RunIdentity, RunSpec,
-    RunState, SceneRef, Scope, Shard, StopReason, Target,
+    RunState, SamplerChoice, SceneRef, Scope, Shard, StopReason, Target,
 };
 use scene_complexity::{
     sphere_lines, LineBound, LineSource, LinesThrough, Sampler, MAX_BUNDLE_GRID,
@@ -58,12 +58,15 @@ pub struct AnalyzeArgs {
     /// packets); 0 casts independent lines. The standard errors include the correlation within a bundle.
     #[arg(long, default_value_t = 0, value_parser = parse_bundle)]
     bundle: u32,
-    /// How the lines are drawn: `independent` (each line on its own), or `sobol` (randomised
-    /// quasi-Monte Carlo: one Owen-scrambled Sobol' sequence per standard-error group, lines that cover
-    /// the space of lines more evenly; not with --bundle). docs/sampling.md says for which measures it
-    /// pays.
-    #[arg(long, default_value = "independent", value_parser = parse_sampler)]
-    sampler: Sampler,
+    /// How the lines are drawn: `independent` (each line on its own), `sobol` (randomised quasi-Monte
+    /// Carlo: one Owen-scrambled Sobol' sequence per standard-error group, lines that cover the space
+    /// of lines more evenly; not with --bundle), or `auto`: `sobol` for a run that counts no patch
+    /// pairs (`--measures continuous` without --patches: I_s^c alone, several times tighter at the same
+    /// cost), `independent` otherwise (the bias-corrected readings need independent lines to be honest
+    /// without a looser debiasing). The report says which. docs/sampling.md says for which measures
+    /// `sobol` pays.
+    #[arg(long, default_value = "auto", value_parser = parse_sampler)]
+    sampler: SamplerChoice,
     /// Where the lines are drawn: `sphere` (the paper's global lines, through the bounding sphere),
     /// `box` (through the scene's bounding box: the sphere's lines that meet it, so no line is spent
     /// missing the box; with --sampler sobol, far smaller errors on scenes whose walls are parallel to
@@ -176,8 +179,8 @@ fn parse_bundle(s: &str) -> Result<u32, String> {
     LineSource::bundles(g).map(|_| g).map_err(|e| e.to_string())
 }
 
-fn parse_sampler(s: &str) -> Result<Sampler, String> {
-    Sampler::from_name(s).ok_or_else(|| format!("`{s}`: expected independent or sobol"))
+fn parse_sampler(s: &str) -> Result<SamplerChoice, String> {
+    SamplerChoice::from_name(s).ok_or_else(|| format!("`{s}`: expected auto, independent or sobol"))
 }
 
 fn parse_bound(s: &str) -> Result<LinesThrough, String> {
@@ -185,8 +188,9 @@ fn parse_bound(s: &str) -> Result<LinesThrough, String> {
         .ok_or_else(|| format!("`{s}`: expected auto, sphere, box or polytope"))
 }
 
-/// The spec of a new run from the arguments, the command line parsed once, before its scene is read:
-/// its bound and the lines it draws are settled with the scene ([`RunSpec::through`]).
+/// The spec of a new run from the arguments, the command line parsed once, before its scene is read,
+/// its sampler settled ([`RunSpec::drawn_by`]): its bound and the lines it draws are settled with the
+/// scene ([`RunSpec::through`]).
 fn spec_of(args: &AnalyzeArgs) -> Result<RunSpec, Failure> {
     let measures = match &args.measures {
         None => Measures::ALL,
@@ -203,7 +207,7 @@ fn spec_of(args: &AnalyzeArgs) -> Result<RunSpec, Failure> {
             stderr,
         }),
     };
-    if args.sampler == Sampler::Sobol && args.bundle > 0 {
+    if args.sampler == SamplerChoice::Given(Sampler::Sobol) && args.bundle > 0 {
         return Err(Failure::bad_input(format!(
             "--sampler sobol draws single lines (each a point of a randomised Sobol' sequence) and does \
              not take --bundle {}: drop one of them",
@@ -237,11 +241,11 @@ fn spec_of(args: &AnalyzeArgs) -> Result<RunSpec, Failure> {
         measures,
         budget,
         source: LineSource::bundles(args.bundle).map_err(Failure::bad_input)?,
-        sampler: args.sampler,
         enclose: args.enclose,
         per_patch: args.files.wants_per_patch(),
         ..args.run.spec(lines, args.run.seed.value)
-    })
+    }
+    .drawn_by(args.sampler))
 }
 
 /// A run about to be cast: its runner, identity (with its spec) and state, and the seconds it took

@@ -330,13 +330,18 @@ pub fn table(run: &RunInfo, a: &Analysis) -> String {
     let _ = writeln!(
         s,
         "\nstandard errors: {errors} (statistical error only).\n\
-         95% intervals: value ± {:.3} stderr (Student's t, {} degrees of freedom).\n\
-         corrected: row entropies by the {} estimator; the plug-in H_s and I_s are biased when rows are \
-         undersampled.",
+         95% intervals: value ± {:.3} stderr (Student's t, {} degrees of freedom).",
         a.interval_quantile(),
         a.groups.saturating_sub(1),
-        a.spec.estimator.name()
     );
+    if a.estimate(Measure::MutualInformationCorrected).is_some() {
+        let _ = writeln!(
+            s,
+            "corrected: row entropies by the {} estimator; the plug-in H_s and I_s are biased when rows \
+             are undersampled.",
+            a.spec.estimator.name()
+        );
+    }
     reliability_summary(&mut s, a);
     if bundle(a) > 0 && a.estimate(Measure::MutualInformationCorrected).is_some() {
         // Measured: 8 x 8 bundles moved the corrected I_s of @cube:30 by 7.7 standard errors (docs/performance.md, "Bundles").
@@ -354,6 +359,13 @@ pub fn table(run: &RunInfo, a: &Analysis) -> String {
             "sobol: the estimator's corrections assume independent lines; the corrected readings are its \
              values less the delete-a-group jackknife's estimate of their bias, with the jackknife's \
              standard errors, or flagged where there is no jackknife (docs/sampling.md)."
+        );
+    } else if a.spec.sampler == Sampler::Sobol {
+        let _ = writeln!(
+            s,
+            "sobol: randomised quasi-Monte Carlo lines, one scrambled Sobol' sequence per group: the groups \
+             are independent, the lines within one are not (--sampler auto draws them for a run that \
+             counts no patch pairs; --sampler independent for the paper's independent lines)."
         );
     }
     if a.spec.bound != LineBound::Sphere {

@@ -286,3 +286,132 @@ fn sobol_runs_split_resumed_and_merged_are_the_single_run() {
         "{err}"
     );
 }
+
+/// `--sampler auto` (the default) draws Sobol' lines for a run that counts no patch pairs (I_s^c alone,
+/// eq. 27) and independent lines for every run that counts them (the discrete measures, per-patch
+/// results, radiosity) and for bundles; a sampler asked for is kept.
+#[test]
+fn auto_draws_sobol_lines_only_for_runs_that_count_no_pairs() {
+    use scene_complexity::internals::run::SamplerChoice;
+    let continuous = Measures {
+        discrete: false,
+        continuous: true,
+        radiosity: false,
+    };
+    let base = RunSpec {
+        measures: continuous,
+        ..RunSpec::new(100_000, 1)
+    };
+    let auto = |spec: &RunSpec| spec.clone().drawn_by(SamplerChoice::Auto).sampler;
+    assert_eq!(auto(&base), Sampler::Sobol);
+    let counting = [
+        RunSpec::new(100_000, 1),
+        RunSpec {
+            measures: Measures {
+                discrete: true,
+                ..continuous
+            },
+            ..base.clone()
+        },
+        RunSpec {
+            measures: Measures {
+                radiosity: true,
+                ..continuous
+            },
+            ..base.clone()
+        },
+        RunSpec {
+            per_patch: true,
+            ..base.clone()
+        },
+        RunSpec {
+            source: LineSource::bundles(4).unwrap(),
+            ..base.clone()
+        },
+    ];
+    for spec in &counting {
+        assert_eq!(auto(spec), Sampler::Independent, "{spec:?}");
+    }
+    for sampler in [Sampler::Independent, Sampler::Sobol] {
+        for spec in [&base, &counting[0]] {
+            let kept = spec.clone().drawn_by(SamplerChoice::Given(sampler));
+            assert_eq!(kept.sampler, sampler);
+        }
+    }
+}
+
+/// The CLI's default sampler: `--measures continuous` runs Sobol' lines (through the box on a cube, the
+/// bound `auto` chooses for them), the report says so, and its I_s^c is the one of `--sampler sobol`
+/// with every measure, bit for bit (the measures asked for do not change the lines), within 4.5
+/// standard errors of the exact value; the default measures, `--patches` and `--bundle` keep independent
+/// lines, and `--sampler independent` gives them back for I_s^c alone.
+#[test]
+fn the_cli_draws_sobol_lines_by_default_for_i_s_c_alone() {
+    use scene_complexity::calibrate::{truth, Basis, CalibrationScene};
+    use support::{json_of, scx};
+    let dir = tempfile::tempdir().unwrap();
+    let run = |more: &[&str]| {
+        let mut args = vec![
+            "analyze", "@cube:6", "--lines", "2e5", "--seed", "7", "--tracer", "rust", "--format",
+            "json",
+        ];
+        args.extend(more);
+        json_of(&scx(&args))
+    };
+    let isc = |v: &serde_json::Value| v["visibility"]["continuous_mutual_information"].clone();
+    let alone = run(&["--measures", "continuous"]);
+    assert_eq!(
+        (&alone["sampler"], &alone["lines_through"]),
+        (&"sobol".into(), &"box".into())
+    );
+    let all_sobol = run(&["--sampler", "sobol"]);
+    assert_eq!(isc(&alone), isc(&all_sobol));
+    let exact = truth::truth(&CalibrationScene::parse("@cube:6").unwrap())
+        .unwrap()
+        .value(Measure::ContinuousMutualInformation, Basis::Closed)
+        .unwrap();
+    let (value, stderr) = (
+        isc(&alone)["value"].as_f64().unwrap(),
+        isc(&alone)["stderr"].as_f64().unwrap(),
+    );
+    assert!(
+        (value - exact).abs() < 4.5 * stderr,
+        "{value} {stderr} {exact}"
+    );
+    let patches = dir.path().join("p.csv");
+    for more in [
+        &[][..],
+        &[
+            "--measures",
+            "continuous",
+            "--patches",
+            patches.to_str().unwrap(),
+        ][..],
+        &["--measures", "continuous", "--bundle", "4"][..],
+        &["--measures", "continuous", "--sampler", "independent"][..],
+    ] {
+        let v = run(more);
+        assert_eq!(
+            (&v["sampler"], &v["lines_through"]),
+            (&"independent".into(), &"sphere".into()),
+            "{more:?}"
+        );
+    }
+    let table = String::from_utf8(
+        scx(&[
+            "analyze",
+            "@cube:3",
+            "--lines",
+            "2e4",
+            "--measures",
+            "continuous",
+        ])
+        .stdout,
+    )
+    .unwrap();
+    assert!(
+        table.contains("(sobol: randomised quasi-Monte Carlo)"),
+        "{table}"
+    );
+    assert!(table.contains("--sampler auto draws them"), "{table}");
+}
