@@ -128,7 +128,7 @@ pub fn segments_and_ends(
         let p = &scene.patches[patch as usize];
         (p.normal, p.offset)
     };
-    ends_of(&scene.triangle_patch, plane, line, hits, visit)
+    ends_of(scene, plane, line, hits, visit)
 }
 
 /// The patch planes of a scene (normal and offset, `n . x = offset`), for the pairing of many lines: a
@@ -201,17 +201,17 @@ impl PatchPlanes {
         let (planes, index) = (&self.planes, &self.index);
         if index.is_empty() {
             let plane = |patch: u32| as_plane(planes[patch as usize]);
-            ends_of(&scene.triangle_patch, plane, line, hits, visit)
+            ends_of(scene, plane, line, hits, visit)
         } else {
             let plane = |patch: u32| as_plane(planes[index[patch as usize] as usize]);
-            ends_of(&scene.triangle_patch, plane, line, hits, visit)
+            ends_of(scene, plane, line, hits, visit)
         }
     }
 }
 
 /// [`segments_and_ends`], with each patch's plane from `plane`.
 fn ends_of(
-    triangle_patch: &[u32],
+    scene: &Scene,
     plane: impl Fn(u32) -> (Normal, f64),
     line: &Line,
     hits: &[Hit],
@@ -222,18 +222,43 @@ fn ends_of(
     }
     let l = LineF64::from(line);
     let crossing = |h: &Hit| {
-        let patch = triangle_patch[h.triangle as usize];
+        let patch = scene.triangle_patch[h.triangle as usize];
         crossing(patch, plane(patch), &l, h)
     };
     if !order::has_close_hits(hits) {
         return pair_crossings(hits.iter().map(crossing), &mut visit);
     }
     let mut crossings: Vec<Crossing> = hits.iter().map(crossing).collect();
-    let overlaps = order::reorder(&mut crossings, hits);
+    let overlaps = order::reorder(&mut crossings, hits, |c| on_its_triangle(scene, &l, c));
     LineEnds {
         overlaps,
         ..pair_crossings(crossings.into_iter(), &mut visit)
     }
+}
+
+/// How far outside its triangle (tracing units, the bounding sphere's radius being 1) a crossing's f64
+/// point may lie and still be on it: far above the f64 rounding of the point (~1e-16), far below the
+/// gaps an f32 watertight test closes (~1e-7), so a line that misses an edge by more is told apart.
+const ON_TRIANGLE: f64 = 1e-12;
+
+/// Whether the point where `l` crosses the plane of `c`'s triangle, in f64, lies on that triangle (to
+/// [`ON_TRIANGLE`]): what tells a line that passes through the wedge at an edge from one that only
+/// touches the edge ([`order::reorder`]).
+fn on_its_triangle(scene: &Scene, l: &LineF64, c: &Crossing) -> bool {
+    let [a, b, d] = scene.triangles[c.triangle as usize].map(|v| scene.vertices[v as usize]);
+    let p = l.origin + l.dir * c.t;
+    let n = (b - a).cross(d - a);
+    // A degenerate triangle has no inside (the scene drops them; NaN-safe all the same).
+    let length = n.length();
+    if length.is_nan() || length <= 0.0 {
+        return false;
+    }
+    let n = n / length;
+    [(a, b), (b, d), (d, a)].iter().all(|&(from, to)| {
+        let edge = to - from;
+        let side = edge.cross(p - from).dot(n);
+        side >= -ON_TRIANGLE * edge.length()
+    })
 }
 
 /// A hit on `patch`, whose plane is `(n, offset)`, as a crossing: its patch, the facing and the f64
