@@ -272,6 +272,7 @@ pub fn cast(
         None => TargetReading {
             stderr: None,
             reliable: false,
+            floored: false,
         },
     };
     crate::run::cast(
@@ -464,8 +465,18 @@ fn current_reading(
 ) -> TargetReading {
     let run = state.snapshot(scene);
     let (v, _) = judged_visibility(scene, &run, cfg, state.wanted());
+    let stderr = v.estimates.get(measure).and_then(|e| e.stderr);
+    let c = &run.total.counters;
+    let floor = reliability::f32_floor(&reliability::RunFacts {
+        lines: c.lines,
+        pairs: c.pairs,
+        open: false,
+        short_chords: c.short_chords,
+    });
     TargetReading {
-        stderr: v.estimates.get(measure).and_then(|e| e.stderr),
+        stderr,
         reliable: v.reliability.get(measure).map(|r| r.verdict) == Some(Verdict::Ok),
+        floored: measure == Measure::ContinuousMutualInformation
+            && stderr.is_some_and(|se| reliability::below_f32_floor(floor, se)),
     }
 }

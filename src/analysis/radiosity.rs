@@ -140,6 +140,7 @@ pub(crate) fn estimates(
         lines: c.lines,
         pairs: c.pairs,
         open: c.escapes + c.absorbed > 0,
+        short_chords: c.short_chords,
     };
     let reliability = reliability::verdicts(&estimates, Some(sampling), None, facts);
     let solve = RadiositySolve {

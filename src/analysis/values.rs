@@ -264,6 +264,7 @@ pub(super) fn visibility_estimates(
         pairs: c.pairs,
         // Enclosed, the escapes are pairs with the environment: only back sides still lose segments.
         open: c.absorbed > 0 || (c.escapes > 0 && !enclose),
+        short_chords: c.short_chords,
     };
     let mut reliability = reliability::verdicts(&estimates, sampling.as_ref(), Some(&bias), facts);
     if debias && replicates.is_none() {

@@ -517,6 +517,10 @@ fn stop_text(r: StopReason) -> &'static str {
         StopReason::Lines => "all lines cast",
         StopReason::Seconds => "the time budget (--seconds)",
         StopReason::Target => "the precision target (--target-stderr) was met",
+        StopReason::Floor => {
+            "the precision target's reading reached the floor of f32 tracing (I_s^c's flag says \
+             why): more lines would not make it ok"
+        }
         StopReason::Interrupted => {
             "interrupted (Ctrl-C): the report covers the lines gathered so far"
         }

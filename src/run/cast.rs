@@ -25,6 +25,8 @@ pub struct TargetReading {
     pub stderr: Option<f64>,
     /// Whether the reading's verdict is ok.
     pub reliable: bool,
+    /// Whether its standard error is below what f32 tracing resolves: more lines cannot make it ok.
+    pub floored: bool,
 }
 
 /// Reads a precision target's measure on a run's state (between rounds).
@@ -239,11 +241,15 @@ pub fn cast(
             let TargetReading {
                 stderr: se,
                 reliable,
+                floored,
             } = watch(state);
             let ready = se.is_some_and(|se| se <= target.stderr) && reliable;
             // The first reading only plans: a run stopped there would be stopped by its own error's dip.
             if ready && planned {
                 break StopReason::Target;
+            }
+            if floored && planned {
+                break StopReason::Floor;
             }
             planned = true;
             round = match se {

@@ -68,6 +68,9 @@ pub enum StopReason {
     Seconds,
     /// The precision target was reached.
     Target,
+    /// The precision target's reading reached the floor of f32 tracing (its standard error is so small
+    /// that the chords lost near edges could bias it by more): more lines would not make it reliable.
+    Floor,
     /// A stop was requested (Ctrl-C).
     Interrupted,
 }
@@ -79,6 +82,7 @@ impl StopReason {
             StopReason::Lines => "lines",
             StopReason::Seconds => "seconds",
             StopReason::Target => "target_stderr",
+            StopReason::Floor => "f32_floor",
             StopReason::Interrupted => "interrupted",
         }
     }

@@ -77,7 +77,17 @@ pub struct Counters {
     pub env_log2_sum: ExactSum,
     /// How many segments entered `env_log2_sum`.
     pub env_pairs: u64,
+    /// Pairs whose two points are [`SHORT_CHORD`] apart (tracing units): how densely lines cross the
+    /// scene's corners close to an edge, from which the shorter chords f32 tracing loses are estimated
+    /// (the reliability of I_s^c). Absent from states saved before it existed, which read as none.
+    #[serde(default)]
+    pub short_chords: u64,
 }
+
+/// The chord lengths counted in [`Counters::short_chords`], tracing units (the bounding sphere's radius
+/// being 1): short enough that only lines crossing a corner near its edge have them, long enough that f32
+/// tracing finds every one of them.
+pub const SHORT_CHORD: std::ops::Range<f64> = 1e-5..1e-4;
 
 impl Counters {
     /// Adds another set of lines' counters into these (in any order: every sum is exact).
@@ -95,6 +105,7 @@ impl Counters {
         self.cmi_pairs += other.cmi_pairs;
         self.env_log2_sum.add(other.env_log2_sum);
         self.env_pairs += other.env_pairs;
+        self.short_chords += other.short_chords;
     }
 }
 
@@ -621,6 +632,7 @@ fn tally_batch(prepared: &LineTally, lines: &[Line], hits: &LineHits) -> BatchTa
                     cos_to,
                 } => {
                     c.pairs += 1;
+                    c.short_chords += u64::from(SHORT_CHORD.contains(&distance));
                     if wanted.discrete {
                         keys.push(pair_key(from, to));
                     }
