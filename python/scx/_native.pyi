@@ -239,7 +239,7 @@ class Analysis:
         """Wall-clock seconds of the run (summed over resumes and merged parts)."""
     @property
     def stop_reason(self) -> str:
-        """``"lines"``, ``"seconds"``, ``"target_stderr"`` or ``"interrupted"``."""
+        """``"lines"``, ``"seconds"``, ``"target_stderr"``, ``"f32_floor"`` or ``"interrupted"``."""
     @property
     def complete(self) -> bool:
         """Whether the analysis covers every batch of its run."""

@@ -339,7 +339,7 @@ pub struct RunFacts {
 /// so a count over [1e-5, 1e-4) predicts a 45th as many below 2e-6, each carrying about 42 bits
 /// (`-2 log2 d` and the cosines). Measured on `@cube:1` at 10^8 lines: I_s^c read 5.5e-5 low; this
 /// estimate gives 6.0e-5 (docs/scenes.md, stiff geometry).
-const BITS_PER_SHORT_CHORD: f64 = 42.0 / 45.0;
+pub const BITS_PER_SHORT_CHORD: f64 = 42.0 / 45.0;
 
 /// How low f32 tracing may read I_s^c (eq. 27) on the run's scene: the chords it loses near edges
 /// ([`BITS_PER_SHORT_CHORD`]) over the pairs.
