@@ -467,12 +467,7 @@ fn current_reading(
     let (v, _) = judged_visibility(scene, &run, cfg, state.wanted());
     let stderr = v.estimates.get(measure).and_then(|e| e.stderr);
     let c = &run.total.counters;
-    let floor = reliability::f32_floor(&reliability::RunFacts {
-        lines: c.lines,
-        pairs: c.pairs,
-        open: false,
-        short_chords: c.short_chords,
-    });
+    let floor = reliability::f32_floor(c.pairs, c.short_chords);
     TargetReading {
         stderr,
         reliable: v.reliability.get(measure).map(|r| r.verdict) == Some(Verdict::Ok),

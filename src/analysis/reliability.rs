@@ -341,13 +341,14 @@ pub struct RunFacts {
 /// estimate gives 6.0e-5 (docs/scenes.md, stiff geometry).
 pub const BITS_PER_SHORT_CHORD: f64 = 42.0 / 45.0;
 
-/// How low f32 tracing may read I_s^c (eq. 27) on the run's scene: the chords it loses near edges
+/// How low f32 tracing may read I_s^c (eq. 27) on a run of `pairs` visible pairs of which
+/// `short_chords` were [`crate::sample::tally::SHORT_CHORD`] long: the chords it loses near edges
 /// ([`BITS_PER_SHORT_CHORD`]) over the pairs.
-pub fn f32_floor(facts: &RunFacts) -> f64 {
-    if facts.pairs == 0 {
+pub fn f32_floor(pairs: u64, short_chords: u64) -> f64 {
+    if pairs == 0 {
         return 0.0;
     }
-    BITS_PER_SHORT_CHORD * facts.short_chords as f64 / facts.pairs as f64
+    BITS_PER_SHORT_CHORD * short_chords as f64 / pairs as f64
 }
 
 /// What the verdicts of a family's readings are judged from.
@@ -394,7 +395,7 @@ pub fn verdicts(
         lines: facts.lines,
         pairs: facts.pairs,
         open: facts.open,
-        f32_floor: f32_floor(&facts),
+        f32_floor: f32_floor(facts.pairs, facts.short_chords),
     };
     let mut out = ByMeasure::default();
     for (m, &e) in estimates.iter() {
@@ -761,7 +762,8 @@ mod tests {
             short_chords: 4132 * stderr_lines / 100_000_000,
             ..closed(stderr_lines, 637 * stderr_lines / 1000)
         };
-        let floor = f32_floor(&facts(100_000_000));
+        let f = facts(100_000_000);
+        let floor = f32_floor(f.pairs, f.short_chords);
         assert!((floor - 6.06e-5).abs() < 1e-6, "{floor}");
         for (lines, stderr, flagged) in [(100_000_000, 4e-5, true), (10_000_000, 1.5e-4, false)] {
             let mut v = readings(7.8, 7.8, 1.61);
