@@ -7,6 +7,10 @@
 //! * our tracer ([`BvhTracer::raw_hits`]: obvhs's CWBVH topology with exact f32 boxes, unordered
 //!   traversal) from several obvhs build presets and leaf sizes.
 //!
+//! First, per scene, the tracer as runs build it (large planes in grids: `src/trace/rust/grids.rs`)
+//! against the same tracer with every triangle in the BVH, and whether their hits agree
+//! (`SCX_GRIDS_ONLY=1` stops there).
+//!
 //! Prints M lines per CPU-second of this thread (robust when the machine is shared) and, for obvhs's
 //! traversals, candidates per line.
 //!
@@ -26,7 +30,7 @@ use obvhs::{
 use scene_complexity::internals::sample::lines::batch_lines;
 use scene_complexity::internals::scene::Scene;
 use scene_complexity::internals::trace::rust::{bvh::margin, watertight::ShearedRay, BvhTracer};
-use scene_complexity::internals::trace::{Line, Tracer};
+use scene_complexity::internals::trace::{Line, LineHits, Tracer};
 
 fn main() -> anyhow::Result<()> {
     let mut specs: Vec<String> = std::env::args()
@@ -42,6 +46,10 @@ fn main() -> anyhow::Result<()> {
     }
     for spec in &specs {
         let scene = scenes::load(spec)?;
+        grids_against_tree(spec, &scene, &lines)?;
+        if std::env::var_os("SCX_GRIDS_ONLY").is_some() {
+            continue;
+        }
         obvhs_traversals(spec, &scene, &lines);
         let presets = [
             ("fast", BvhBuildParams::fast_build()),
@@ -72,6 +80,55 @@ fn main() -> anyhow::Result<()> {
         }
     }
     Ok(())
+}
+
+/// The tracer as runs build it (planes of many triangles in grids, the rest in the tree) against every
+/// triangle in the tree, interleaved, 3 rounds: M lines per CPU-second of each (the best round), and
+/// whether they found the same canonical hits and first hits.
+fn grids_against_tree(spec: &str, scene: &Scene, lines: &[Line]) -> anyhow::Result<()> {
+    let with_grids = BvhTracer::new(scene)?;
+    let tree = BvhTracer::tree_only(scene)?;
+    let tracers = [&tree, &with_grids];
+    let mut rates = [0.0f64; 2];
+    let mut rows = [LineHits::default(), LineHits::default()];
+    for _ in 0..3 {
+        for (k, tracer) in tracers.into_iter().enumerate() {
+            let mut scratch = Vec::new();
+            let mut hits = 0usize;
+            let seconds = cpu_seconds(|| {
+                for chunk in lines.chunks(4096) {
+                    tracer.all_hits(chunk, &mut scratch, &mut rows[k]).unwrap();
+                    hits += rows[k].hits.len();
+                }
+            });
+            std::hint::black_box(hits);
+            rates[k] = rates[k].max(lines.len() as f64 / seconds / 1e6);
+        }
+    }
+    let (mut same, mut first) = (true, [Vec::new(), Vec::new()]);
+    for chunk in lines.chunks(4096) {
+        for (k, tracer) in tracers.into_iter().enumerate() {
+            tracer
+                .all_hits(chunk, &mut Vec::new(), &mut rows[k])
+                .unwrap();
+            tracer.first_hits(chunk, &mut first[k]).unwrap();
+        }
+        same &= rows[0].hits == rows[1].hits && rows[0].start == rows[1].start;
+        same &= first[0] == first[1];
+    }
+    println!(
+        "{spec:<10} all hits: tree only {:5.2}, with grids {:5.2} M lines/s ({:.2}x); same hits: {same}",
+        rates[0],
+        rates[1],
+        rates[1] / rates[0]
+    );
+    Ok(())
+}
+
+fn cpu_seconds(f: impl FnOnce()) -> f64 {
+    let t0 = common::thread_cpu_seconds();
+    f();
+    common::thread_cpu_seconds() - t0
 }
 
 /// obvhs's `ray_traverse` on its CWBVH and Bvh2 (medium build), as an all-hits traversal: the callback

@@ -159,3 +159,166 @@ fn bad_lines_are_errors_not_panics() {
     let mut first = Vec::new();
     assert!(bvh.first_hits(&[bad], &mut first).is_err());
 }
+
+/// An OBJ of the cube [-1, 1]^3, each face meshed into `n` x `n` quads facing inward, turned by
+/// `turn` radians about the x axis and then the z axis; with `inner_box`, an unmeshed box inside.
+fn turned_meshed_room(n: usize, turn: f64, inner_box: bool) -> String {
+    let (s, c) = turn.sin_cos();
+    let rotate = |p: [f64; 3]| {
+        let q = [p[0], c * p[1] - s * p[2], s * p[1] + c * p[2]];
+        [c * q[0] - s * q[1], s * q[0] + c * q[1], q[2]]
+    };
+    let mut obj = String::from("o room\n");
+    let mut count = 0;
+    let mut quad = |obj: &mut String, corners: [[f64; 3]; 4]| {
+        for p in corners.map(rotate) {
+            obj.push_str(&format!("v {} {} {}\n", p[0], p[1], p[2]));
+        }
+        obj.push_str(&format!(
+            "f {} {} {} {}\n",
+            count + 1,
+            count + 2,
+            count + 3,
+            count + 4
+        ));
+        count += 4;
+    };
+    let at = |i: usize| -1.0 + 2.0 * i as f64 / n as f64;
+    for axis in 0..3 {
+        for side in [-1.0, 1.0] {
+            let (u, v) = ((axis + 1) % 3, (axis + 2) % 3);
+            for i in 0..n {
+                for j in 0..n {
+                    let point = |a: f64, b: f64| {
+                        let mut p = [0.0; 3];
+                        p[axis] = side;
+                        p[u] = a;
+                        p[v] = b;
+                        p
+                    };
+                    let (a0, a1, b0, b1) = (at(i), at(i + 1), at(j), at(j + 1));
+                    let mut q = [point(a0, b0), point(a1, b0), point(a1, b1), point(a0, b1)];
+                    if side > 0.0 {
+                        q.reverse();
+                    }
+                    quad(&mut obj, q);
+                }
+            }
+        }
+    }
+    if inner_box {
+        obj.push_str("o box\n");
+        let (lo, hi) = (-0.3, 0.25);
+        for axis in 0..3 {
+            for (side, value) in [(-1.0, lo), (1.0, hi)] {
+                let (u, v) = ((axis + 1) % 3, (axis + 2) % 3);
+                let point = |a: f64, b: f64| {
+                    let mut p = [0.0; 3];
+                    p[axis] = value;
+                    p[u] = a;
+                    p[v] = b;
+                    p
+                };
+                let mut q = [point(lo, lo), point(hi, lo), point(hi, hi), point(lo, hi)];
+                if side < 0.0 {
+                    q.reverse();
+                }
+                quad(&mut obj, q);
+            }
+        }
+    }
+    obj
+}
+
+/// Lines within 1e-6 of a wall's plane, at angles of 1e-6 to 1e-2 to it: the grids' slabs and cell
+/// ranges at their widest.
+fn grazing_lines(scene: &Scene, rng: &mut Pcg64, count: usize) -> Vec<Line> {
+    (0..count)
+        .map(|k| {
+            let tri = scene.triangles[rng.gen_range(0..scene.triangles.len())];
+            let [a, b, c] = tri.map(|v| scene.positions[v as usize].map(f64::from));
+            let e1 = [0, 1, 2].map(|i| b[i] - a[i]);
+            let e2 = [0, 1, 2].map(|i| c[i] - a[i]);
+            let n = [
+                e1[1] * e2[2] - e1[2] * e2[1],
+                e1[2] * e2[0] - e1[0] * e2[2],
+                e1[0] * e2[1] - e1[1] * e2[0],
+            ];
+            let unit = |v: [f64; 3]| {
+                let l = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+                v.map(|x| x / l)
+            };
+            let (n, e1) = (unit(n), unit(e1));
+            let angle = 10f64.powi(-2 - (k % 5) as i32);
+            let offset = rng.gen_range(-1e-6..1e-6);
+            let f: f64 = rng.gen_range(0.0..1.0);
+            let p = [0, 1, 2].map(|i| a[i] + f * (c[i] - a[i]) + offset * n[i]);
+            let d = unit([0, 1, 2].map(|i| e1[i] + angle * n[i]));
+            Line {
+                origin: [0, 1, 2].map(|i| (p[i] - 2.0 * d[i]) as f32),
+                dir: d.map(|x| x as f32),
+                t_max: 4.0,
+            }
+        })
+        .collect()
+}
+
+/// Rooms whose walls are meshed finely enough for grids (`src/trace/rust/grids.rs`), axis-aligned and
+/// turned off the axes, empty and holding a box the tree keeps: the same canonical hits as the
+/// brute-force tracer and as the tracer with every triangle in its tree, to the bit, and the same first
+/// hits, on random lines, lines through vertices and edges, in a wall's plane, starting on a surface
+/// and grazing a wall.
+#[test]
+fn grids_find_the_brute_force_tracers_hits_to_the_bit() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut scenes = vec![scenes::load("@cube:10").unwrap()];
+    for (k, (turn, inner_box)) in [(0.0, true), (0.3, false), (0.05, true)].iter().enumerate() {
+        let path = dir.path().join(format!("room{k}.obj"));
+        std::fs::write(&path, turned_meshed_room(12, *turn, *inner_box)).unwrap();
+        scenes.push(scenes::load(path.to_str().unwrap()).unwrap());
+    }
+    for (k, scene) in scenes.iter().enumerate() {
+        let tracer = BvhTracer::new(scene).unwrap();
+        assert_eq!(
+            tracer.planes_in_grids(),
+            6,
+            "{}: every wall in a grid",
+            scene.name
+        );
+        let mut lines = test_lines(scene, 60 + k as u64);
+        lines.extend(grazing_lines(
+            scene,
+            &mut Pcg64::seed_from_u64(k as u64),
+            3000,
+        ));
+        let reference = trace(&BruteForceTracer::new(scene), &lines);
+        let got = trace(&tracer, &lines);
+        let tree = trace(&BvhTracer::tree_only(scene).unwrap(), &lines);
+        for (l, line) in lines.iter().enumerate() {
+            assert_eq!(
+                got.of_line(l),
+                reference.of_line(l),
+                "{}: line {l} {line:?}",
+                scene.name
+            );
+            assert_eq!(
+                tree.of_line(l),
+                reference.of_line(l),
+                "{}: line {l}",
+                scene.name
+            );
+        }
+        let mut first = Vec::new();
+        tracer.first_hits(&lines, &mut first).unwrap();
+        for (l, f) in first.iter().enumerate() {
+            assert_eq!(
+                *f,
+                reference.of_line(l).first().copied(),
+                "{}: line {l}",
+                scene.name
+            );
+        }
+        assert!(reference.hits.len() > lines.len(), "{}", scene.name);
+        assert!(reference.hits.iter().any(|h| h.t == 0.0), "{}", scene.name);
+    }
+}

@@ -28,6 +28,14 @@
 //! noise (+-5%). The `bvh` crate (nalgebra-based) was the other candidate builder; it offers only a
 //! binary BVH, the layout that loses here, so it was not measured.
 //!
+//! # Walls meshed into many patches: grids
+//!
+//! The triangles of a plane holding many of them (a radiosity mesh's walls) are not in the tree: each
+//! such plane has a 2D grid ([`super::grids`]) that proposes the few triangles under a line's crossing,
+//! tested four at a time ([`ShearedRay::intersect4`], the same bits as the scalar test). The grids'
+//! candidates are a superset of the hits as the tree's are, so the hits are the same to the bit
+//! ([`BvhTracer::tree_only`] keeps every triangle in the tree, for benchmarks and tests).
+//!
 //! # Exactness
 //!
 //! A box test in f32 can miss a triangle that a line grazes (a wall is a box of zero thickness), so each
@@ -39,7 +47,7 @@
 //! proposed at most once per line; repeats would be harmless anyway ([`crate::trace::HitRules`] removes
 //! exact `(t, triangle)` repeats).
 
-use glam::{Vec3A, Vec4};
+use glam::{DVec3, Vec3A, Vec4};
 use obvhs::aabb::Aabb;
 use obvhs::bvh2::reinsertion::ReinsertionOptimizer;
 use obvhs::bvh2::{Bvh2, Bvh2Node};
@@ -48,6 +56,7 @@ use obvhs::ray::safe_inverse;
 use obvhs::BvhBuildParams;
 
 use super::collapse::Collapse;
+use super::grids::Grids;
 use super::ploc::{self, Pending};
 use super::watertight::ShearedRay;
 use crate::scene::Scene;
@@ -90,6 +99,8 @@ pub struct BvhTracer {
     triangles: Vec<[[f32; 3]; 3]>,
     /// The scene's index of each triangle in `triangles`.
     ids: Vec<u32>,
+    /// The large planes' grids ([`Grids`]); the tree holds the other triangles.
+    grids: Grids,
     rules: HitRules,
 }
 
@@ -121,8 +132,16 @@ struct Node {
 /// made straight from the triangles (no list of boxes beside them), and the collapse is ours
 /// ([`Collapse`]: one byte per decision where obvhs keeps eight, and no compressed nodes) and writes
 /// our [`Node`]s directly. Returns the nodes and the scene's index of each triangle in BVH order.
-fn build(scene: &Scene, margin: f32, params: &BvhBuildParams) -> (Vec<Node>, Vec<u32>) {
-    let mut bvh2 = binary_bvh(scene, margin, params);
+fn build(
+    scene: &Scene,
+    margin: f32,
+    params: &BvhBuildParams,
+    in_tree: impl Fn(usize) -> bool,
+) -> (Vec<Node>, Vec<u32>) {
+    let mut bvh2 = binary_bvh(scene, margin, params, in_tree);
+    if bvh2.nodes.is_empty() {
+        return (Vec::new(), Vec::new());
+    }
     ReinsertionOptimizer::run(&mut bvh2, params.reinsertion_batch_ratio, None);
     let collapse = Collapse::new(&bvh2, params.max_prims_per_leaf);
     let mut nodes = Vec::with_capacity(collapse.node_count());
@@ -136,12 +155,18 @@ fn build(scene: &Scene, margin: f32, params: &BvhBuildParams) -> (Vec<Node>, Vec
 /// obvhs's PLOC build (`build_ploc`, one triangle per leaf, the triangle's index as its primitive; our
 /// [`ploc`] in its memory) from leaves made here: the same boxes and the same bounds of them all, in
 /// the same operations.
-fn binary_bvh(scene: &Scene, margin: f32, params: &BvhBuildParams) -> Bvh2 {
+fn binary_bvh(
+    scene: &Scene,
+    margin: f32,
+    params: &BvhBuildParams,
+    in_tree: impl Fn(usize) -> bool,
+) -> Bvh2 {
     let mut total = Aabb::empty();
     let leaves: Vec<Pending> = scene
         .triangles
         .iter()
         .enumerate()
+        .filter(|&(i, _)| in_tree(i))
         .map(|(i, t)| {
             let aabb = inflated_box(t.map(|v| scene.positions[v as usize]), margin);
             total.extend(aabb.min);
@@ -158,6 +183,13 @@ fn binary_bvh(scene: &Scene, margin: f32, params: &BvhBuildParams) -> Bvh2 {
         PlocSearchDistance::High => ploc::build::<24>,
         PlocSearchDistance::VeryHigh => ploc::build::<32>,
     };
+    if leaves.is_empty() {
+        return Bvh2 {
+            nodes: Vec::new(),
+            primitive_indices: Vec::new(),
+            max_depth: None,
+        };
+    }
     Bvh2 {
         nodes: ploc(
             leaves,
@@ -264,9 +296,23 @@ impl BvhTracer {
         Self::with_params(scene, build_params())
     }
 
+    /// The tracer without grids: every triangle in the BVH (for benchmarks and for tests that hold the
+    /// grids to the tree's hits).
+    pub fn tree_only(scene: &Scene) -> Result<Self, TraceError> {
+        Self::build_with(scene, build_params(), false)
+    }
+
     /// [`BvhTracer::new`] with other obvhs build parameters (for benchmarks); `pre_split` is ignored, spatial
     /// splits are never used.
     pub fn with_params(scene: &Scene, params: BvhBuildParams) -> Result<Self, TraceError> {
+        Self::build_with(scene, params, true)
+    }
+
+    fn build_with(
+        scene: &Scene,
+        params: BvhBuildParams,
+        use_grids: bool,
+    ) -> Result<Self, TraceError> {
         let params = BvhBuildParams {
             pre_split: false,
             ..params
@@ -278,7 +324,16 @@ impl BvhTracer {
                 scene.triangles.len()
             )));
         }
-        let (nodes, ids) = build(scene, margin(scene), &params);
+        let margin = margin(scene);
+        let (grids, gridded) = if use_grids {
+            Grids::build(scene, margin)
+        } else {
+            (Grids::default(), Vec::new())
+        };
+        let (nodes, ids) = build(scene, margin, &params, |t| {
+            !gridded.get(t).copied().unwrap_or(false)
+        });
+        drop(gridded);
         let triangles: Vec<[[f32; 3]; 3]> = ids
             .iter()
             .map(|&i| scene.triangles[i as usize].map(|v| scene.positions[v as usize]))
@@ -287,8 +342,14 @@ impl BvhTracer {
             nodes,
             triangles,
             ids,
+            grids,
             rules: HitRules::new(scene),
         })
+    }
+
+    /// How many planes' triangles the tracer finds through grids ([`super::grids`]) rather than the tree.
+    pub fn planes_in_grids(&self) -> usize {
+        self.grids.grids.len()
     }
 
     /// Offers every leaf whose box the line crosses within `[0, t_max]` to `leaf(first, count)`, which
@@ -298,13 +359,13 @@ impl BvhTracer {
     fn traverse(
         &self,
         line: &Line,
+        ray: &BoxRay,
         stack: &mut Vec<u32>,
         mut leaf: impl FnMut(usize, usize) -> f32,
     ) {
         if self.nodes.is_empty() {
             return;
         }
-        let ray = BoxRay::new(line);
         let mut t_max = Vec4::splat(line.t_max);
         stack.clear();
         stack.push(0);
@@ -343,11 +404,13 @@ impl BvhTracer {
         mut visit: impl FnMut(f32, u32),
     ) {
         leaves.clear();
-        self.traverse(line, stack, |first, count| {
+        let ray = BoxRay::new(line);
+        let sheared = ShearedRay::new(line.origin, line.dir);
+        self.grid_hits(line, &ray, &sheared, line.t_max, &mut visit);
+        self.traverse(line, &ray, stack, |first, count| {
             leaves.push((first as u32, count as u32));
             line.t_max
         });
-        let sheared = ShearedRay::new(line.origin, line.dir);
         for &(first, count) in leaves.iter() {
             let (first, count) = (first as usize, count as usize);
             for (slot, [a, b, c]) in self.triangles[first..first + count].iter().enumerate() {
@@ -363,7 +426,13 @@ impl BvhTracer {
     fn line_first_hit(&self, line: &Line, stack: &mut Vec<u32>) -> Option<Hit> {
         let sheared = ShearedRay::new(line.origin, line.dir);
         let mut best: Option<Hit> = None;
-        self.traverse(line, stack, |first, count| {
+        let ray = BoxRay::new(line);
+        self.grid_hits(line, &ray, &sheared, line.t_max, |t, triangle| {
+            if best.is_none_or(|h| t.total_cmp(&h.t).then(triangle.cmp(&h.triangle)).is_lt()) {
+                best = Some(Hit { t, triangle });
+            }
+        });
+        let nearest = |first: usize, count: usize| {
             for (slot, [a, b, c]) in self.triangles[first..first + count].iter().enumerate() {
                 // Only as far as the nearest hit so far, inclusive: an equal-t tie is still seen.
                 let t_max = best.map_or(line.t_max, |h| h.t);
@@ -379,8 +448,70 @@ impl BvhTracer {
             // Boxes beyond the nearest hit hold no nearer one (a box reaching back to a hit at `t` is
             // entered at or before `t`, so ties are still offered).
             best.map_or(line.t_max, |h| h.t)
-        });
+        };
+        self.traverse(line, &ray, stack, nearest);
         best
+    }
+
+    /// Calls `visit(t, triangle)` for every hit of the line in a grid's triangles: those of the cells
+    /// under its crossing of every grid whose box it crosses, four at a time.
+    #[inline(always)]
+    fn grid_hits(
+        &self,
+        line: &Line,
+        ray: &BoxRay,
+        sheared: &ShearedRay,
+        t_max: f32,
+        mut visit: impl FnMut(f32, u32),
+    ) {
+        if self.grids.is_empty() {
+            return;
+        }
+        let origin = DVec3::from_array(line.origin.map(f64::from));
+        let dir = DVec3::from_array(line.dir.map(f64::from));
+        // The cells' runs are gathered before any is tested, so that their loads (often cache misses)
+        // overlap rather than wait for each other's tests.
+        let mut runs = [(0, 0); 8];
+        let mut held = 0;
+        for (four, boxes) in self.grids.boxes.iter().enumerate() {
+            let mut mask = ray.crossed(boxes, Vec4::splat(line.t_max));
+            while mask != 0 {
+                let k = mask.trailing_zeros() as usize;
+                mask &= mask - 1;
+                let grid = &self.grids.grids[4 * four + k];
+                grid.candidates(origin, dir, f64::from(line.t_max), |first, end| {
+                    if held == runs.len() {
+                        self.test_packets(sheared, first, end, t_max, &mut visit);
+                    } else {
+                        runs[held] = (first, end);
+                        held += 1;
+                    }
+                });
+            }
+        }
+        for &(first, end) in &runs[..held] {
+            self.test_packets(sheared, first, end, t_max, &mut visit);
+        }
+    }
+
+    /// Tests packets `first..end` of the grids' triangles.
+    #[inline(always)]
+    fn test_packets(
+        &self,
+        sheared: &ShearedRay,
+        first: usize,
+        end: usize,
+        t_max: f32,
+        visit: &mut impl FnMut(f32, u32),
+    ) {
+        for p in first..end {
+            let (mut hits, t) = sheared.intersect4(&self.grids.packets[p], 0.0, t_max);
+            while hits != 0 {
+                let lane = hits.trailing_zeros() as usize;
+                hits &= hits - 1;
+                visit(t[lane], self.grids.ids[p][lane]);
+            }
+        }
     }
 }
 
@@ -521,6 +652,7 @@ impl std::fmt::Debug for BvhTracer {
         f.debug_struct("BvhTracer")
             .field("triangles", &self.triangles.len())
             .field("nodes", &self.nodes.len())
+            .field("planes_in_grids", &self.grids.grids.len())
             .finish_non_exhaustive()
     }
 }
@@ -629,7 +761,7 @@ mod tests {
                     max_prims_per_leaf: leaf,
                     ..*preset
                 };
-                let (ours, ids) = build(scene, margin(scene), &params);
+                let (ours, ids) = build(scene, margin(scene), &params, |_| true);
                 let (theirs, their_ids) = obvhs_tree(scene, &params);
                 assert_eq!(ids, their_ids, "{} leaves {leaf}", scene.name);
                 assert_eq!(ours.len(), theirs.len(), "{} leaves {leaf}", scene.name);

@@ -7,6 +7,7 @@
 
 pub mod bvh;
 mod collapse;
+pub mod grids;
 mod ploc;
 pub mod watertight;
 

@@ -2,6 +2,8 @@
 //! JCGT 2(1), 2013: no ray passes between two triangles that share an edge, whatever f32 rounding does.
 //! Both faces are hit; hits on an edge or vertex are reported for every triangle that owns it.
 
+use glam::Vec4;
+
 /// A coordinate axis, as an index that needs no bounds check (its values are 0, 1, 2).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[repr(usize)]
@@ -117,6 +119,87 @@ impl ShearedRay {
     }
 }
 
+/// Four triangles in the lanes of SSE vectors, for [`ShearedRay::intersect4`]: `v[vertex][axis]`.
+/// Unused lanes hold NaN, which no test accepts.
+#[derive(Clone, Copy, Debug)]
+pub struct Triangles4 {
+    v: [[Vec4; 3]; 3],
+}
+
+impl Triangles4 {
+    /// Up to four triangles (lanes beyond `triangles.len()` unused).
+    pub fn new(triangles: &[[[f32; 3]; 3]]) -> Self {
+        assert!(triangles.len() <= 4, "four triangles at most");
+        let mut lanes = [[[f32::NAN; 4]; 3]; 3];
+        for (lane, triangle) in triangles.iter().enumerate() {
+            for (vertex, p) in triangle.iter().enumerate() {
+                for axis in 0..3 {
+                    lanes[vertex][axis][lane] = p[axis];
+                }
+            }
+        }
+        Triangles4 {
+            v: lanes.map(|vertex| vertex.map(Vec4::from_array)),
+        }
+    }
+
+    /// Lane `lane`'s triangle (NaN corners for an unused lane).
+    pub fn triangle(&self, lane: usize) -> [[f32; 3]; 3] {
+        self.v
+            .map(|vertex| vertex.map(|axis| axis.to_array()[lane]))
+    }
+}
+
+impl ShearedRay {
+    /// [`ShearedRay::intersect`] on four triangles at once: bit `k` of the mask for a hit of lane `k`'s
+    /// triangle, at `t[k]`. Each lane computes what the scalar test computes, in the same f32 operations
+    /// (so the same bits); a lane with an edge function exactly 0, which the scalar test decides in f64,
+    /// is handed to the scalar test.
+    #[inline]
+    pub fn intersect4(&self, tri: &Triangles4, t_min: f32, t_max: f32) -> (u32, [f32; 4]) {
+        let (kx, ky, kz) = (self.kx as usize, self.ky as usize, self.kz as usize);
+        let (ox, oy, oz) = (
+            Vec4::splat(self.ox),
+            Vec4::splat(self.oy),
+            Vec4::splat(self.oz),
+        );
+        let (sx, sy) = (Vec4::splat(self.sx), Vec4::splat(self.sy));
+        let shear = |p: &[Vec4; 3]| {
+            let z = p[kz] - oz;
+            ((p[kx] - ox) - sx * z, (p[ky] - oy) - sy * z, z)
+        };
+        let (ax, ay, az) = shear(&tri.v[0]);
+        let (bx, by, bz) = shear(&tri.v[1]);
+        let (cx, cy, cz) = shear(&tri.v[2]);
+        let u = cx * by - cy * bx;
+        let v = ax * cy - ay * cx;
+        let w = bx * ay - by * ax;
+        let zero = Vec4::ZERO;
+        let on_edge = (u.cmpeq(zero) | v.cmpeq(zero) | w.cmpeq(zero)).bitmask();
+        let negative = u.cmplt(zero) | v.cmplt(zero) | w.cmplt(zero);
+        let positive = u.cmpgt(zero) | v.cmpgt(zero) | w.cmpgt(zero);
+        let det = u + v + w;
+        let sz = Vec4::splat(self.sz);
+        let t = (u * (sz * az) + v * (sz * bz) + w * (sz * cz)) / det;
+        let inside = !(negative & positive).bitmask() & 0xf;
+        let accepted =
+            (det.cmpne(zero) & t.cmpge(Vec4::splat(t_min)) & t.cmple(Vec4::splat(t_max))).bitmask();
+        let mut hits = inside & accepted & !on_edge;
+        let mut ts = t.to_array();
+        let mut edges = on_edge;
+        while edges != 0 {
+            let k = edges.trailing_zeros() as usize;
+            edges &= edges - 1;
+            let [a, b, c] = tri.triangle(k);
+            if let Some(tk) = self.intersect(a, b, c, t_min, t_max) {
+                hits |= 1 << k;
+                ts[k] = tk;
+            }
+        }
+        (hits, ts)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -144,6 +227,62 @@ mod tests {
         assert_eq!(
             on_edge.intersect(B, [1.0, 1.0, 0.0], C, 0.0, 10.0),
             Some(1.0)
+        );
+    }
+
+    /// The four-lane test gives the scalar test's answers to the bit: on triangles with corners on a
+    /// coarse lattice (so that many lines pass exactly through edges and vertices, the f64 path), with
+    /// one to four lanes used, lines from lattice points and random ones.
+    #[test]
+    fn four_lanes_are_the_scalar_test_bit_for_bit() {
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state
+        };
+        let mut lattice = || (next() % 9) as f32 * 0.25 - 1.0;
+        let (mut hits, mut edges) = (0, 0);
+        for k in 0..20_000 {
+            let used = 1 + k % 4;
+            let triangles: Vec<[[f32; 3]; 3]> = (0..used)
+                .map(|_| {
+                    [(); 3].map(|_| {
+                        [
+                            lattice(),
+                            lattice(),
+                            if k % 3 == 0 { 0.0 } else { lattice() },
+                        ]
+                    })
+                })
+                .collect();
+            let packet = Triangles4::new(&triangles);
+            let origin = [lattice(), lattice(), 2.0];
+            let target = [
+                lattice(),
+                lattice(),
+                if k % 2 == 0 { 0.0 } else { lattice() },
+            ];
+            let dir = [0, 1, 2].map(|a| target[a] - origin[a]);
+            let ray = ShearedRay::new(origin, dir);
+            let (mask, t) = ray.intersect4(&packet, 0.0, 10.0);
+            for (lane, [a, b, c]) in triangles.iter().enumerate() {
+                let scalar = ray.intersect(*a, *b, *c, 0.0, 10.0);
+                let four = (mask >> lane & 1 == 1).then_some(t[lane]);
+                assert_eq!(
+                    four.map(f32::to_bits),
+                    scalar.map(f32::to_bits),
+                    "{k} {lane}"
+                );
+                hits += usize::from(scalar.is_some());
+            }
+            edges += usize::from(mask != 0 && k % 2 == 0);
+            assert_eq!(mask >> used, 0, "unused lanes never hit");
+        }
+        assert!(
+            hits > 3_000 && edges > 1_000,
+            "{hits} hits, {edges} lattice lines hitting"
         );
     }
 
