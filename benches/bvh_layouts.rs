@@ -117,10 +117,11 @@ fn grids_against_tree(spec: &str, scene: &Scene, lines: &[Line]) -> anyhow::Resu
         same &= first[0] == first[1];
     }
     println!(
-        "{spec:<10} all hits: tree only {:5.2}, with grids {:5.2} M lines/s ({:.2}x); same hits: {same}",
+        "{spec:<10} all hits: tree only {:5.2}, with grids {:5.2} M lines/s ({:.2}x; {} planes in grids); same hits: {same}",
         rates[0],
         rates[1],
-        rates[1] / rates[0]
+        rates[1] / rates[0],
+        with_grids.planes_in_grids()
     );
     Ok(())
 }

@@ -40,7 +40,7 @@ pub const MAX_GRIDS: usize = 16;
 
 /// The grids are used only when they hold at least this share of the scene's triangles: a line pays
 /// for their boxes and for the BVH of the rest.
-const MIN_SHARE: f64 = 0.5;
+const MIN_SHARE: f64 = 0.75;
 
 /// Planes are told apart by their unit normals and offsets rounded to this (tracing units); triangles
 /// whose planes round alike and lie within the BVH margin of one fitted plane share a grid.
