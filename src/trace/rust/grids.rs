@@ -42,6 +42,9 @@ pub const MAX_GRIDS: usize = 16;
 /// for their boxes and for the BVH of the rest.
 const MIN_SHARE: f64 = 0.75;
 
+/// A plane whose triangles would fill more cells than this each, on average, stays in the tree.
+const MAX_CELLS_PER_TRIANGLE: usize = 4;
+
 /// Planes are told apart by their unit normals and offsets rounded to this (tracing units); triangles
 /// whose planes round alike and lie within the BVH margin of one fitted plane share a grid.
 const PLANE_QUANTUM: f64 = 1e-4;
@@ -90,20 +93,29 @@ impl Grids {
     pub fn build(scene: &Scene, margin: f32) -> (Grids, Vec<bool>) {
         let margin = f64::from(margin);
         let planes = large_planes(scene, margin);
-        let held: usize = planes.iter().map(|p| p.len()).sum();
+        let enough = |planes: &[Vec<u32>]| {
+            let held: usize = planes.iter().map(|p| p.len()).sum();
+            !planes.is_empty() && held as f64 >= MIN_SHARE * scene.triangles.len() as f64
+        };
         let mut grids = Grids::default();
         let mut gridded = vec![false; scene.triangles.len()];
-        if planes.is_empty() || (held as f64) < MIN_SHARE * scene.triangles.len() as f64 {
+        if !enough(&planes) {
             return (grids, gridded);
         }
-        for members in &planes {
-            let grid = Grid::new(scene, members, margin, &mut grids);
-            grids.grids.push(grid);
-            for &t in members {
-                gridded[t as usize] = true;
+        let mut kept = Vec::with_capacity(planes.len());
+        for members in planes {
+            if let Some(grid) = Grid::new(scene, &members, margin, &mut grids) {
+                grids.grids.push(grid);
+                kept.push(members);
             }
         }
-        grids.boxes = grid_boxes(scene, &planes, margin as f32);
+        if !enough(&kept) {
+            return (Grids::default(), gridded);
+        }
+        for &t in kept.iter().flatten() {
+            gridded[t as usize] = true;
+        }
+        grids.boxes = grid_boxes(scene, &kept, margin as f32);
         (grids, gridded)
     }
 
@@ -129,8 +141,9 @@ impl Grids {
 
 impl Grid {
     /// The grid of the triangles `members` (indices into `scene.triangles`); appends their packets,
-    /// cell after cell, to `into`'s.
-    fn new(scene: &Scene, members: &[u32], margin: f64, into: &mut Grids) -> Grid {
+    /// cell after cell, to `into`'s. None (and nothing appended) when the triangles would fill more
+    /// than [`MAX_CELLS_PER_TRIANGLE`] cells each on average.
+    fn new(scene: &Scene, members: &[u32], margin: f64, into: &mut Grids) -> Option<Grid> {
         let corners = |t: u32| scene.triangles[t as usize].map(|v| point(scene, v));
         let (normal, offset, spread) = fit_plane(scene, members);
         let axes = projection_axes(normal);
@@ -183,6 +196,15 @@ impl Grid {
                 })
             })
             .collect();
+        // Long thin triangles would each fill many cells (a hostile file's could fill them all, for
+        // every triangle): such a plane stays in the tree.
+        let entries: usize = ranges
+            .iter()
+            .map(|r| (r[0][1] - r[0][0] + 1) * (r[1][1] - r[1][0] + 1))
+            .sum();
+        if entries > MAX_CELLS_PER_TRIANGLE * members.len() {
+            return None;
+        }
         let n_cells = cells[0] * cells[1];
         let mut count = vec![0u32; n_cells + 1];
         for r in &ranges {
@@ -229,7 +251,7 @@ impl Grid {
                 into.push_triangles(scene, &packet);
             }
         }
-        grid
+        Some(grid)
     }
 
     /// The cell along projected axis `k` of coordinate `x`, clamped to the grid: monotone in `x`.
@@ -482,5 +504,35 @@ mod tests {
             let (grids, gridded) = Grids::build(&scene, MARGIN);
             assert!(grids.is_empty() && !gridded.contains(&true), "{spec}");
         }
+    }
+
+    /// A plane of small squares (which set the cells' size) crossed by long slivers along its diagonal
+    /// (each would fill a whole diagonal band of cells, as a hostile file's triangles could fill them
+    /// all): the plane stays in the tree, and the scene gets no grid.
+    #[test]
+    fn long_slivers_keep_their_plane_in_the_tree() {
+        let mut b = crate::scene::SceneBuilder::new("slivers");
+        let material = b.material(crate::scene::Material::default());
+        for i in 0..10 {
+            for j in 0..10 {
+                let (x, y) = (i as f64, j as f64);
+                let v = [[x, y], [x + 1.0, y], [x + 1.0, y + 1.0], [x, y + 1.0]]
+                    .map(|[x, y]| b.vertex([x, y, 0.0]));
+                b.polygon(&v, material, "squares");
+            }
+        }
+        for k in 0..100 {
+            let o = k as f64 * 1e-3;
+            let v = [[o, 0.0], [10.0, 10.0 - o], [10.0, 10.0]].map(|[x, y]| b.vertex([x, y, 0.0]));
+            b.polygon(&v, material, "slivers");
+        }
+        let scene = b.build().unwrap();
+        assert_eq!(
+            large_planes(&scene, f64::from(MARGIN)).len(),
+            1,
+            "one large plane"
+        );
+        let (grids, gridded) = Grids::build(&scene, MARGIN);
+        assert!(grids.is_empty() && !gridded.contains(&true));
     }
 }
