@@ -43,9 +43,9 @@
 //! slab test (the Embree backend proposes from the same grown boxes); a node's boxes are exact f32 unions of these
 //! (min and max round nothing): the candidates are then a superset of the true hits, and every hit (and
 //! its `t`) comes from the watertight test on the original triangle, in the same operations as the
-//! brute-force tracer and the Embree filter. No spatial splits are used, so a triangle is
-//! proposed at most once per line; repeats would be harmless anyway ([`crate::trace::HitRules`] removes
-//! exact `(t, triangle)` repeats).
+//! brute-force tracer and the Embree filter. The tree uses no spatial splits, so it proposes a
+//! triangle at most once per line; a grid proposes a triangle entered in two cells under the line twice,
+//! and the repeat is harmless ([`crate::trace::HitRules`] removes exact `(t, triangle)` repeats).
 
 use glam::{DVec3, Vec3A, Vec4};
 use obvhs::aabb::Aabb;

@@ -45,6 +45,10 @@ const MIN_SHARE: f64 = 0.75;
 /// A plane whose triangles would fill more cells than this each, on average, stays in the tree.
 const MAX_CELLS_PER_TRIANGLE: usize = 4;
 
+/// So does one whose cells would hold more triangles than this each, on average (a graded mesh's small
+/// patches crowd into few cells): a line crossing the plane tests a cell's worth.
+const MAX_TRIANGLES_PER_CELL: usize = 8;
+
 /// Planes are told apart by their unit normals and offsets rounded to this (tracing units); triangles
 /// whose planes round alike and lie within the BVH margin of one fitted plane share a grid.
 const PLANE_QUANTUM: f64 = 1e-4;
@@ -93,23 +97,37 @@ impl Grids {
     pub fn build(scene: &Scene, margin: f32) -> (Grids, Vec<bool>) {
         let margin = f64::from(margin);
         let planes = large_planes(scene, margin);
-        let enough = |planes: &[Vec<u32>]| {
-            let held: usize = planes.iter().map(|p| p.len()).sum();
-            !planes.is_empty() && held as f64 >= MIN_SHARE * scene.triangles.len() as f64
-        };
+        let enough = |held: usize| held as f64 >= MIN_SHARE * scene.triangles.len() as f64;
         let mut grids = Grids::default();
         let mut gridded = vec![false; scene.triangles.len()];
-        if !enough(&planes) {
+        if planes.is_empty() || !enough(planes.iter().map(Plane::len).sum()) {
             return (grids, gridded);
         }
-        let mut kept = Vec::with_capacity(planes.len());
-        for members in planes {
-            if let Some(grid) = Grid::new(scene, &members, margin, &mut grids) {
+        // A plane refused (its triangles would fill too many cells) leaves its place to the next; one
+        // joined from neighbouring plane keys is tried in its parts (a floor and the turned boxes
+        // standing on it may fit no grid together, and fit apart).
+        let mut kept: Vec<Vec<u32>> = Vec::with_capacity(MAX_GRIDS);
+        let mut try_grid = |members: Vec<u32>, grids: &mut Grids| {
+            let fits = kept.len() < MAX_GRIDS;
+            if let Some(grid) = fits
+                .then(|| Grid::new(scene, &members, margin, grids))
+                .flatten()
+            {
                 grids.grids.push(grid);
                 kept.push(members);
+                return true;
+            }
+            false
+        };
+        for plane in planes {
+            if try_grid(plane.whole(), &mut grids) || plane.parts.len() < 2 {
+                continue;
+            }
+            for part in plane.parts.into_iter().filter(|p| p.len() >= MIN_TRIANGLES) {
+                try_grid(part, &mut grids);
             }
         }
-        if !enough(&kept) {
+        if kept.is_empty() || !enough(kept.iter().map(Vec::len).sum()) {
             return (Grids::default(), gridded);
         }
         for &t in kept.iter().flatten() {
@@ -141,12 +159,12 @@ impl Grids {
 
 impl Grid {
     /// The grid of the triangles `members` (indices into `scene.triangles`); appends their packets,
-    /// cell after cell, to `into`'s. None (and nothing appended) when the triangles would fill more
-    /// than [`MAX_CELLS_PER_TRIANGLE`] cells each on average.
+    /// cell after cell, to `into`'s. None (and nothing appended) when its cells do not
+    /// [fit](Grid::fits) them.
     fn new(scene: &Scene, members: &[u32], margin: f64, into: &mut Grids) -> Option<Grid> {
         let corners = |t: u32| scene.triangles[t as usize].map(|v| point(scene, v));
-        let (normal, offset, spread) = fit_plane(scene, members);
-        let axes = projection_axes(normal);
+        let fit = fit_plane(scene, members);
+        let axes = projection_axes(fit.0);
         let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
         let mut sides: [Vec<f64>; 2] = [Vec::new(), Vec::new()];
         for &t in members {
@@ -159,52 +177,12 @@ impl Grid {
             }
         }
         let cells = cell_counts(&mut sides, lo, hi, members.len());
-        let inv_cell = [0, 1].map(|k| {
-            let side = (hi[k] - lo[k]) / cells[k] as f64;
-            if side > 0.0 {
-                1.0 / side
-            } else {
-                0.0
-            }
-        });
-        let mut grid = Grid {
-            normal,
-            offset,
-            half_width: spread + margin,
-            axes,
-            corner: lo,
-            inv_cell,
-            cells,
-            packets: Vec::new(),
-            margin,
-        };
-        // Each triangle's cells (its box shrunk by a quarter margin), counted, then placed.
-        let shrink = margin / 4.0;
-        let ranges: Vec<[[usize; 2]; 2]> = members
-            .iter()
-            .map(|&t| {
-                let c = corners(t);
-                [0, 1].map(|k| {
-                    let (l, h) = span(c.map(|p| p[axes[k]]));
-                    let (l, h) = if h - l > 2.0 * shrink {
-                        (l + shrink, h - shrink)
-                    } else {
-                        let mid = 0.5 * (l + h);
-                        (mid, mid)
-                    };
-                    [grid.cell(k, l), grid.cell(k, h)]
-                })
-            })
-            .collect();
-        // Long thin triangles would each fill many cells (a hostile file's could fill them all, for
-        // every triangle): such a plane stays in the tree.
-        let entries: usize = ranges
-            .iter()
-            .map(|r| (r[0][1] - r[0][0] + 1) * (r[1][1] - r[1][0] + 1))
-            .sum();
-        if entries > MAX_CELLS_PER_TRIANGLE * members.len() {
+        let mut grid = Grid::empty(fit, axes, (lo, hi), cells, margin);
+        let ranges = grid.cells_of(scene, members);
+        if !grid.fits(&ranges) {
             return None;
         }
+        let cells = grid.cells;
         let n_cells = cells[0] * cells[1];
         let mut count = vec![0u32; n_cells + 1];
         for r in &ranges {
@@ -258,6 +236,70 @@ impl Grid {
     /// (Clamped first, the conversion's truncation is the floor; `floor` itself is a library call
     /// without SSE 4.1.)
     #[inline(always)]
+    /// A grid with no triangles yet: `cells` cells over the box `lo..hi` of a plane `fit` (normal,
+    /// offset, spread: [`fit_plane`]) projected on `axes`.
+    fn empty(
+        (normal, offset, spread): (DVec3, f64, f64),
+        axes: [usize; 2],
+        (lo, hi): ([f64; 2], [f64; 2]),
+        cells: [usize; 2],
+        margin: f64,
+    ) -> Grid {
+        let inv_cell = [0, 1].map(|k| {
+            let side = (hi[k] - lo[k]) / cells[k] as f64;
+            if side > 0.0 {
+                1.0 / side
+            } else {
+                0.0
+            }
+        });
+        Grid {
+            normal,
+            offset,
+            half_width: spread + margin,
+            axes,
+            corner: lo,
+            inv_cell,
+            cells,
+            packets: Vec::new(),
+            margin,
+        }
+    }
+
+    /// The first and last cell along each axis of each of `members`: those its projected box, shrunk by
+    /// a quarter margin on every side, overlaps.
+    fn cells_of(&self, scene: &Scene, members: &[u32]) -> Vec<[[usize; 2]; 2]> {
+        let shrink = self.margin / 4.0;
+        members
+            .iter()
+            .map(|&t| {
+                let c = scene.triangles[t as usize].map(|v| point(scene, v));
+                [0, 1].map(|k| {
+                    let (l, h) = span(c.map(|p| p[self.axes[k]]));
+                    let (l, h) = if h - l > 2.0 * shrink {
+                        (l + shrink, h - shrink)
+                    } else {
+                        let mid = 0.5 * (l + h);
+                        (mid, mid)
+                    };
+                    [self.cell(k, l), self.cell(k, h)]
+                })
+            })
+            .collect()
+    }
+
+    /// Whether triangles entered in the cells `ranges` stay within [`MAX_CELLS_PER_TRIANGLE`] cells each
+    /// and [`MAX_TRIANGLES_PER_CELL`] triangles a cell, on average. Long thin triangles would each fill
+    /// many cells (a hostile file's could fill them all, for every triangle); coarse cells hold many.
+    fn fits(&self, ranges: &[[[usize; 2]; 2]]) -> bool {
+        let entries: usize = ranges
+            .iter()
+            .map(|r| (r[0][1] - r[0][0] + 1) * (r[1][1] - r[1][0] + 1))
+            .sum();
+        entries <= MAX_CELLS_PER_TRIANGLE * ranges.len()
+            && entries <= MAX_TRIANGLES_PER_CELL * self.cells[0] * self.cells[1]
+    }
+
     fn cell(&self, k: usize, x: f64) -> usize {
         let c = (x - self.corner[k]) * self.inv_cell[k];
         c.clamp(0.0, (self.cells[k] - 1) as f64) as usize
@@ -322,45 +364,159 @@ fn span(x: [f64; 3]) -> (f64, f64) {
     (x[0].min(x[1]).min(x[2]), x[0].max(x[1]).max(x[2]))
 }
 
-/// The triangles of each plane holding at least [`MIN_TRIANGLES`] and lying within `margin` of one
-/// fitted plane, largest first, at most [`MAX_GRIDS`]; each list in the scene's triangle order.
-fn large_planes(scene: &Scene, margin: f64) -> Vec<Vec<u32>> {
+/// The triangles of one plane, as the runs of triangles whose rounded planes were joined into it
+/// ([`joined_runs`]), each in the scene's triangle order.
+struct Plane {
+    parts: Vec<Vec<u32>>,
+}
+
+impl Plane {
+    fn len(&self) -> usize {
+        self.parts.iter().map(Vec::len).sum()
+    }
+
+    /// All its triangles, in the scene's order.
+    fn whole(&self) -> Vec<u32> {
+        let mut m = self.parts.concat();
+        m.sort_unstable();
+        m
+    }
+}
+
+/// The planes holding at least [`MIN_TRIANGLES`] triangles lying within `margin` of one fitted plane,
+/// largest first.
+fn large_planes(scene: &Scene, margin: f64) -> Vec<Plane> {
     if scene.triangles.len() < MIN_TRIANGLES {
         return Vec::new();
     }
     // Each triangle's rounded plane, hashed: 16 bytes a triangle while the planes are sorted out (a map
     // of lists would weigh several times that on a large curved mesh, where every plane is new). Two
     // planes whose hashes collide fail the flatness test below and stay in the tree.
-    let mut keyed: Vec<(u64, u32)> = scene
-        .triangles
-        .iter()
-        .enumerate()
-        .filter_map(|(t, tri)| {
-            let [a, b, c] = tri.map(|v| point(scene, v));
-            let n = (b - a).cross(c - a);
-            let length = n.length();
-            // Degenerate (or NaN) normals belong to no plane.
-            if length.is_nan() || length <= 0.0 {
-                return None;
-            }
-            let n = canonical_sign(n / length);
-            let key = [n.x, n.y, n.z, n.dot(a)].map(|x| (x / PLANE_QUANTUM).round() as i64);
-            let mut hasher = std::hash::DefaultHasher::new();
-            key.hash(&mut hasher);
-            Some((hasher.finish(), t as u32))
-        })
+    let mut keyed: Vec<(u64, u32)> = (0..scene.triangles.len() as u32)
+        .filter_map(|t| plane_key(scene, t).map(|key| (hash_key(key), t)))
         .collect();
     keyed.sort_unstable();
-    let mut planes: Vec<Vec<u32>> = keyed
-        .chunk_by(|x, y| x.0 == y.0)
-        .filter(|run| run.len() >= MIN_TRIANGLES)
-        .map(|run| run.iter().map(|&(_, t)| t).collect::<Vec<u32>>())
-        .filter(|m| fit_plane(scene, m).2 <= margin)
-        .collect();
+    let flat = |p: &Plane| fit_plane(scene, &p.whole()).2 <= margin;
+    let mut planes: Vec<Plane> = Vec::new();
+    for group in joined_runs(scene, &keyed) {
+        let part = |r: &Run| {
+            keyed[r.clone()]
+                .iter()
+                .map(|&(_, t)| t)
+                .collect::<Vec<u32>>()
+        };
+        let whole = Plane {
+            parts: group.iter().map(part).collect(),
+        };
+        if flat(&whole) {
+            planes.push(whole);
+        } else {
+            // Neighbouring keys that are not one plane: each run on its own, as if never joined.
+            planes.extend(
+                whole
+                    .parts
+                    .into_iter()
+                    .map(|p| Plane { parts: vec![p] })
+                    .filter(|p| p.len() >= MIN_TRIANGLES && flat(p)),
+            );
+        }
+    }
     // Largest first; ties by first triangle, so that the choice does not depend on the map's order.
-    planes.sort_by_key(|m| (std::cmp::Reverse(m.len()), m[0]));
-    planes.truncate(MAX_GRIDS);
+    planes.sort_by_key(|p| {
+        (
+            std::cmp::Reverse(p.len()),
+            p.parts.iter().map(|q| q[0]).min(),
+        )
+    });
     planes
+}
+
+/// A run of triangles with one plane key: a range of indices into the sorted `(hash, triangle)` list.
+type Run = std::ops::Range<usize>;
+
+/// Runs whose plane keys are neighbours (one quantum apart in some of their four numbers) joined, when
+/// one of them holds a quarter of [`MIN_TRIANGLES`] or more: the triangles of one plane whose numbers
+/// lie near a rounding boundary round to either side of it (small triangles of a wall turned off the
+/// axes, whose normals carry the rounding of their f32 vertices, split a wall two to four ways). The
+/// groups holding at least [`MIN_TRIANGLES`]; the flatness test decides whether a group is one plane.
+fn joined_runs(scene: &Scene, keyed: &[(u64, u32)]) -> Vec<Vec<Run>> {
+    let run_at = |start: usize| {
+        let h = keyed[start].0;
+        start..start + keyed[start..].partition_point(|x| x.0 == h)
+    };
+    let mut seeds: Vec<Run> = Vec::new();
+    let mut start = 0;
+    while start < keyed.len() {
+        let run = run_at(start);
+        start = run.end;
+        if run.len() >= MIN_TRIANGLES / 4 {
+            seeds.push(run);
+        }
+    }
+    // Union-find over the runs met, each known by its start.
+    let mut parent: std::collections::BTreeMap<usize, usize> =
+        seeds.iter().map(|r| (r.start, r.start)).collect();
+    fn root(parent: &mut std::collections::BTreeMap<usize, usize>, mut x: usize) -> usize {
+        while parent[&x] != x {
+            let up = parent[&parent[&x]];
+            parent.insert(x, up);
+            x = up;
+        }
+        x
+    }
+    for seed in &seeds {
+        let Some(key) = plane_key(scene, keyed[seed.start].1) else {
+            continue;
+        };
+        for near in neighbour_keys(key) {
+            let h = hash_key(near);
+            let at = keyed.partition_point(|x| x.0 < h);
+            // The run found must have this very key, not one whose hash collides with it.
+            if at == keyed.len() || keyed[at].0 != h || plane_key(scene, keyed[at].1) != Some(near)
+            {
+                continue;
+            }
+            parent.entry(at).or_insert(at);
+            let (a, b) = (root(&mut parent, seed.start), root(&mut parent, at));
+            parent.insert(a.max(b), a.min(b));
+        }
+    }
+    let mut groups: std::collections::BTreeMap<usize, Vec<Run>> = Default::default();
+    let starts: Vec<usize> = parent.keys().copied().collect();
+    for s in starts {
+        let r = root(&mut parent, s);
+        groups.entry(r).or_default().push(run_at(s));
+    }
+    groups
+        .into_values()
+        .filter(|g| g.iter().map(|r| r.len()).sum::<usize>() >= MIN_TRIANGLES)
+        .collect()
+}
+
+/// A triangle's plane rounded to [`PLANE_QUANTUM`]: its unit normal (largest component positive) and
+/// offset; None for a degenerate (or NaN) normal, which belongs to no plane.
+fn plane_key(scene: &Scene, t: u32) -> Option<[i64; 4]> {
+    let [a, b, c] = scene.triangles[t as usize].map(|v| point(scene, v));
+    let n = (b - a).cross(c - a);
+    let length = n.length();
+    if length.is_nan() || length <= 0.0 {
+        return None;
+    }
+    let n = canonical_sign(n / length);
+    Some([n.x, n.y, n.z, n.dot(a)].map(|x| (x / PLANE_QUANTUM).round() as i64))
+}
+
+fn hash_key(key: [i64; 4]) -> u64 {
+    let mut hasher = std::hash::DefaultHasher::new();
+    key.hash(&mut hasher);
+    hasher.finish()
+}
+
+/// The 80 keys one quantum away from `key` in one to four of its numbers.
+fn neighbour_keys(key: [i64; 4]) -> impl Iterator<Item = [i64; 4]> {
+    (0..81)
+        .filter(|&k| k != 40)
+        .map(move |k: i64| [0, 1, 2, 3].map(|i| key[i] + (k / 3i64.pow(i as u32)) % 3 - 1))
 }
 
 /// The normal with its largest component positive (a plane's two faces share a grid).
@@ -414,7 +570,8 @@ fn projection_axes(n: DVec3) -> [usize; 2] {
 }
 
 /// Cells along each axis: the extent over the triangles' median side along it (a regular mesh gets one
-/// cell per patch, aligned with it), at most twice as many cells as triangles in all.
+/// cell per patch, aligned with it), at most twice as many cells as triangles in all (an axis cut down
+/// to one cell leaves the other the whole allowance, not more).
 fn cell_counts(
     sides: &mut [Vec<f64>; 2],
     lo: [f64; 2],
@@ -435,7 +592,7 @@ fn cell_counts(
     let most = 2.0 * triangles as f64;
     if n[0] * n[1] > most {
         let scale = (most / (n[0] * n[1])).sqrt();
-        n = n.map(|c| (c * scale).floor().max(1.0));
+        n = n.map(|c| (c * scale).floor().max(1.0).min(most));
     }
     n.map(|c| c as usize)
 }
@@ -534,5 +691,40 @@ mod tests {
         );
         let (grids, gridded) = Grids::build(&scene, MARGIN);
         assert!(grids.is_empty() && !gridded.contains(&true));
+    }
+
+    /// A refused plane leaves its place among the [`MAX_GRIDS`] to the next largest: the largest plane
+    /// (slivers among squares) stays in the tree, and the 16 smaller walls all get grids.
+    #[test]
+    fn a_refused_plane_leaves_its_place_to_the_next() {
+        let mut b = crate::scene::SceneBuilder::new("walls and slivers");
+        let material = b.material(crate::scene::Material::default());
+        let square = |b: &mut crate::scene::SceneBuilder, x: f64, y: f64, z: f64, group: &str| {
+            let v = [[x, y], [x + 1.0, y], [x + 1.0, y + 1.0], [x, y + 1.0]]
+                .map(|[x, y]| b.vertex([x, y, z]));
+            b.polygon(&v, material, group);
+        };
+        for (i, j) in (0..10).flat_map(|i| (0..10).map(move |j| (i, j))) {
+            square(&mut b, i as f64, j as f64, 0.0, "floor");
+        }
+        for k in 1..=100 {
+            let o = k as f64 * 1e-3;
+            let v = [[o, 0.0], [10.0, 10.0 - o], [10.0, 10.0]].map(|[x, y]| b.vertex([x, y, 0.0]));
+            b.polygon(&v, material, "slivers");
+        }
+        let walls = MAX_GRIDS;
+        for z in 1..=walls {
+            for (i, j) in (0..8).flat_map(|i| (0..8).map(move |j| (i, j))) {
+                square(&mut b, i as f64, j as f64, z as f64, "wall");
+            }
+        }
+        let scene = b.build().unwrap();
+        let planes = large_planes(&scene, f64::from(MARGIN));
+        assert_eq!(planes.len(), walls + 1);
+        assert_eq!(planes[0].len(), 300, "the sliver plane is the largest");
+        let (grids, gridded) = Grids::build(&scene, MARGIN);
+        assert_eq!(grids.grids.len(), walls, "every wall gets a grid");
+        assert!(planes[0].whole().iter().all(|&t| !gridded[t as usize]));
+        assert_eq!(gridded.iter().filter(|&&g| g).count(), walls * 128);
     }
 }
