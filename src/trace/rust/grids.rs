@@ -6,8 +6,9 @@
 //! patches. A BVH reaches the triangle a line crosses in such a wall through a descent of box tests,
 //! each a likely cache miss; on a plane, the cell of a uniform grid under the line's crossing point
 //! holds it, found with a few f64 operations. The tracer keeps a grid for each of the (at most
-//! [`MAX_GRIDS`]) planes holding at least [`MIN_TRIANGLES`] triangles, when together they hold most of
-//! the scene; every other triangle stays in the BVH.
+//! [`MAX_GRIDS`]) planes holding at least [`MIN_TRIANGLES`] triangles whose cells fit them (a few
+//! cells a triangle, a few triangles a cell: `Grid::fits`; a plane refused leaves its place to the
+//! next), when together they hold most of the scene; every other triangle stays in the BVH.
 //!
 //! # Exactness
 //!
@@ -50,7 +51,8 @@ const MAX_CELLS_PER_TRIANGLE: usize = 4;
 const MAX_TRIANGLES_PER_CELL: usize = 8;
 
 /// Planes are told apart by their unit normals and offsets rounded to this (tracing units); triangles
-/// whose planes round alike and lie within the BVH margin of one fitted plane share a grid.
+/// whose planes round alike, or to neighbouring values ([`joined_runs`]), and lie within the BVH margin
+/// of one fitted plane share a grid.
 const PLANE_QUANTUM: f64 = 1e-4;
 
 /// The grids of a scene's large planes, and the boxes every line tests first.
@@ -103,28 +105,31 @@ impl Grids {
         if planes.is_empty() || !enough(planes.iter().map(Plane::len).sum()) {
             return (grids, gridded);
         }
-        // A plane refused (its triangles would fill too many cells) leaves its place to the next; one
-        // joined from neighbouring plane keys is tried in its parts (a floor and the turned boxes
-        // standing on it may fit no grid together, and fit apart).
+        // A plane refused (its cells would not fit its triangles: `Grid::fits`) leaves its place to
+        // the next; one joined from neighbouring plane keys is tried in its parts, largest first, before
+        // the next plane (patches turned differently in one plane may fit no grid together, and fit
+        // apart).
         let mut kept: Vec<Vec<u32>> = Vec::with_capacity(MAX_GRIDS);
-        let mut try_grid = |members: Vec<u32>, grids: &mut Grids| {
-            let fits = kept.len() < MAX_GRIDS;
-            if let Some(grid) = fits
-                .then(|| Grid::new(scene, &members, margin, grids))
-                .flatten()
-            {
-                grids.grids.push(grid);
-                kept.push(members);
-                return true;
+        let try_grid = |members: Vec<u32>, grids: &mut Grids, kept: &mut Vec<Vec<u32>>| {
+            if kept.len() == MAX_GRIDS {
+                return false;
             }
-            false
+            let Some(grid) = Grid::new(scene, &members, margin, grids) else {
+                return false;
+            };
+            grids.grids.push(grid);
+            kept.push(members);
+            true
         };
         for plane in planes {
-            if try_grid(plane.whole(), &mut grids) || plane.parts.len() < 2 {
+            if kept.len() == MAX_GRIDS {
+                break;
+            }
+            if try_grid(plane.whole(), &mut grids, &mut kept) || plane.parts.len() < 2 {
                 continue;
             }
             for part in plane.parts.into_iter().filter(|p| p.len() >= MIN_TRIANGLES) {
-                try_grid(part, &mut grids);
+                try_grid(part, &mut grids, &mut kept);
             }
         }
         if kept.is_empty() || !enough(kept.iter().map(Vec::len).sum()) {
@@ -232,10 +237,6 @@ impl Grid {
         Some(grid)
     }
 
-    /// The cell along projected axis `k` of coordinate `x`, clamped to the grid: monotone in `x`.
-    /// (Clamped first, the conversion's truncation is the floor; `floor` itself is a library call
-    /// without SSE 4.1.)
-    #[inline(always)]
     /// A grid with no triangles yet: `cells` cells over the box `lo..hi` of a plane `fit` (normal,
     /// offset, spread: [`fit_plane`]) projected on `axes`.
     fn empty(
@@ -300,6 +301,10 @@ impl Grid {
             && entries <= MAX_TRIANGLES_PER_CELL * self.cells[0] * self.cells[1]
     }
 
+    /// The cell along projected axis `k` of coordinate `x`, clamped to the grid: monotone in `x`.
+    /// (Clamped first, the conversion's truncation is the floor; `floor` itself is a library call
+    /// without SSE 4.1.)
+    #[inline(always)]
     fn cell(&self, k: usize, x: f64) -> usize {
         let c = (x - self.corner[k]) * self.inv_cell[k];
         c.clamp(0.0, (self.cells[k] - 1) as f64) as usize
@@ -405,9 +410,10 @@ fn large_planes(scene: &Scene, margin: f64) -> Vec<Plane> {
                 .map(|&(_, t)| t)
                 .collect::<Vec<u32>>()
         };
-        let whole = Plane {
-            parts: group.iter().map(part).collect(),
-        };
+        let mut parts: Vec<Vec<u32>> = group.iter().map(part).collect();
+        // Largest first, ties by first triangle: not in the hashes' order.
+        parts.sort_by_key(|p| (std::cmp::Reverse(p.len()), p[0]));
+        let whole = Plane { parts };
         if flat(&whole) {
             planes.push(whole);
         } else {
