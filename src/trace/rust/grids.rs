@@ -699,6 +699,23 @@ mod tests {
         assert!(grids.is_empty() && !gridded.contains(&true));
     }
 
+    /// At most twice as many cells as triangles, also when one axis is cut down to a single cell (a
+    /// long strip: 65,536 cells along it by its patches' median side, one across).
+    #[test]
+    fn cells_stay_within_twice_the_triangles() {
+        for (along, across) in [(65536.0, 1e-3), (1e9, 1.0), (100.0, 100.0), (3.0, 1e6)] {
+            let mut sides = [vec![1.0; 64], vec![1.0; 64]];
+            let n = cell_counts(&mut sides, [0.0, 0.0], [along, across], 64);
+            assert!(n[0] >= 1 && n[1] >= 1, "{along} x {across}: {n:?}");
+            assert!(n[0] * n[1] <= 128, "{along} x {across}: {n:?}");
+        }
+        let mut regular = [vec![1.0; 200], vec![1.0; 200]];
+        assert_eq!(
+            cell_counts(&mut regular, [0.0; 2], [10.0; 2], 200),
+            [10, 10]
+        );
+    }
+
     /// A refused plane leaves its place among the [`MAX_GRIDS`] to the next largest: the largest plane
     /// (slivers among squares) stays in the tree, and the 16 smaller walls all get grids.
     #[test]
