@@ -2,6 +2,7 @@
 
 #include "scx_embree.h"
 
+#include <float.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -348,12 +349,78 @@ static void shear_line(scx_sheared* r, const scx_line* line) {
   const unsigned kx = kx_of[2 * kz + neg];
   const unsigned ky = ky_of[2 * kz + neg];
   memcpy(r->org, line->org, sizeof r->org);
+  memcpy(r->dir, line->dir, sizeof r->dir);
   r->kx = (int)kx;
   r->ky = (int)ky;
   r->kz = (int)kz;
   r->sx = d[kx] / d[kz];
   r->sy = d[ky] / d[kz];
   r->sz = 1.0f / d[kz];
+}
+
+/* The bounds of grazing crossings (src/trace/rust/watertight.rs: GRAZING_BOUND, NOISY_DETERMINANT,
+ * CLEAR_OF_EDGES). */
+#define SCX_GRAZING_BOUND 4.0f
+#define SCX_NOISY_DETERMINANT 16.0f
+#define SCX_CLEAR_OF_EDGES 32.0f
+
+static inline float max_f(float a, float b) { return a > b ? a : b; }
+static inline float min_f(float a, float b) { return a < b ? a : b; }
+
+/* The scale of the edge functions' rounding: edge_error of src/trace/rust/watertight.rs, in its order. */
+static float edge_error(float ax, float ay, float az, float bx, float by, float bz, float cx, float cy, float cz) {
+  const float x = max_f(max_f(max_f(max_f(max_f(fabsf(ax), fabsf(ay)), fabsf(bx)), fabsf(by)), fabsf(cx)), fabsf(cy));
+  const float z = max_f(max_f(fabsf(az), fabsf(bz)), fabsf(cz));
+  return (x + z) * x;
+}
+
+/* Whether the f32 t of an accepted crossing may be more than SCX_GRAZING_BOUND ulps off: the f32
+ * operations of ShearedRay::grazing, in its order. */
+static int grazing(const scx_sheared* r, float scale, float az, float bz, float cz, float det, float t) {
+  const float spread = max_f(max_f(az, bz), cz) - min_f(min_f(az, bz), cz);
+  const float d = fabsf(det);
+  return d <= (SCX_NOISY_DETERMINANT * FLT_EPSILON) * scale ||
+         scale * spread * fabsf(r->sz) > SCX_GRAZING_BOUND * d * max_f(fabsf(t), 1.0f);
+}
+
+/* The distance of a grazing crossing of triangle (a, b, c) in f64: for a crossing clear of the edges
+ * (interior), the distance to its plane, else (or for a plane parallel to the line) t32, kept within the
+ * stretch of the line inside the triangle's box. The operations of ShearedRay::grazing_t, in its order
+ * (see there why). */
+static float grazing_t(const scx_sheared* r, const float* a, const float* b, const float* c, float t32,
+                       int interior) {
+  const int kx = r->kx, ky = r->ky, kz = r->kz;
+  const double ox = (double)r->org[kx], oy = (double)r->org[ky], oz = (double)r->org[kz];
+  const double ra[3] = {(double)a[kx] - ox, (double)a[ky] - oy, (double)a[kz] - oz};
+  const double rb[3] = {(double)b[kx] - ox, (double)b[ky] - oy, (double)b[kz] - oz};
+  const double rc[3] = {(double)c[kx] - ox, (double)c[ky] - oy, (double)c[kz] - oz};
+  const double dir[3] = {(double)r->dir[kx], (double)r->dir[ky], (double)r->dir[kz]};
+  const double e1[3] = {rb[0] - ra[0], rb[1] - ra[1], rb[2] - ra[2]};
+  const double e2[3] = {rc[0] - ra[0], rc[1] - ra[1], rc[2] - ra[2]};
+  const double n[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]};
+  const double along = n[0] * dir[0] + n[1] * dir[1] + n[2] * dir[2];
+  const double plane = (n[0] * ra[0] + n[1] * ra[1] + n[2] * ra[2]) / along;
+  double t = interior && isfinite(plane) ? plane : (double)t32;
+  double enter = -INFINITY, exit = INFINITY;
+  for (int k = 0; k < 3; ++k) {
+    if (dir[k] == 0.0) continue;
+    double lo = ra[k] < rb[k] ? ra[k] : rb[k];
+    lo = rc[k] < lo ? rc[k] : lo;
+    double hi = ra[k] > rb[k] ? ra[k] : rb[k];
+    hi = rc[k] > hi ? rc[k] : hi;
+    const double t1 = lo / dir[k], t2 = hi / dir[k];
+    const double near = t1 < t2 ? t1 : t2, far = t1 < t2 ? t2 : t1;
+    if (near > enter) enter = near;
+    if (far < exit) exit = far;
+  }
+  if (enter > exit) {
+    t = 0.5 * (enter + exit);
+  } else if (t < enter) {
+    t = enter;
+  } else if (t > exit) {
+    t = exit;
+  }
+  return (float)t;
 }
 
 /* Whether the line hits triangle tri (9 floats) at t in [t_min, t_max]; t in *t_out. */
@@ -379,7 +446,12 @@ static int watertight_hit(const scx_sheared* r, const float* tri, float t_min, f
   if ((u < 0.0f || v < 0.0f || w < 0.0f) && (u > 0.0f || v > 0.0f || w > 0.0f)) return 0;
   const float det = u + v + w;
   if (det == 0.0f) return 0;
-  const float t = (u * (r->sz * az) + v * (r->sz * bz) + w * (r->sz * cz)) / det;
+  float t = (u * (r->sz * az) + v * (r->sz * bz) + w * (r->sz * cz)) / det;
+  const float scale = edge_error(ax, ay, az, bx, by, bz, cx, cy, cz);
+  if (grazing(r, scale, az, bz, cz, det, t)) {
+    const float clear = (SCX_CLEAR_OF_EDGES * FLT_EPSILON) * scale;
+    t = grazing_t(r, a, b, c, t, fabsf(u) > clear && fabsf(v) > clear && fabsf(w) > clear);
+  }
   if (!(t >= t_min && t <= t_max)) return 0;
   *t_out = t;
   return 1;

@@ -91,6 +91,7 @@ typedef struct scx_first_hit {
  * and shear that map its direction onto +z. Internal; in the header for the size check. */
 typedef struct scx_sheared {
   float org[3];
+  float dir[3]; /* for the f64 distance of a grazing crossing */
   int kx, ky, kz;
   float sx, sy, sz;
 } scx_sheared;

@@ -279,9 +279,9 @@ pub struct KindComparison {
     /// What each example line was aimed at, in the order of `hits.examples`.
     pub aims: Vec<Aim>,
     /// The first tracer's hits whose point lies outside its triangle's box grown by the tracers' margin
-    /// (1/65536 of the scene's size): hits of lines that lie in the triangle's plane to within rounding, where the
-    /// watertight test's verdict and distance are rounding ([`aimed`], "What agreement means on these
-    /// lines").
+    /// (1/65536 of the scene's size). The watertight test keeps the distance of a grazing crossing
+    /// within the box, so this reads 0; it once counted hits of lines in a triangle's plane to within
+    /// rounding, whose distance was rounding ([`aimed`], "What agreement means on these lines").
     pub stray_hits: u64,
 }
 

@@ -20,15 +20,17 @@
 //! scene's size), the line crosses. So they can only differ on a hit that the test grants to a triangle one of
 //! them does not propose: a hit far from its triangle. Such hits exist: on a line in a triangle's plane to
 //! within rounding (`in-face`, `edge-in-face`, the smallest `grazing` angles) the projected triangle is a
-//! sliver across which the line's position is rounding, and so are the test's verdict and its distance
-//! `t`, which can put the hit anywhere along the line (measured: up to 1.3 away on `@cornell`). But the
+//! sliver across which the line's position is rounding, and so is the test's verdict (its distance `t`
+//! could put the hit anywhere along the line, up to 1.3 away on `@cornell`, until such distances were
+//! kept within the triangle's box: `crate::trace::rust::watertight`, "The distance of a grazing
+//! crossing"). But the
 //! rounding acts only across the plane: within the plane the line's side of each edge is well defined,
 //! so the test grants the triangle only to lines that pass through it (within 4e-8 in every such case
 //! measured, on the built-in scenes and the public OBJ files, against a margin of at least 1.5e-5),
 //! which cross its grown box, where both tracers propose it. Stray hits are thus ambiguous geometrically
 //! (whether a line lying in a face meets it is not a question f32 can answer) but decided identically by
-//! both tracers; the report counts them (`stray`) and a test checks that each lies on a line through its
-//! triangle.
+//! both tracers; the report counts hits outside the grown box (`stray`, now 0) and a test checks that
+//! none is.
 //!
 //! # Targets and streams
 //!

@@ -410,3 +410,101 @@ pub fn unit_cube_matches_closed_forms(a: &Analysis, label: &str) {
         );
     }
 }
+
+/// Writes an OBJ of slivers: in three parallel planes 2e-3 apart (turned off the axes), strips of long
+/// thin triangles (sides 1 by 1e-4 to 1e-2) and a fan of 48 narrow ones, so that a line grazing one
+/// plane crosses slivers of the others close by. The tracers' distances of grazing crossings, and the
+/// order of close crossings, meet their worst cases here.
+pub fn slivers_obj() -> String {
+    let (turn_a, turn_b) = (0.37f64, 0.61f64);
+    let rotate = |p: [f64; 3]| {
+        let (ca, sa, cb, sb) = (turn_a.cos(), turn_a.sin(), turn_b.cos(), turn_b.sin());
+        let q = [p[0], ca * p[1] - sa * p[2], sa * p[1] + ca * p[2]];
+        [cb * q[0] - sb * q[1], sb * q[0] + cb * q[1], q[2]]
+    };
+    let mut verts = Vec::new();
+    let mut faces = Vec::new();
+    for layer in 0..3 {
+        let z = 2e-3 * f64::from(layer);
+        let mut y = -0.5;
+        for k in 0..40 {
+            let h = 1e-4 * 100f64.powf(f64::from((k * 7 + layer) % 40) / 39.0);
+            let base = verts.len() + 1;
+            verts.push([-0.5, y, z]);
+            verts.push([0.5, y, z]);
+            verts.push([0.5, y + h, z]);
+            verts.push([-0.5, y + h, z]);
+            faces.push([base, base + 1, base + 2]);
+            faces.push([base, base + 2, base + 3]);
+            y += h;
+        }
+        let centre = verts.len() + 1;
+        verts.push([0.0, 0.3, z]);
+        for k in 0..=48 {
+            let angle = std::f64::consts::PI * f64::from(k) / 48.0;
+            verts.push([0.45 * angle.cos(), 0.3 + 0.45 * angle.sin(), z]);
+        }
+        for k in 0..48 {
+            faces.push([centre, centre + 1 + k, centre + 2 + k]);
+        }
+    }
+    let mut s = String::new();
+    for v in verts {
+        let p = rotate(v);
+        s.push_str(&format!("v {} {} {}\n", p[0], p[1], p[2]));
+    }
+    for f in faces {
+        s.push_str(&format!("f {} {} {}\n", f[0], f[1], f[2]));
+    }
+    s
+}
+
+/// Lines through random points of random triangles of `scene`, at angles of 1e-2 to 1e-6 to the
+/// triangle's plane, in random directions within it, from 2 before the point to 2 past it.
+pub fn lines_grazing_triangles(
+    scene: &Scene,
+    rng: &mut rand_pcg::Pcg64,
+    count: usize,
+) -> Vec<scene_complexity::internals::trace::Line> {
+    use rand::Rng;
+    let unit = |v: [f64; 3]| {
+        let l = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+        v.map(|x| x / l)
+    };
+    (0..count)
+        .map(|k| {
+            let tri = scene.triangles[rng.gen_range(0..scene.triangles.len())];
+            let [a, b, c] = tri.map(|v| scene.positions[v as usize].map(f64::from));
+            let e1 = [0, 1, 2].map(|i| b[i] - a[i]);
+            let e2 = [0, 1, 2].map(|i| c[i] - a[i]);
+            let n = unit([
+                e1[1] * e2[2] - e1[2] * e2[1],
+                e1[2] * e2[0] - e1[0] * e2[2],
+                e1[0] * e2[1] - e1[1] * e2[0],
+            ]);
+            let u = unit(e1);
+            let w = [
+                n[1] * u[2] - n[2] * u[1],
+                n[2] * u[0] - n[0] * u[2],
+                n[0] * u[1] - n[1] * u[0],
+            ];
+            let (l1, l2) = loop {
+                let (l1, l2): (f64, f64) = (rng.gen(), rng.gen());
+                if l1 + l2 < 1.0 {
+                    break (l1, l2);
+                }
+            };
+            let p = [0, 1, 2].map(|i| a[i] + l1 * e1[i] + l2 * e2[i]);
+            let sine = 10f64.powi(-2 - (k % 5) as i32) * if k % 2 == 0 { 1.0 } else { -1.0 };
+            let cosine = (1.0 - sine * sine).sqrt();
+            let angle: f64 = rng.gen_range(0.0..std::f64::consts::TAU);
+            let d =
+                [0, 1, 2].map(|i| cosine * (angle.cos() * u[i] + angle.sin() * w[i]) + sine * n[i]);
+            scene_complexity::internals::trace::Line {
+                origin: [0, 1, 2].map(|i| (p[i] - 2.0 * d[i]) as f32),
+                dir: d.map(|x| x as f32),
+                t_max: 4.0,
+            }
+        })
+        .collect()
+}
