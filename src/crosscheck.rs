@@ -648,8 +648,8 @@ pub fn report_aimed(check: &AimedCheck, scene: &Scene, show: usize) -> String {
     }
     s += &kind_row("all", String::new(), &total, stray);
     s += &format!(
-        "stray: {na} hits further than the box margin from their triangle (lines in its plane to within \
-         rounding, where the hit and its t are rounding; both tracers round alike)\n"
+        "stray: {na} hits further than the box margin from their triangle (expected 0: the distance of \
+         a grazing crossing is kept within its triangle's box)\n"
     );
     let examples = check
         .kinds

@@ -20,7 +20,8 @@ use crate::geom::Normal;
 use crate::trace::Hit;
 
 /// Consecutive hits at most this many f32 ulps apart (at max(t, 1)) may be in either order: the
-/// watertight test's `t` is good to a few ulps, so this leaves a wide margin.
+/// watertight test's `t` is good to a few ulps (a grazing crossing's is recomputed in f64 when it might
+/// not be, `crate::trace::rust::watertight`), so this leaves a wide margin.
 const WINDOW_ULPS: f32 = 16.0;
 
 /// Crossings whose f64 plane distances differ by less than this (times max(t, 1)) are at the same place:
