@@ -17,7 +17,8 @@
 //! nearest hit so far, still finds the crossing): a crossing within rounding of an edge keeps the f32
 //! `t`, which its neighbours across the edge report too (their planes' distances differ there by
 //! rounding / cos, and the rules merge such reports only when their distances agree); and a plane
-//! parallel to the line in f64 leaves the f32 `t`. Hit or miss is never changed: the test stays
+//! parallel to the line in f64 leaves the f32 `t`. Whether the line crosses the triangle is never
+//! changed (only, through `t`, whether the crossing falls within `[t_min, t_max]`): the test stays
 //! watertight.
 
 use glam::Vec4;
