@@ -437,12 +437,11 @@ static int watertight_hit(const scx_sheared* r, const float* tri, float t_min, f
   float u = cx * by - cy * bx;
   float v = ax * cy - ay * cx;
   float w = bx * ay - by * ax;
-  /* On an edge in f32: decide it exactly (enough) in f64 so both neighbours agree. */
-  if (u == 0.0f || v == 0.0f || w == 0.0f) {
-    u = (float)((double)cx * (double)by - (double)cy * (double)bx);
-    v = (float)((double)ax * (double)cy - (double)ay * (double)cx);
-    w = (float)((double)bx * (double)ay - (double)by * (double)ax);
-  }
+  /* On an edge in f32: decide it exactly (enough) in f64 so both neighbours agree; only the edge functions
+   * that are 0 (see ShearedRay::intersect). */
+  if (u == 0.0f) u = (float)((double)cx * (double)by - (double)cy * (double)bx);
+  if (v == 0.0f) v = (float)((double)ax * (double)cy - (double)ay * (double)cx);
+  if (w == 0.0f) w = (float)((double)bx * (double)ay - (double)by * (double)ax);
   if ((u < 0.0f || v < 0.0f || w < 0.0f) && (u > 0.0f || v > 0.0f || w > 0.0f)) return 0;
   const float det = u + v + w;
   if (det == 0.0f) return 0;

@@ -247,11 +247,17 @@ impl ShearedRay {
         let mut u = cx * by - cy * bx;
         let mut v = ax * cy - ay * cx;
         let mut w = bx * ay - by * ax;
-        // On an edge in f32: decide it exactly (enough) in f64 so both neighbours agree.
-        if u == 0.0 || v == 0.0 || w == 0.0 {
-            let d = |x: f32| x as f64;
+        // On an edge in f32: decide it exactly (enough) in f64 so both neighbours agree. Only the edge
+        // functions that are 0: a neighbour sees its copy of a non-zero one non-zero too and keeps the
+        // f32 value, so recomputing it here alone could give the shared edge two signs.
+        let d = |x: f32| x as f64;
+        if u == 0.0 {
             u = (d(cx) * d(by) - d(cy) * d(bx)) as f32;
+        }
+        if v == 0.0 {
             v = (d(ax) * d(cy) - d(ay) * d(cx)) as f32;
+        }
+        if w == 0.0 {
             w = (d(bx) * d(ay) - d(by) * d(ax)) as f32;
         }
         if (u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0) {
