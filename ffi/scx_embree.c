@@ -363,6 +363,8 @@ static void shear_line(scx_sheared* r, const scx_line* line) {
 #define SCX_GRAZING_BOUND 4.0f
 #define SCX_NOISY_DETERMINANT 16.0f
 #define SCX_CLEAR_OF_EDGES 32.0f
+/* src/trace/rust/watertight.rs: EXACT_SIGN (f32::EPSILON). */
+#define SCX_EXACT_SIGN FLT_EPSILON
 
 static inline float max_f(float a, float b) { return a > b ? a : b; }
 static inline float min_f(float a, float b) { return a < b ? a : b; }
@@ -423,6 +425,27 @@ static float grazing_t(const scx_sheared* r, const float* a, const float* b, con
   return (float)t;
 }
 
+/* The edge function p q - r s as the f32 test computes it, and in *exact a double of its exact sign:
+ * edge_function of src/trace/rust/watertight.rs, in its operations (see there why the sign is exact). */
+static inline float edge_function(float p, float q, float r, float s, double* exact) {
+  const float pq = p * q, rs = r * s;
+  const float e = pq - rs;
+  if (fabsf(e) > SCX_EXACT_SIGN * (fabsf(pq) + fabsf(rs)) + FLT_MIN) {
+    *exact = (double)e;
+    return e;
+  }
+  *exact = (double)p * (double)q - (double)r * (double)s;
+  return (float)*exact;
+}
+
+/* The sign of an edge function with the origin moved by (epsilon, epsilon^2) when it is exactly 0:
+ * perturbed_sign of src/trace/rust/watertight.rs. */
+static inline int perturbed_sign(double exact, float dx, float dy) {
+  if (exact != 0.0) return (exact > 0.0) - (exact < 0.0);
+  if (dx != 0.0f) return (dx > 0.0f) - (dx < 0.0f);
+  return (dy > 0.0f) - (dy < 0.0f);
+}
+
 /* Whether the line hits triangle tri (9 floats) at t in [t_min, t_max]; t in *t_out. */
 static int watertight_hit(const scx_sheared* r, const float* tri, float t_min, float t_max, float* t_out) {
   /* Relative to the origin, then sheared; only the components the shear reads are computed (each in the
@@ -434,15 +457,14 @@ static int watertight_hit(const scx_sheared* r, const float* tri, float t_min, f
   const float ax = (a[kx] - ox) - r->sx * az, ay = (a[ky] - oy) - r->sy * az;
   const float bx = (b[kx] - ox) - r->sx * bz, by = (b[ky] - oy) - r->sy * bz;
   const float cx = (c[kx] - ox) - r->sx * cz, cy = (c[ky] - oy) - r->sy * cz;
-  float u = cx * by - cy * bx;
-  float v = ax * cy - ay * cx;
-  float w = bx * ay - by * ax;
-  /* On an edge in f32: decide it exactly (enough) in f64 so both neighbours agree; only the edge functions
-   * that are 0 (see ShearedRay::intersect). */
-  if (u == 0.0f) u = (float)((double)cx * (double)by - (double)cy * (double)bx);
-  if (v == 0.0f) v = (float)((double)ax * (double)cy - (double)ay * (double)cx);
-  if (w == 0.0f) w = (float)((double)bx * (double)ay - (double)by * (double)ax);
-  if ((u < 0.0f || v < 0.0f || w < 0.0f) && (u > 0.0f || v > 0.0f || w > 0.0f)) return 0;
+  double u_exact, v_exact, w_exact;
+  const float u = edge_function(cx, by, cy, bx, &u_exact);
+  const float v = edge_function(ax, cy, ay, cx, &v_exact);
+  const float w = edge_function(bx, ay, by, ax, &w_exact);
+  const int su = perturbed_sign(u_exact, cy - by, bx - cx);
+  const int sv = perturbed_sign(v_exact, ay - cy, cx - ax);
+  const int sw = perturbed_sign(w_exact, by - ay, ax - bx);
+  if (!((su > 0 && sv > 0 && sw > 0) || (su < 0 && sv < 0 && sw < 0))) return 0;
   const float det = u + v + w;
   if (det == 0.0f) return 0;
   float t = (u * (r->sz * az) + v * (r->sz * bz) + w * (r->sz * cz)) / det;

@@ -1,16 +1,17 @@
 //! Tracing backends: every intersection along a batch of global lines.
 //!
 //! A backend (`embree`, or the pure-Rust BVH) only reports *raw* hits: `(line, t, triangle)` in any
-//! order, possibly with the same crossing reported twice (a line through a shared edge or vertex hits every
-//! triangle that owns it). [`HitRules::canonicalize`] turns them into the canonical form that every
-//! consumer relies on, identically for every backend:
+//! order. Every backend decides a hit with the same watertight test, exact on edges and vertices, so a
+//! crossing of a shared edge or vertex is reported once, by the triangle a line beside it would cross,
+//! and the raw reports of a line through a closed mesh are even in number. [`HitRules::canonicalize`]
+//! turns them into the canonical form that every consumer relies on, identically for every backend:
 //!
 //! * hits of a line are sorted by `(t, triangle)`;
 //! * exact repeats of `(t, triangle)` are removed;
-//! * hits within a few f32 ulps of each other whose triangles share a vertex and face the line the same way
-//!   are one crossing, kept once (the first in sort order). Hits at the same place that face the line
-//!   differently are a graze (the line touches a ridge and leaves) and are all kept. So a line through a
-//!   closed mesh always has an even number of hits.
+//! * hits within a few f32 ulps of each other whose triangles share a vertex and face the line the same
+//!   way (a line grazing a surface within f32 rounding, which can fold the f32 mesh there) are one
+//!   crossing, kept once (the first in sort order). Hits at the same place that face the line
+//!   differently are a graze (the line touches a ridge and leaves) and are all kept.
 
 #[cfg(feature = "embree")]
 #[allow(unsafe_code)]

@@ -113,7 +113,10 @@ fn all_hits_equal_the_brute_force_tracer_to_the_bit() {
             );
         }
         // The check means something: lines did hit, and some hits were at t = 0.
-        assert!(reference.hits.len() > lines.len());
+        let hit = (0..lines.len())
+            .filter(|&l| !reference.of_line(l).is_empty())
+            .count();
+        assert!(hit > lines.len() / 4, "{}: {hit} lines hit", scene.name);
         assert!(reference.hits.iter().any(|h| h.t == 0.0), "{}", scene.name);
     }
 }

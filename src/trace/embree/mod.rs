@@ -13,7 +13,7 @@
 //! test of Woop, Benthin and Wald on the original triangle, in the same operations as
 //! [`crate::trace::rust::watertight`]: the hits are bit-identical to the pure-Rust tracers', at edges and
 //! vertices too, and for lines grazing a triangle at any angle. A crossing of a shared edge or vertex is
-//! reported by every triangle that owns it; [`HitRules`] merges those.
+//! reported by one triangle, as for a line beside it ([`HitRules`] merges what rounding leaves).
 //!
 //! Embree's own triangle tests are not used, even on inflated triangles: its robust test can reject every
 //! triangle around a vertex a line passes within rounding distance of (measured on `@cube:N`: 1-2% of
