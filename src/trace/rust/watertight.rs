@@ -564,7 +564,7 @@ mod tests {
             [ny, nx, nz],
             [px, ny, nz],
         ];
-        // A knife edge along y: two faces meeting at 90 degrees, closed by three more.
+        // A knife edge along y: two faces meeting at 53 degrees, closed by three more.
         let (a, b, c, e, f, g) = (
             [0.0, 0.0, 0.0],
             [0.0, 1.0, 0.0],
