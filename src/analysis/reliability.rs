@@ -218,6 +218,16 @@ pub(crate) fn coverage_verdict(report: &SamplingReport) -> Reliability {
     r
 }
 
+/// The verdict on an estimate unbiased whatever the coverage ([`VerdictRule::UnbiasedEstimate`]):
+/// `unusable` below [`COVERAGE_UNUSABLE`] (rows too thin to hold two segments each), else `ok`.
+fn unbiased_estimate_verdict(report: &SamplingReport) -> Reliability {
+    let mut r = coverage_verdict(report);
+    if r.verdict == Verdict::Undersampled {
+        r = Reliability::new(Verdict::Ok);
+    }
+    r
+}
+
 /// A plug-in reading with estimated bias `bias`.
 pub(crate) fn plug_in(e: Estimate, bias: f64, report: &SamplingReport, lines: u64) -> Reliability {
     let mut r = coverage_verdict(report);
@@ -453,6 +463,13 @@ fn verdict(
                 .map(|(b, c)| sign * b / c.value);
             r
         }
+        VerdictRule::UnbiasedEstimate => {
+            let r = unbiased_estimate_verdict(evidence.discrete(info.family)?.0);
+            match evidence.bias.and_then(|b| b.of(m)) {
+                Some(bias) => corrected(r, e, bias, evidence.lines),
+                None => r,
+            }
+        }
         VerdictRule::Unbiased => {
             let (report, _) = evidence.discrete(info.family)?;
             // The rows' multinomial estimate of the plug-in's bias, unless the jackknife gives one (Sobol'
@@ -541,6 +558,7 @@ mod tests {
             Measure::AccuracyCorrected => est((9.0 - hc) / isc, 0.001),
             Measure::RelativeError => est(1.0 - (9.0 - h) / isc, 0.001),
             Measure::MsePerLine => est(500.0, 0.01),
+            Measure::MsePerLineCorrected => est(500.001, 0.01),
             _ => None,
         })
     }
@@ -648,6 +666,32 @@ mod tests {
         );
         // E(MSE) has an unbiased estimate whatever the coverage: its bias (0.001) is within 0.01.
         assert_eq!(of(&r, Measure::MsePerLine).verdict, Verdict::Ok);
+    }
+
+    /// The unbiased E(MSE) needs no coverage of the rows, only rows above the `unusable` floor; a
+    /// jackknife estimate of its bias beyond its standard error (rows that are no multinomial samples)
+    /// makes it `undersampled`.
+    #[test]
+    fn the_unbiased_e_mse_is_ok_below_the_coverage_of_corrected_entropies() {
+        let at = |coverage: f64, bias: Option<f64>| {
+            let bias = bias
+                .map(|b| ByMeasure::from_fn(|m| (m == Measure::MsePerLineCorrected).then_some(b)));
+            let r = verdicts(
+                &readings(7.6, 7.8, 1.6),
+                Some(&report(coverage)),
+                bias.as_ref(),
+                closed(1_000_000, 1_000_000),
+            );
+            (
+                of(&r, Measure::MsePerLineCorrected).verdict,
+                of(&r, Measure::EntropyCorrected).verdict,
+            )
+        };
+        assert_eq!(at(0.8, None), (Verdict::Ok, Verdict::Undersampled));
+        assert_eq!(at(0.999, None), (Verdict::Ok, Verdict::Ok));
+        assert_eq!(at(0.4, None), (Verdict::Unusable, Verdict::Unusable));
+        assert_eq!(at(0.8, Some(0.005)).0, Verdict::Ok);
+        assert_eq!(at(0.8, Some(0.05)).0, Verdict::Undersampled);
     }
 
     /// Readings beyond the theory's bounds are flagged and never ok.

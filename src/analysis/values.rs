@@ -215,11 +215,11 @@ pub(super) fn visibility_estimates(
         }
         let jackknife = |m: Measure| with_replicates.jackknife_bias(|g| value_of(m, g));
         match info.verdict {
-            VerdictRule::Corrected if debiased(m) => {
+            VerdictRule::Corrected | VerdictRule::UnbiasedEstimate if debiased(m) => {
                 let debiased_value = |m: Measure| with_replicates.debiased(|g| value_of(m, g));
                 Some(debiased_value(m)?.value - debiased_value(plug_in_of(m)?)?.value)
             }
-            VerdictRule::Corrected => jackknife(m),
+            VerdictRule::Corrected | VerdictRule::UnbiasedEstimate => jackknife(m),
             VerdictRule::Unbiased if debias => jackknife(m),
             _ => None,
         }
@@ -431,6 +431,7 @@ fn value_of(m: Measure, g: &GroupValues) -> Option<f64> {
         Measure::AccuracyCorrected => g.accuracy_corrected(),
         Measure::RelativeError => Some(1.0 - g.accuracy()?),
         Measure::MsePerLine => Some(g.discrete?.mse_per_line),
+        Measure::MsePerLineCorrected => Some(g.corrected?.mse_per_line),
         Measure::PositionalEntropy
         | Measure::RadiosityPositionalEntropy
         | Measure::RadiosityEntropy

@@ -279,6 +279,7 @@ fn visibility_values(basis: Basis, d: DiscreteExact, continuous: f64) -> Vec<Exa
     push(Measure::RelativeError, 1.0 - accuracy);
     if let Some(mse) = d.mse_per_line {
         push(Measure::MsePerLine, mse);
+        push(Measure::MsePerLineCorrected, mse);
     }
     out
 }

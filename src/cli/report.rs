@@ -337,8 +337,8 @@ pub fn table(run: &RunInfo, a: &Analysis) -> String {
     if a.estimate(Measure::MutualInformationCorrected).is_some() {
         let _ = writeln!(
             s,
-            "corrected: row entropies by the {} estimator; the plug-in H_s and I_s are biased when rows \
-             are undersampled.",
+            "corrected: row entropies by the {} estimator, E(MSE) from each row's unbiased sum of \
+             F_ij^2; the plug-in readings are biased when rows are undersampled.",
             a.spec.estimator.name()
         );
     }
@@ -348,8 +348,8 @@ pub fn table(run: &RunInfo, a: &Analysis) -> String {
         let _ = writeln!(
             s,
             "bundles: the corrections infer unseen patch pairs as if the lines were independent; the lines \
-             of a bundle repeat their neighbours' pairs, which can shift the corrected values (the plug-in \
-             values, I_s^c and E(MSE) stay unbiased)."
+             of a bundle repeat their neighbours' pairs, which can shift the corrected values (I_s^c and the \
+             form factors stay unbiased)."
         );
     }
     if a.spec.sampler == Sampler::Sobol && a.estimate(Measure::MutualInformationCorrected).is_some()

@@ -33,6 +33,10 @@ pub struct CorrectedValues {
     pub entropy: f64,
     /// `X - H_s` (eq. 20 in a closed scene).
     pub mutual_information: f64,
+    /// Eq. (22) per line, `n_p - sum_ij F_ij^2`, with each row's `sum_j F_ij^2` estimated without bias
+    /// ([`super::rows::RowSums::unbiased_sum_of_squares`]): the plug-in reads it low by
+    /// `sum_i sum_j F_ij (1 - F_ij) / N_i`.
+    pub mse_per_line: f64,
 }
 
 /// Per-row statistics gathered in a first pass over the counts.
@@ -114,9 +118,18 @@ pub fn corrected_from_rows(
         .zip(&rows.sums)
         .map(|(a, r)| a * r.cross_entropy_with_areas())
         .sum();
+    // Summed as the plug-in's `sum F^2` is ([`super::visibility::discrete_from_rows`]): rows without
+    // segments add nothing.
+    let sum_f2: f64 = a
+        .iter()
+        .zip(&rows.sums)
+        .filter(|(_, r)| r.segments > 0)
+        .map(|(_, r)| r.unbiased_sum_of_squares())
+        .sum();
     CorrectedValues {
         entropy,
         mutual_information: cross - entropy,
+        mse_per_line: a.len() as f64 - sum_f2,
     }
 }
 

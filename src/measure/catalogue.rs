@@ -121,9 +121,14 @@ pub enum VerdictRule {
         /// +1, or -1 for `1 - ratio`.
         sign: f64,
     },
-    /// Unbiased whatever the coverage (eq. 22's estimate); `ok` when its estimated bias (from the rows'
-    /// sampling) is within its standard error.
+    /// A plug-in reading with an unbiased estimate whatever the coverage (eq. 22's); `ok` when its
+    /// estimated bias (from the rows' sampling) is within its standard error.
     Unbiased,
+    /// That unbiased estimate (each row's `sum_j x_j (x_j - 1) / (N_i (N_i - 1))` for `sum_j F_ij^2`):
+    /// it needs no coverage of the rows, only rows of at least two segments, which any coverage above
+    /// the `unusable` floor gives; like a corrected reading it assumes each row a multinomial sample,
+    /// and the jackknife's estimate of its bias, when there is one, must be within its standard error.
+    UnbiasedEstimate,
 }
 
 /// The bounds of the theory a reading must respect; one broken by more than twice the standard error
@@ -206,8 +211,10 @@ pub enum Measure {
     AccuracyCorrected,
     /// The discretisation relative error (I_s^c - I_s) / I_s^c (sec. 3.3).
     RelativeError,
-    /// The form factors' E(MSE) of one line, eq. (22).
+    /// The form factors' E(MSE) of one line, eq. (22), plug-in.
     MsePerLine,
+    /// Eq. (22) with each row's `sum_j F_ij^2` estimated without bias.
+    MsePerLineCorrected,
     /// The radiosity positional entropy, eq. (33).
     RadiosityPositionalEntropy,
     /// The radiosity entropy, eq. (34), plug-in.
@@ -381,6 +388,19 @@ pub const CATALOGUE: [MeasureInfo; Measure::COUNT] = [
         ..entry(Measure::MsePerLine, Visibility, "mse_per_line")
     },
     MeasureInfo {
+        label: "form-factor E(MSE), corrected",
+        symbol: "E(MSE) corrected",
+        unit: Unit::PerLine,
+        equation: "eq. 22",
+        corrects: Some(Measure::MsePerLine),
+        verdict: VerdictRule::UnbiasedEstimate,
+        ..entry(
+            Measure::MsePerLineCorrected,
+            Visibility,
+            "mse_per_line_corrected",
+        )
+    },
+    MeasureInfo {
         label: "radiosity positional entropy H_p",
         symbol: "radiosity H_p",
         equation: "eq. 33",
@@ -441,7 +461,7 @@ pub const CATALOGUE: [MeasureInfo; Measure::COUNT] = [
 
 impl Measure {
     /// How many measures the catalogue has.
-    pub const COUNT: usize = 16;
+    pub const COUNT: usize = 17;
 
     /// Every measure, in report order.
     pub const ALL: [Measure; Measure::COUNT] = {
@@ -472,7 +492,7 @@ impl Measure {
     /// give and randomised quasi-Monte Carlo lines do not.
     pub const fn rests_on_corrected_rows(self) -> bool {
         match self.info().verdict {
-            VerdictRule::Corrected => true,
+            VerdictRule::Corrected | VerdictRule::UnbiasedEstimate => true,
             VerdictRule::RatioOf { of, .. } => matches!(of.info().verdict, VerdictRule::Corrected),
             _ => false,
         }

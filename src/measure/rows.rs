@@ -199,6 +199,19 @@ impl RowSums {
         }
     }
 
+    /// The unbiased estimate of `sum_j F_ij^2` over the patches (escapes are an outcome, not a patch):
+    /// `sum_j x_j (x_j - 1) / (N (N - 1))`, since a row's counts are a multinomial sample of its `N`
+    /// segments and `E[x (x - 1)] = N (N - 1) F^2`. A row of fewer than two segments has none; its
+    /// plug-in value stands in.
+    pub fn unbiased_sum_of_squares(&self) -> f64 {
+        let n = self.n();
+        if n < 2.0 {
+            return self.sum_of_squares();
+        }
+        let to_patches = (self.segments - self.escapes) as f64;
+        (self.x_squared - to_patches) / (n * (n - 1.0))
+    }
+
     /// The row's entropy over the patches, in bits, by `estimator` (which must be the one the sums were
     /// gathered for, see [`Rows`]); `None` for Chao–Shen, which needs each outcome with its row's size
     /// ([`super::bias`] computes it in a second pass).
@@ -377,6 +390,51 @@ mod tests {
 
     /// A row's integer sums counted straight from the keys (a map of outcomes per row, a segment from a
     /// patch to itself twice), in both count layouts, with escapes; and the same as a full gather's.
+    /// The unbiased `sum_j F_ij^2` has the row's exact `sum_j F_ij^2` as its expectation over every
+    /// multinomial sample of 2 to 7 segments (three patches and the escapes as a fourth outcome, which
+    /// is no patch), where the plug-in's is higher by `sum_j F_ij (1 - F_ij) / N`.
+    #[test]
+    fn the_unbiased_sum_of_squares_has_the_exact_expectation() {
+        let p = [0.5, 0.3, 0.15, 0.05];
+        let exact: f64 = p[..3].iter().map(|q| q * q).sum();
+        let spread: f64 = p[..3].iter().map(|q| q * (1.0 - q)).sum();
+        let factorial = |k: u64| (1..=k).map(|v| v as f64).product::<f64>();
+        for n in 2u64..=7 {
+            let (mut unbiased, mut plug_in, mut total) = (0.0, 0.0, 0.0);
+            for x0 in 0..=n {
+                for x1 in 0..=n - x0 {
+                    for x2 in 0..=n - x0 - x1 {
+                        let xs = [x0, x1, x2, n - x0 - x1 - x2];
+                        let prob = factorial(n)
+                            * xs.iter()
+                                .zip(p)
+                                .map(|(&x, q)| q.powi(x as i32) / factorial(x))
+                                .product::<f64>();
+                        let row = RowSums {
+                            segments: n,
+                            escapes: xs[3],
+                            x_squared: xs[..3].iter().map(|&x| (x * x) as f64).sum(),
+                            ..RowSums::default()
+                        };
+                        unbiased += prob * row.unbiased_sum_of_squares();
+                        plug_in += prob * row.sum_of_squares();
+                        total += prob;
+                    }
+                }
+            }
+            assert!((total - 1.0).abs() < 1e-12, "{n}: {total}");
+            assert!(
+                (unbiased - exact).abs() < 1e-12,
+                "{n}: {unbiased} vs {exact}"
+            );
+            let expected = exact + spread / n as f64;
+            assert!(
+                (plug_in - expected).abs() < 1e-12,
+                "{n}: {plug_in} vs {expected}"
+            );
+        }
+    }
+
     #[test]
     fn outcome_frequencies_count_each_rows_outcomes() {
         use std::collections::BTreeMap;

@@ -50,7 +50,7 @@ impl Sampling {
             sampled_rows += 1;
             segments += a_i * row.n();
             coverage += a_i * row_coverage(row, 0.0);
-            mse_bias -= row.sum_of_squares() - unbiased_sum_of_squares(row);
+            mse_bias -= row.sum_of_squares() - row.unbiased_sum_of_squares();
         }
         let sampled_weight: f64 = a
             .iter()
@@ -141,17 +141,6 @@ fn row_coverage(row: &RowSums, more: f64) -> f64 {
         (n - 1.0) * (f1 - 1.0) / ((n - 1.0) * (f1 - 1.0) + 2.0)
     };
     (1.0 - f1 / n * q.powf(more + 1.0)).clamp(0.0, 1.0)
-}
-
-/// The unbiased estimate of a row's `sum_j F_ij^2` over the patches (escapes are an outcome, not a
-/// patch): `sum_j x_j (x_j - 1) / (N (N - 1))`.
-fn unbiased_sum_of_squares(row: &RowSums) -> f64 {
-    let n = row.n();
-    if n < 2.0 {
-        return row.sum_of_squares();
-    }
-    let to_patches = (row.segments - row.escapes) as f64;
-    (row.x_squared - to_patches) / (n * (n - 1.0))
 }
 
 #[cfg(test)]
