@@ -36,7 +36,7 @@ use crate::run::{
     RunState, SpecError, StartError, StopReason, TargetReading,
 };
 use crate::sample::bounds::sphere_lines;
-use crate::sample::lines::Sampler;
+use crate::sample::lines::{LineSource, Sampler};
 use crate::sample::tally::{ObjectSides, Tally, Wanted};
 use crate::scene::Scene;
 use crate::trace::{TraceError, Tracer};
@@ -452,6 +452,8 @@ fn replication(cfg: &RunSpec, run: &FinishedRun, enclose: bool) -> Replication {
         replicable,
         jackknife: replicable && cfg.errors == ErrorMethod::Jackknife,
         debias: cfg.sampler == Sampler::Sobol,
+        dependent_lines: cfg.sampler == Sampler::Sobol
+            || matches!(cfg.source, LineSource::Bundles { .. }),
     }
 }
 

@@ -473,7 +473,7 @@ fn verdict(
         VerdictRule::Unbiased => {
             let (report, _) = evidence.discrete(info.family)?;
             // The rows' multinomial estimate of the plug-in's bias, unless the jackknife gives one (Sobol'
-            // lines, whose rows are no multinomial samples).
+            // lines or bundles, whose rows are no multinomial samples).
             let bias = evidence
                 .bias
                 .and_then(|b| b.of(m))
