@@ -442,6 +442,7 @@ pub fn run(args: &AnalyzeArgs) -> Result<Exit, Failure> {
         Some(file) => resumed_run(args, file)?,
         None => new_run(args, args.scene.as_deref().unwrap_or("-"))?,
     };
+    output::check_not_read_by(&outputs, &runner.scene)?;
     // The per-patch files asked for now decide what is shared out at the end; what is gathered is what
     // the state gathers.
     let cfg = RunSpec {

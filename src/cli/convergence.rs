@@ -120,6 +120,7 @@ pub fn run(args: &ConvergenceArgs) -> Result<Exit, Failure> {
         plot::check_target(p).map_err(Failure::bad_input)?;
     }
     let runner = Runner::new(&args.scene, &args.run)?;
+    output::check_not_read_by(&outputs, &runner.scene)?;
     let mut counts = args.lines.clone();
     counts.sort_unstable();
     counts.dedup();

@@ -29,6 +29,7 @@ pub struct ExportArgs {
 pub fn run(args: &ExportArgs) -> Result<Exit, Failure> {
     let format = planned_output(&args.output, &args.scene)?;
     let scene = load_scene(&args.scene, &args.input.options(), &args.input.policy())?;
+    check_not_read(&args.output, format, &scene)?;
     let beside = write_scene(&scene, format, &args.output)?;
     output::note(&format!(
         "wrote {} as {}, {} patches{beside}",
@@ -54,6 +55,15 @@ pub fn planned_output(output: &Path, scene: &str) -> Result<WriteFormat, Failure
     };
     check_outputs(output, format.companion(output).as_deref(), scene)?;
     Ok(format)
+}
+
+/// Refuses, once `scene` is read, to write `output` (or the MTL library beside it) over a file the
+/// scene read.
+pub fn check_not_read(output: &Path, format: WriteFormat, scene: &Scene) -> Result<(), Failure> {
+    let companion = format.companion(output);
+    let mut outputs = vec![("-o", output)];
+    outputs.extend(companion.as_deref().map(|m| ("its MTL library", m)));
+    output::check_not_read_by(&outputs, scene)
 }
 
 /// Writes a scene in `format` at `output` (each file whole or not at all), warning first of what the

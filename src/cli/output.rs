@@ -211,6 +211,28 @@ pub fn check_distinct(
     Ok(())
 }
 
+/// Refuses, once the scene is read and before any work on it, an output that is a file the scene named
+/// and scx read (an MTL library, a glTF buffer): as much an input as the scene file, which
+/// [`check_distinct`] could not know of before the scene was read.
+pub fn check_not_read_by(
+    outputs: &[(&str, &Path)],
+    scene: &scene_complexity::Scene,
+) -> Result<(), Failure> {
+    for (flag, path) in outputs {
+        let Some(id) = identity(path) else { continue };
+        if let Some(read) = scene.files_read.iter().find(|r| **r == id) {
+            return Err(Failure::bad_input(format!(
+                "{flag} {} is {}, which the scene {} reads: writing it would replace what is read; \
+                 name another file",
+                path.display(),
+                read.display(),
+                scene.name
+            )));
+        }
+    }
+    Ok(())
+}
+
 /// Writes a file whole or not at all (a temporary beside it, renamed over it; into a device or FIFO as
 /// a stream) from what `fill` writes, and says so.
 pub fn write_with(

@@ -74,6 +74,7 @@ fn parse_patches(s: &str) -> Result<u64, String> {
 pub fn run(args: &RefineArgs) -> Result<Exit, Failure> {
     let format = super::export::planned_output(&args.output, &args.scene)?;
     let scene = load_scene(&args.scene, &args.input.options(), &args.input.policy())?;
+    super::export::check_not_read(&args.output, format, &scene)?;
     let backend = TracerArg::backend(args.tracer.value);
     // Check the backend once up front, so that an unavailable one is a clear input error.
     make_tracer(backend, &scene, Query::Single).map_err(Failure::bad_input)?;

@@ -180,6 +180,7 @@ pub fn run(args: &RenderArgs) -> Result<Exit, Failure> {
         )));
     }
     let runner = Runner::new(&args.scene, &args.run)?;
+    output::check_not_read_by(&outputs, &runner.scene)?;
     if args.color.needs_light() && !emits(&runner.scene)? {
         return Err(Failure::bad_input(format!(
             "{}: --color {} needs light, and nothing in this scene emits (no material has Ke above 0)",

@@ -321,6 +321,7 @@ impl SceneBuilder {
             normalization,
             area_scene_units: 0.0,
             warnings: std::mem::take(&mut self.warnings),
+            files_read: Vec::new(),
         };
         let mut dropped_triangles = 0usize;
         // How many polygons were dropped, and the first of them.

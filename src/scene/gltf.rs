@@ -43,12 +43,14 @@ pub(crate) fn load_bytes(
     let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
         load_document(shown, bytes, folder, options)
     }));
-    result.unwrap_or_else(|_| {
+    let mut scene = result.unwrap_or_else(|_| {
         Err(SceneError::File {
             path: shown.to_string(),
             message: "malformed glTF: the glTF reader failed on it".into(),
         })
-    })
+    })?;
+    scene.files_read = folder.files_read();
+    Ok(scene)
 }
 
 fn load_document(

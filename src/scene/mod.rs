@@ -181,6 +181,9 @@ pub struct Scene {
     pub area_scene_units: f64,
     /// Non-fatal problems found while loading (missing MTL, dropped degenerate triangles, ...).
     pub warnings: Vec<SceneWarning>,
+    /// The files the scene's own file named and that were read (MTL libraries, glTF buffers), as
+    /// canonical paths: inputs as much as the scene file, so nothing a run writes may replace them.
+    pub files_read: Vec<std::path::PathBuf>,
 }
 
 impl Scene {

@@ -46,12 +46,14 @@ pub(crate) fn load_obj_text(
     folder: &Folder,
     options: &SceneOptions,
 ) -> Result<Scene, SceneError> {
-    load_text_with(
+    let mut scene = load_text_with(
         shown,
         text,
         &|mtl: &Path| read_libraries(folder, mtl),
         options,
-    )
+    )?;
+    scene.files_read = folder.files_read();
+    Ok(scene)
 }
 
 /// The MTL text an `mtllib` statement names, read in the OBJ's folder. The statement may list several

@@ -260,6 +260,14 @@ impl Folder {
         Folder::new(path.parent().unwrap_or(Path::new("")), policy)
     }
 
+    /// The files read through this folder so far (canonical paths, sorted): what a scene named and scx
+    /// read, which nothing the same run writes may replace.
+    pub fn files_read(&self) -> Vec<PathBuf> {
+        let mut files: Vec<PathBuf> = self.read.borrow().keys().cloned().collect();
+        files.sort();
+        files
+    }
+
     /// The policy this folder is read under.
     pub fn policy(&self) -> ReadPolicy {
         self.policy

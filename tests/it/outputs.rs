@@ -179,6 +179,64 @@ fn one_path_for_two_outputs_is_refused() {
     assert_eq!(code(&out), Some(2), "{}", stderr(&out));
 }
 
+/// A file the scene names and scx reads (an OBJ's MTL library, a glTF buffer) is an input as much as
+/// the scene file: no output may replace it, whichever command writes (the MTL library written beside
+/// an exported OBJ included).
+#[test]
+fn files_a_scene_reads_are_inputs() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let mtl = b"newmtl red\nKd 0.8 0.1 0.1\n";
+    std::fs::write(d.join("out.mtl"), mtl).unwrap();
+    std::fs::write(
+        d.join("q.obj"),
+        "mtllib out.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nusemtl red\nf 1 2 3\n",
+    )
+    .unwrap();
+    // A glTF whose one triangle lies in a buffer file of its own.
+    let corners: [f32; 9] = [0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0];
+    let bin: Vec<u8> = corners.iter().flat_map(|c| c.to_le_bytes()).collect();
+    std::fs::write(d.join("tri.bin"), &bin).unwrap();
+    std::fs::write(
+        d.join("tri.gltf"),
+        r#"{"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":[0]}],"nodes":[{"mesh":0}],
+        "meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}],
+        "accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3",
+          "min":[0,0,0],"max":[1,1,0]}],
+        "bufferViews":[{"buffer":0,"byteLength":36}],
+        "buffers":[{"uri":"tri.bin","byteLength":36}]}"#,
+    )
+    .unwrap();
+    let out = scx_in(d, &["export", "tri.gltf", "-o", "tri.obj"]);
+    assert_eq!(code(&out), Some(0), "the glTF loads: {}", stderr(&out));
+    let cases: Vec<(Vec<&str>, &str)> = vec![
+        (vec!["export", "q.obj", "-o", "out.obj"], "its MTL library out.mtl"),
+        (vec!["export", "q.obj", "-o", "out.mtl.ply"], ""),
+        (vec!["refine", "q.obj", "-o", "out.obj", "--patches", "4", "--strategy", "uniform"], "its MTL library out.mtl"),
+        (vec!["analyze", "q.obj", "--lines", "1e4", "-o", "out.mtl"], "-o out.mtl"),
+        (vec!["render", "q.obj", "-o", "x.png", "--patches-mesh", "out.mtl"], ""),
+    ];
+    for (args, names) in &cases {
+        let out = scx_in(d, args);
+        let err = stderr(&out);
+        if names.is_empty() {
+            // Refused for another reason (the extension) or written elsewhere: the library stays.
+            assert_eq!(read(&d.join("out.mtl")), mtl, "{args:?}: {err}");
+            continue;
+        }
+        assert_eq!(code(&out), Some(2), "{args:?}: {err}");
+        for name in [*names, "which the scene q.obj reads"] {
+            assert!(err.contains(name), "{args:?} should say {name}: {err}");
+        }
+        assert_eq!(read(&d.join("out.mtl")), mtl, "{args:?} replaced the library");
+    }
+    let out = scx_in(d, &["analyze", "tri.gltf", "--lines", "1e4", "-o", "tri.bin"]);
+    let err = stderr(&out);
+    assert_eq!(code(&out), Some(2), "{err}");
+    assert!(err.contains("which the scene tri.gltf reads"), "{err}");
+    assert_eq!(read(&d.join("tri.bin")), bin);
+}
+
 /// Devices are written into as streams, states refused there; directories are refused before work;
 /// a symbolic link to a file is written through (the link stays, its target holds the output).
 #[test]
