@@ -119,7 +119,7 @@ pub use analysis::{
     analyze, cast, finish, Analysis, AnalysisError, HalfRun, LinesAdvice, ObjectResult,
     PatchResult, RadiosityOutcome, RadiositySolve, Reliability, RunWarning, RunWarningKind,
     SamplingReport, SolveFailure, TargetOutcome, Verdict, ADVICE_SETTLED_GROWTH, COVERAGE_OK,
-    COVERAGE_UNUSABLE, ENVIRONMENT,
+    COVERAGE_UNUSABLE, ENVIRONMENT, MIN_PAIRS,
 };
 pub use measure::catalogue::{
     Bound, ByMeasure, Family, Measure, MeasureInfo, Needs, PatchMeasure, PatchMeasureInfo, Unit,

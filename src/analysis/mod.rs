@@ -21,7 +21,7 @@ pub use patch_results::{PatchLight, PatchResult};
 pub use radiosity::{RadiosityOutcome, RadiositySolve, SolveFailure, NOTHING_EMITS};
 pub use reliability::{
     HalfRun, LinesAdvice, Reliability, SamplingReport, Verdict, ADVICE_SETTLED_GROWTH, COVERAGE_OK,
-    COVERAGE_UNUSABLE,
+    COVERAGE_UNUSABLE, MIN_PAIRS,
 };
 pub use warnings::{RunWarning, RunWarningKind};
 

@@ -27,8 +27,9 @@ use crate::measure::{ByMeasure, Estimate, Family, Measure};
 pub const COVERAGE_OK: f64 = 0.99;
 /// Below this coverage every discrete reading is `unusable`.
 pub const COVERAGE_UNUSABLE: f64 = 0.5;
-/// I_s^c needs at least this many pairs in the run to be `ok`.
-const MIN_PAIRS: u64 = 1000;
+/// I_s^c needs at least this many pairs in the run to be `ok` (with `--enclose`, pairs with the
+/// environment count).
+pub const MIN_PAIRS: u64 = 1000;
 
 /// What a reading is worth.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
@@ -457,6 +458,10 @@ fn verdict(
                 .cloned()
                 .unwrap_or_else(|| Reliability::new(Verdict::Unusable));
             r.flags.clear();
+            // Nor is the ratio worth more than its denominator.
+            if let Some(c) = so_far.get(Measure::ContinuousMutualInformation) {
+                r.verdict = r.verdict.max(c.verdict);
+            }
             r.estimated_bias = r
                 .estimated_bias
                 .zip(continuous)

@@ -267,8 +267,9 @@ pub(super) fn visibility_estimates(
     let c = &run.total.counters;
     let facts = RunFacts {
         lines: sphere_lines,
-        pairs: c.pairs,
-        // Enclosed, the escapes are pairs with the environment: only back sides still lose segments.
+        // Enclosed, the escapes are pairs with the environment (I_s^c has their terms too), and only back
+        // sides still lose segments.
+        pairs: if enclose { c.pairs + c.escapes } else { c.pairs },
         open: c.absorbed > 0 || (c.escapes > 0 && !enclose),
         short_chords: c.short_chords,
     };

@@ -14,7 +14,7 @@ use scene_complexity::VerdictRule;
 use scene_complexity::{sphere_lines, ErrorMethod, LineBound, Sampler, Shard, StopReason, Tracing};
 use scene_complexity::{
     Analysis, LinesAdvice, RadiosityOutcome, Reliability, SamplingReport, TargetOutcome, Verdict,
-    COVERAGE_OK,
+    COVERAGE_OK, COVERAGE_UNUSABLE, MIN_PAIRS,
 };
 use scene_complexity::{Estimate, Family, Measure};
 
@@ -431,12 +431,36 @@ fn reliability_summary(s: &mut String, a: &Analysis) {
         .max();
     if worst.is_some_and(|v| v != Verdict::Ok) {
         let needed = corrected_needs(a);
+        let why = unusable_reasons(a);
         let _ = writeln!(
             s,
             "reliability: an `undersampled` reading is biased beyond its standard error, an `unusable` one \
-             cannot be trusted (rows' coverage below 0.5){needed} (docs/results.md, \"Reading the reliability \
-             verdict\")."
+             cannot be trusted{why}{needed} (docs/results.md, \"Reading the reliability verdict\")."
         );
+    }
+}
+
+/// Why this run's `unusable` readings are so, for the reliability line: rows' coverage below 0.5 (the
+/// discrete readings), too few visible pairs (the means such as I_s^c); empty when none is.
+fn unusable_reasons(a: &Analysis) -> String {
+    let unusable = |m: Measure| a.verdict(m) == Some(Verdict::Unusable);
+    let mut reasons = Vec::new();
+    let coverage_low = a
+        .sampling
+        .as_ref()
+        .is_some_and(|smp| smp.sampling.coverage < COVERAGE_UNUSABLE);
+    if coverage_low && unusable(Measure::Entropy) {
+        reasons.push(format!("rows' coverage below {COVERAGE_UNUSABLE}"));
+    }
+    if unusable(Measure::ContinuousMutualInformation) {
+        reasons.push(format!(
+            "I_s^c from fewer than {MIN_PAIRS} visible pairs, or without a standard error"
+        ));
+    }
+    if reasons.is_empty() {
+        String::new()
+    } else {
+        format!(" ({})", reasons.join("; "))
     }
 }
 

@@ -113,8 +113,9 @@ pub enum VerdictRule {
     },
     /// A bias-corrected reading: the rows' coverage.
     Corrected,
-    /// A ratio to I_s^c of the reading `of`: that reading's verdict (not its flags), its bias divided by
-    /// I_s^c times `sign`, and `unusable` when I_s^c is not distinguishable from 0.
+    /// A ratio to I_s^c of the reading `of`: that reading's verdict (not its flags) or I_s^c's, whichever
+    /// is worse, its bias divided by I_s^c times `sign`, and `unusable` when I_s^c is not
+    /// distinguishable from 0.
     RatioOf {
         /// The reading in the numerator.
         of: Measure,

@@ -359,3 +359,45 @@ fn the_lines_advice_says_when_it_is_a_lower_bound() {
         "@sphere:2 at 1.05 x the {n} lines advised: coverage {c}"
     );
 }
+
+/// An object in open space measured against its surroundings (`--enclose`): its only pairs are with the
+/// environment, and they are what I_s^c is read from, so it is judged on them. A run of too few pairs
+/// says that is why I_s^c is `unusable` (not the rows' coverage, which is full), and the ratios to
+/// I_s^c are worth no more than it.
+#[test]
+fn i_s_c_is_judged_on_the_pairs_it_is_read_from() {
+    let enclosed = json_run(&[
+        "@cube:2",
+        "--flip-normals",
+        "--enclose",
+        "--lines",
+        "1e5",
+    ]);
+    for m in [
+        "entropy",
+        "mutual_information",
+        "continuous_mutual_information",
+        "accuracy",
+        "mse_per_line",
+    ] {
+        assert_eq!(verdict(&enclosed, &[m]), "ok", "{m}: {}", enclosed["visibility"][m]);
+    }
+
+    let out = scx(&["analyze", "@cube:1", "--lines", "300", "--tracer", "rust"]);
+    let report = String::from_utf8_lossy(&out.stdout).into_owned();
+    let few = json_run(&["@cube:1", "--lines", "300"]);
+    assert_eq!(
+        few["sampling"]["coverage"].as_f64(),
+        Some(1.0),
+        "{}",
+        few["sampling"]
+    );
+    assert_eq!(verdict(&few, &["continuous_mutual_information"]), "unusable");
+    assert_eq!(verdict(&few, &["accuracy"]), "unusable");
+    assert_eq!(verdict(&few, &["accuracy", "corrected"]), "unusable");
+    assert_eq!(verdict(&few, &["mutual_information"]), "ok");
+    assert!(
+        report.contains("I_s^c from fewer than 1000 visible pairs") && !report.contains("coverage below"),
+        "{report}"
+    );
+}
