@@ -27,7 +27,7 @@ pub struct ConvergenceArgs {
     scene: String,
     /// The line counts to run, comma separated (accepts `1e6`).
     #[arg(long, value_delimiter = ',', value_parser = parse_count, default_value = "1e4,1e5,1e6,1e7",
-          allow_negative_numbers = true)]
+          allow_hyphen_values = true)]
     lines: Vec<u64>,
     /// Runs per line count (seeds seed, seed+1, ...).
     #[arg(long, default_value_t = 1, value_parser = parse_repeats, allow_negative_numbers = true)]

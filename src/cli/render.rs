@@ -44,7 +44,7 @@ pub struct RenderArgs {
           requires = "patches_mesh")]
     patches_mesh_format: MeshFormat,
     /// Global lines of the run behind the colours (accepts `1e7`).
-    #[arg(long, default_value = "1e6", value_parser = parse_count, allow_negative_numbers = true)]
+    #[arg(long, default_value = "1e6", value_parser = parse_count, allow_hyphen_values = true)]
     lines: u64,
     #[command(flatten)]
     run: RunOptions,
@@ -54,7 +54,7 @@ pub struct RenderArgs {
     /// seen through the opening) and around an object, the one showing most of the scene's area from
     /// the front, with fewest back sides, kept (the classic view from the -z wall unless another is
     /// over 10% better).
-    #[arg(long, value_parser = parse_camera, allow_negative_numbers = true)]
+    #[arg(long, value_parser = parse_camera, allow_hyphen_values = true)]
     camera: Option<Camera>,
     /// The picture's size in pixels, WIDTHxHEIGHT (the colour bar is added on the right).
     #[arg(long, default_value = "800x600", value_parser = parse_size)]
@@ -66,7 +66,7 @@ pub struct RenderArgs {
     per_area: bool,
     /// The values at the two ends of the colour bar, `LO,HI`. Default: the range of the patches
     /// between the 1% and 99% area quantiles (values beyond are drawn in the end colours).
-    #[arg(long, value_parser = parse_range, allow_negative_numbers = true)]
+    #[arg(long, value_parser = parse_range, allow_hyphen_values = true)]
     range: Option<(f64, f64)>,
     /// How values map to colours: `linear`, `log` (equal ratios, equal steps; positive values), or
     /// `auto` (log for the radiosities, which span orders of magnitude; linear otherwise).

@@ -15,7 +15,7 @@ use super::runner::thread_pool;
 #[derive(clap::Args, Debug)]
 pub struct ReproduceArgs {
     /// The tables to regenerate, comma separated (default: all, 1 to 9).
-    #[arg(long, value_delimiter = ',', value_parser = parse_table, allow_negative_numbers = true)]
+    #[arg(long, value_delimiter = ',', value_parser = parse_table, allow_hyphen_values = true)]
     table: Vec<u8>,
     /// Lines per run: `default` (the paper's counts, at most 1e8 per run), `paper` (the paper's counts,
     /// 1e9 included), a factor on the defaults (`x0.1`), or one count for every run (`1e6`).

@@ -775,7 +775,7 @@ fn assert_usage(out: &Output, expected: &[&str]) {
 fn numeric_flags_name_their_range() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    let cases: [(&[&str], &[&str]); 7] = [
+    let cases: [(&[&str], &[&str]); 9] = [
         (
             &["analyze", "@cube:3", "--groups", "1e9"],
             &["--groups", "number of groups", "from 2 to 1024"],
@@ -801,10 +801,37 @@ fn numeric_flags_name_their_range() {
             &["calibrate", "--scene", "@cube", "--seeds", "0"],
             &["--seeds", "runs per cell", "from 1"],
         ),
+        (
+            &["convergence", "@cube:2", "--lines", "-1,5"],
+            &["--lines", "cannot be negative"],
+        ),
+        (
+            &["reproduce", "--table", "-1,2"],
+            &["--table", "cannot be negative"],
+        ),
     ];
     for (args, expected) in cases {
         assert_usage(&scx_in(d, args), expected);
     }
+    // Lists that start with a negative number are values, not flags.
+    let out = scx_in(
+        d,
+        &[
+            "render",
+            "@cube:2",
+            "--color",
+            "mutual-information",
+            "--lines",
+            "1e4",
+            "-o",
+            "c.png",
+            "--camera",
+            "-0.5,0.5,2.5,0.5,0.5,0.5,0,1,0,50",
+            "--range",
+            "-1,1",
+        ],
+    );
+    assert_eq!(code(&out), Some(0), "{}", stderr(&out));
 }
 
 /// `refine --patches 0` speaks of patches, not of "a line count"; a target beyond the largest scene scx
