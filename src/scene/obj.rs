@@ -48,12 +48,18 @@ pub(crate) fn load_obj_text(
 ) -> Result<Scene, SceneError> {
     let mut scene = load_text_with(
         shown,
-        text,
+        without_bom(text),
         &|mtl: &Path| read_libraries(folder, mtl),
         options,
     )?;
     scene.files_read = folder.files_read();
     Ok(scene)
+}
+
+/// Text without the byte-order mark some editors put first: left in, it would glue itself to the first
+/// statement's keyword (`\u{feff}mtllib`), and that statement would be dropped unseen.
+fn without_bom(text: &str) -> &str {
+    text.strip_prefix('\u{feff}').unwrap_or(text)
 }
 
 /// The MTL text an `mtllib` statement names, read in the OBJ's folder. The statement may list several
@@ -124,7 +130,7 @@ fn library_text(fetched: Fetched) -> Result<(String, String), MtlError> {
         return Ok((name, String::new()));
     }
     match String::from_utf8(fetched.bytes.to_vec()) {
-        Ok(text) => Ok((name, text)),
+        Ok(text) => Ok((name, without_bom(&text).to_string())),
         Err(e) => Err(MtlErrorKind::NotText {
             at: e.utf8_error().valid_up_to(),
             name,

@@ -1032,3 +1032,25 @@ fn scenes_written_in_every_format_read_back_the_same() {
     );
     assert!(!dir.path().join("cube.txt").exists());
 }
+
+/// A byte-order mark before the OBJ's first statement (or the MTL's) is no part of it: the library
+/// that statement names is read and its light kept, where the mark glued to `mtllib` used to drop the
+/// statement unseen.
+#[test]
+fn a_byte_order_mark_is_not_part_of_the_first_statement() {
+    let dir = tempfile::tempdir().unwrap();
+    write(
+        dir.path(),
+        "lit.mtl",
+        "\u{feff}newmtl lamp\nKd 0.5 0.5 0.5\nKe 2 2 2\n".as_bytes(),
+    );
+    let obj = write(
+        dir.path(),
+        "lit.obj",
+        "\u{feff}mtllib lit.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nusemtl lamp\nf 1 2 3 4\n".as_bytes(),
+    );
+    let scene = load_file(&obj, &SceneOptions::default());
+    assert!(scene.warnings.is_empty(), "{}", messages(&scene.warnings));
+    let lamp = &scene.materials[scene.patches[0].material as usize];
+    assert_eq!((lamp.name.as_str(), lamp.emission, lamp.reflectance), ("lamp", 2.0, 0.5));
+}
