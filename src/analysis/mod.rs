@@ -359,6 +359,12 @@ pub fn finish(
         visibility.environment_area,
     );
     warnings.extend(orientation::warnings(scene, &total, enclose));
+    warnings.extend(warnings::fewer_groups(
+        &scene.name,
+        (cfg.groups.max(2), visibility.groups),
+        covered.len(),
+        BatchPlan::lines_for_batches(cfg.groups.max(2) as u64, cfg.budget.is_open_ended()),
+    ));
     let mut visibility = visibility;
     if total.counters.pairs == 0 && !enclose {
         // No pair: only H_p (exact, from the areas) is defined; zeros would read as measurements.

@@ -28,6 +28,8 @@ pub enum RunWarningKind {
     LightSeenFromBehind,
     /// Closed solids whose back sides are seen from front sides inside them.
     SeenInsideSolid,
+    /// The run had fewer standard-error groups than asked (`--groups`): too few batches to deal.
+    FewerGroups,
 }
 
 impl RunWarningKind {
@@ -43,6 +45,7 @@ impl RunWarningKind {
             RunWarningKind::OneSided => "one-sided",
             RunWarningKind::LightSeenFromBehind => "light-seen-from-behind",
             RunWarningKind::SeenInsideSolid => "seen-inside-solid",
+            RunWarningKind::FewerGroups => "fewer-groups",
         }
     }
 }
@@ -120,4 +123,43 @@ pub(crate) fn of_run(
         );
     }
     w
+}
+
+/// What a run whose lines are `batches` batches gets for standard errors when they fill fewer groups
+/// (`used`) than the `asked` ones: a group is made of whole batches. `needed` is how many lines (as
+/// `--lines` counts them) give every group a batch. `None` when it has the groups asked for.
+pub(crate) fn fewer_groups(
+    scene: &str,
+    (asked, used): (usize, usize),
+    batches: u64,
+    needed: u64,
+) -> Option<RunWarning> {
+    if used >= asked {
+        return None;
+    }
+    let what = if used == 0 {
+        "the run cast no line, so it has no standard errors".to_string()
+    } else if used < 2 {
+        format!(
+            "the run's lines ({batches} batch(es)) fill one group, so it has no standard errors (they \
+             are the spread of two groups or more)"
+        )
+    } else {
+        format!(
+            "the run's {batches} batches of lines fill {used} groups, not the {asked} asked \
+             (--groups), so its standard errors rest on {used} groups and its intervals are wider \
+             (Student's t, {} degrees of freedom)",
+            used - 1
+        )
+    };
+    let message = format!(
+        "{scene}: {what}; a group holds whole batches: {asked} groups need at least {needed} lines"
+    );
+    Some(
+        RunWarning::new(RunWarningKind::FewerGroups, message).with_numbers(&[
+            ("asked", asked as f64),
+            ("groups", used as f64),
+            ("lines_needed", needed as f64),
+        ]),
+    )
 }

@@ -327,13 +327,21 @@ pub fn table(run: &RunInfo, a: &Analysis) -> String {
             a.groups, a.groups
         ),
     };
-    let _ = writeln!(
-        s,
-        "\nstandard errors: {errors} (statistical error only).\n\
-         95% intervals: value ± {:.3} stderr (Student's t, {} degrees of freedom).",
-        a.interval_quantile(),
-        a.groups.saturating_sub(1),
-    );
+    if a.groups < 2 {
+        let _ = writeln!(
+            s,
+            "\nstandard errors: none: the lines fill fewer than two groups, and a standard error is the spread of two \
+             or more (the warning says how many lines it takes)."
+        );
+    } else {
+        let _ = writeln!(
+            s,
+            "\nstandard errors: {errors} (statistical error only).\n\
+             95% intervals: value ± {:.3} stderr (Student's t, {} degrees of freedom).",
+            a.interval_quantile(),
+            a.groups - 1,
+        );
+    }
     if a.estimate(Measure::MutualInformationCorrected).is_some() {
         let _ = writeln!(
             s,

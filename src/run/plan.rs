@@ -42,6 +42,25 @@ impl BatchPlan {
         BatchPlan { lines, batch_size }
     }
 
+    /// The fewest lines whose plan has at least `batches` batches (the standard-error groups a run can
+    /// have): [`BatchPlan::new`]'s, or with `open_ended` [`BatchPlan::open_ended`]'s full batches; for
+    /// bundled lines, about as many.
+    pub fn lines_for_batches(batches: u64, open_ended: bool) -> u64 {
+        let k = batches.max(1);
+        if open_ended {
+            return (k - 1) * Self::MAX_BATCH + 1;
+        }
+        if k <= Self::MIN_BATCHES {
+            (k - 1) * Self::MIN_BATCH + 1
+        } else if k == Self::MIN_BATCHES + 1 {
+            // One line past MIN_BATCHES full minimal batches starts one more; from there on the batch
+            // grows with the lines, and a 66th batch waits for full batches.
+            Self::MIN_BATCHES * Self::MIN_BATCH + 1
+        } else {
+            (k - 1) * Self::MAX_BATCH + 1
+        }
+    }
+
     /// The plan for lines from `source`: the line count is rounded up to whole bundles, and each batch
     /// holds whole bundles only, so that a bundle never straddles two batches (nor two standard-error
     /// groups, which are made of whole batches). For independent lines this is [`BatchPlan::new`].
@@ -211,6 +230,27 @@ impl BatchSet {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// `lines_for_batches` is the least line count from which some plan has that many batches: found by
+    /// walking every line count (the batches do not grow monotonically with the lines).
+    #[test]
+    fn the_lines_for_a_number_of_batches_are_the_least() {
+        let mut most = 0;
+        let mut first_with = vec![0u64];
+        for lines in 1..=110 * BatchPlan::MAX_BATCH {
+            let batches = BatchPlan::new(lines).batches();
+            while batches > most {
+                most += 1;
+                first_with.push(lines);
+            }
+        }
+        for k in 1..=100u64 {
+            assert_eq!(BatchPlan::lines_for_batches(k, false), first_with[k as usize], "{k}");
+            let open = BatchPlan::lines_for_batches(k, true);
+            assert!(BatchPlan::open_ended(open, LineSource::default()).batches() >= k);
+            assert!(BatchPlan::open_ended(open - 1, LineSource::default()).batches() < k);
+        }
+    }
 
     #[test]
     fn batch_sets_join_split_and_complement() {

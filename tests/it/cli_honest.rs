@@ -401,3 +401,42 @@ fn i_s_c_is_judged_on_the_pairs_it_is_read_from() {
         "{report}"
     );
 }
+
+/// A run too short for the groups asked says so (issue of a review: `--lines 900` quietly used 4 groups,
+/// `--lines 100` printed "± inf" on "0 degrees of freedom"), and the lines it names do give them.
+#[test]
+fn fewer_groups_than_asked_are_a_warning() {
+    let fewer = |doc: &serde_json::Value| {
+        doc["warnings"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|w| w["code"] == "fewer-groups")
+            .cloned()
+    };
+    let short = json_run(&["@cube:2", "--lines", "900"]);
+    let w = fewer(&short).expect("a warning");
+    assert_eq!(short["groups"], 4);
+    assert_eq!(w["numbers"]["groups"], 4.0);
+    assert_eq!(w["numbers"]["asked"], 16.0);
+    let needed = w["numbers"]["lines_needed"].as_f64().unwrap() as u64;
+    let enough = json_run(&["@cube:2", "--lines", &needed.to_string()]);
+    assert_eq!(enough["groups"], 16);
+    assert!(fewer(&enough).is_none(), "{}", enough["warnings"]);
+    let below = json_run(&["@cube:2", "--lines", &(needed - 1).to_string()]);
+    assert!(fewer(&below).is_some(), "{needed} is the least: {}", below["groups"]);
+
+    let many = json_run(&["@cube:2", "--lines", "1e5", "--groups", "100"]);
+    let w = fewer(&many).expect("a warning");
+    let needed = w["numbers"]["lines_needed"].as_f64().unwrap() as u64;
+    let enough = json_run(&["@cube:2", "--lines", &needed.to_string(), "--groups", "100"]);
+    assert_eq!(enough["groups"], 100);
+
+    let out = scx(&["analyze", "@cube:2", "--lines", "100", "--tracer", "rust"]);
+    let report = String::from_utf8_lossy(&out.stdout).into_owned();
+    assert!(
+        report.contains("standard errors: none") && !report.contains("± inf"),
+        "{report}"
+    );
+    assert!(stderr_of(&out).contains("no standard errors"), "{}", stderr_of(&out));
+}
