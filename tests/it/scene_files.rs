@@ -256,6 +256,9 @@ fn inside_out_objects_are_diagnosed_and_flipped() {
         a.estimate(Measure::ContinuousMutualInformation).is_none()
             && a.estimate(Measure::Accuracy).is_none()
     );
+    // Undefined readings have no verdict either (nor lines to advise for them).
+    let judged: Vec<Measure> = a.reliability.iter().map(|(m, _)| m).collect();
+    assert!(judged.iter().all(|&m| m == Measure::PositionalEntropy), "{judged:?}");
     let all = SceneOptions {
         flip_normals: ObjectSet::All,
         ..SceneOptions::default()
