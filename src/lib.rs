@@ -86,7 +86,7 @@ pub use scene::{
     Material, Normalization, ObjectSet, Patch, Planarity, Scene, SceneBuilder, SceneError,
     SceneOptions, DEFAULT_PLANARITY,
 };
-pub use scene::{Reach, ReadPolicy, SceneWarning, SceneWarningKind, Warning};
+pub use scene::{quantity_text, Reach, ReadPolicy, SceneWarning, SceneWarningKind, Warning};
 pub use scenes::{
     load, load_with, load_with_policy, read_guarded, Builtin, CATALOGUE, MAX_BUILTIN_PATCHES,
 };

@@ -74,9 +74,9 @@ pub(crate) fn of_run(
     if let Some(fraction) = escape_fraction(counters).filter(|&f| f > 0.0) {
         let effect = match environment_area {
             Some(env) => format!(
-                "with --enclose they are pairs with the environment patch (area {:.6} scene units^2), and \
+                "with --enclose they are pairs with the environment patch (area {} scene units^2), and \
                  the measures are those of the enclosed scene",
-                env.value
+                crate::scene::quantity_text(env.value)
             ),
             None => "so form-factor rows sum to less than 1 (--enclose closes the scene)".into(),
         };

@@ -9,7 +9,7 @@ use clap::ValueEnum;
 use scene_complexity::report::{
     bundle, positive_zero, rows, skipped_reason, Context, Process, Row,
 };
-use scene_complexity::Scene;
+use scene_complexity::{quantity_text, Scene};
 use scene_complexity::VerdictRule;
 use scene_complexity::{sphere_lines, ErrorMethod, LineBound, Sampler, Shard, StopReason, Tracing};
 use scene_complexity::{
@@ -184,11 +184,11 @@ pub fn table(run: &RunInfo, a: &Analysis) -> String {
     let scene = run.scene;
     let _ = writeln!(
         s,
-        "scene    {}  ({} patches, {} triangles, area {:.6} scene units^2)",
+        "scene    {}  ({} patches, {} triangles, area {} scene units^2)",
         scene.name,
         scene.patch_count(),
         scene.triangles.len(),
-        scene.total_area_scene_units()
+        quantity_text(scene.total_area_scene_units())
     );
     let _ = writeln!(
         s,
@@ -267,11 +267,11 @@ pub fn table(run: &RunInfo, a: &Analysis) -> String {
         let r = scene.normalization.scale;
         let _ = writeln!(
             s,
-            "enclosed by the environment patch (--enclose): area {:.6} +- {} scene units^2 of the bounding \
-             sphere's {:.6}",
-            env.value,
-            stderr_text(env),
-            4.0 * std::f64::consts::PI * r * r
+            "enclosed by the environment patch (--enclose): area {} +- {} scene units^2 of the bounding \
+             sphere's {}",
+            quantity_text(env.value),
+            env.stderr.map_or_else(|| "n/a".into(), quantity_text),
+            quantity_text(4.0 * std::f64::consts::PI * r * r)
         );
     }
     let _ = writeln!(s);

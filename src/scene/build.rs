@@ -10,7 +10,7 @@ use std::collections::HashMap;
 
 use super::{Material, Normalization, Patch, Scene, SceneError, SceneWarning, SceneWarningKind};
 use crate::geom::polygon::{planar_pieces, planarity_deviation, triangulate};
-use crate::geom::{centroid, newell, triangle_area, Point};
+use crate::geom::{centroid, newell, triangle_area, Point, Vector};
 
 /// A triangle whose area, relative to the squared bounding radius, is below this is degenerate.
 const DEGENERATE_AREA: f64 = 1e-14;
@@ -526,20 +526,24 @@ impl SceneBuilder {
                 hi[a] = hi[a].max(p[a]);
             }
         }
-        let center = 0.5 * (lo + hi);
-        let radius = used().map(|p| (p - center).length()).fold(0.0f64, f64::max);
-        if !radius.is_finite() {
-            // Each coordinate is finite (checked before), but the extent is beyond f64's range.
-            return Err(self.geometry_error(format!(
-                "the scene is too large to measure: its bounding box runs from ({:e}, {:e}, {:e}) to \
-                 ({:e}, {:e}, {:e}), and the radius of its bounding sphere is beyond the range of 64-bit \
-                 numbers (rescale it)",
-                lo.x, lo.y, lo.z, hi.x, hi.y, hi.z
-            )));
+        // Halves first: the centre of a box from -1e308 to 1e308 stays finite.
+        let center = 0.5 * lo + 0.5 * hi;
+        let radius = used()
+            .map(|p| length_without_overflow(p - center))
+            .fold(0.0f64, f64::max);
+        if radius == 0.0 {
+            return Err(self.geometry_error("the scene has no extent: every vertex is one point".into()));
         }
-        if radius <= 0.0 {
+        if !(MIN_RADIUS..=MAX_RADIUS).contains(&radius) {
+            let size = if radius > MAX_RADIUS { "large" } else { "small" };
+            // Each coordinate is finite (checked before), but areas, the square of the size, and the sums
+            // over them must stay well inside f64's range.
             return Err(self.geometry_error(format!(
-                "the scene has no extent (bounding radius {radius})"
+                "the scene is too {size} to measure: its bounding box runs from ({:e}, {:e}, {:e}) to \
+                 ({:e}, {:e}, {:e}), a bounding sphere of radius {radius:e}; scx measures scenes of radius \
+                 {MIN_RADIUS:e} to {MAX_RADIUS:e} in their own units, so that areas stay well inside the \
+                 range of 64-bit numbers (rescale it)",
+                lo.x, lo.y, lo.z, hi.x, hi.y, hi.z
             )));
         }
         Ok(Normalization {
@@ -547,6 +551,26 @@ impl SceneBuilder {
             scale: radius,
         })
     }
+}
+
+/// The smallest bounding radius of a scene scx measures, in its own units: areas (its square) down to
+/// 1e-200 stay far from where 64-bit numbers lose digits.
+pub const MIN_RADIUS: f64 = 1e-100;
+/// The largest bounding radius of a scene scx measures: areas up to 1e200 stay far from overflow.
+pub const MAX_RADIUS: f64 = 1e100;
+
+/// The length of `v`, scaled by its largest component where its square would overflow or underflow (in
+/// range, the plain length: the scenes scx measures keep their numbers bit for bit).
+fn length_without_overflow(v: Vector) -> f64 {
+    let plain = v.length();
+    if plain.is_finite() && plain > 1e-150 {
+        return plain;
+    }
+    let largest = v.x.abs().max(v.y.abs()).max(v.z.abs());
+    if largest == 0.0 || !largest.is_finite() {
+        return largest;
+    }
+    largest * (v / largest).length()
 }
 
 /// Renumbers vertices so that those with equal f32 tracing positions become one, rewriting the polygons;

@@ -19,7 +19,7 @@ mod warning;
 
 pub use build::{ObjectSet, Planarity, SceneBuilder, SceneOptions, Sides, DEFAULT_PLANARITY};
 pub use read::{Reach, ReadPolicy, DEFAULT_MAX_BYTES};
-pub use warning::{SceneWarning, SceneWarningKind, Warning};
+pub use warning::{quantity_text, SceneWarning, SceneWarningKind, Warning};
 
 use std::fmt;
 

@@ -94,3 +94,13 @@ impl<K> std::fmt::Display for Warning<K> {
         f.write_str(&self.message)
     }
 }
+
+/// A quantity in scene units for a sentence: six decimals, or six significant figures in scientific
+/// notation when it is too small or too large for them (a scene in metres of a part 1e-6 across).
+pub fn quantity_text(x: f64) -> String {
+    if x == 0.0 || (1e-3..1e9).contains(&x.abs()) {
+        format!("{x:.6}")
+    } else {
+        format!("{x:.5e}")
+    }
+}

@@ -627,7 +627,7 @@ fn hostile_built_in_parameters_are_bounded() {
 }
 
 /// Messages name the real problem: an STL longer than its header says is not "cut short", a radius
-/// beyond f64 is not "no extent".
+/// beyond f64 is not "no extent", nor a radius that underflows when squared.
 #[test]
 fn hostile_messages_name_the_real_problem() {
     let dir = tempfile::tempdir().unwrap();
@@ -667,7 +667,27 @@ fn hostile_messages_name_the_real_problem() {
         &[
             &huge,
             "too large to measure",
-            "beyond the range of 64-bit numbers",
+            "radius 1e-100 to 1e100",
+            "rescale it",
         ],
     );
+    // A box 1e-200 across is no point: it is too small (its radius underflowed to 0 when squared).
+    let tiny = write(
+        dir.path(),
+        "tiny.obj",
+        b"v 0 0 0\nv 1e-200 0 0\nv 0 1e-200 0\nf 1 2 3\n",
+    );
+    assert_refused(
+        &analyze(&tiny, &[]),
+        &[&tiny, "too small to measure", "rescale it"],
+    );
+    let point = write(
+        dir.path(),
+        "point.obj",
+        b"v 1 1 1\nv 1 1 1\nv 1 1 1\nf 1 2 3\n",
+    );
+    let out = analyze(&point, &[]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(!err.contains("too small"), "{err}");
 }
