@@ -88,8 +88,8 @@ pub struct AnalyzeArgs {
     #[arg(long)]
     enclose: bool,
     /// Output format: `table` (for people), `json` (one document with every field, units and verdicts),
-    /// `csv` (one row per measure: scene, lines, seed, tracer, family, measure, unit, value, stderr,
-    /// reliability, corrected, corrected_stderr, corrected_reliability).
+    /// `csv` (one row per measure: scene, lines, seed, tracer, patches, escape_fraction, seconds, family,
+    /// measure, unit, value, stderr, reliability, corrected, corrected_stderr, corrected_reliability).
     #[arg(long, value_enum, default_value_t = Format::Table)]
     format: Format,
     #[command(flatten)]

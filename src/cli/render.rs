@@ -56,7 +56,8 @@ pub struct RenderArgs {
     /// over 10% better).
     #[arg(long, value_parser = parse_camera, allow_hyphen_values = true)]
     camera: Option<Camera>,
-    /// The picture's size in pixels, WIDTHxHEIGHT (the colour bar is added on the right).
+    /// The size of the scene's picture in pixels, WIDTHxHEIGHT; the file is larger by the colour bar on
+    /// the right (210 pixels) and the title strip above (34): 800x600 makes a file of 1010x634.
     #[arg(long, default_value = "800x600", value_parser = parse_size)]
     size: (usize, usize),
     /// Divide the shares of a sum over patches (mutual-information, continuous-mutual-information,
@@ -491,6 +492,23 @@ fn wrap(s: &str, width: usize) -> Vec<String> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// `--size`'s help says how much larger the file is than the picture: by these margins.
+    #[test]
+    fn the_size_help_names_the_margins() {
+        use clap::CommandFactory;
+        let cli = super::super::commands::Cli::command();
+        let render = cli.find_subcommand("render").unwrap();
+        let size = render.get_arguments().find(|a| a.get_id() == "size").unwrap();
+        let help = size.get_help().unwrap().to_string();
+        for says in [
+            format!("({PANEL} pixels)"),
+            format!("above ({HEADER})"),
+            format!("a file of {}x{}", 800 + PANEL, 600 + HEADER),
+        ] {
+            assert!(help.contains(&says), "{says} not in: {help}");
+        }
+    }
 
     #[test]
     fn camera_size_and_range_parse_or_say_why_not() {
