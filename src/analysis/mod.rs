@@ -375,9 +375,14 @@ pub fn finish(
         visibility.estimates = ByMeasure::default();
         visibility.estimates.set(Measure::PositionalEntropy, kept);
         // Nor has an undefined reading a verdict, nor lines to advise.
-        let exact = visibility.reliability.get(Measure::PositionalEntropy).cloned();
+        let exact = visibility
+            .reliability
+            .get(Measure::PositionalEntropy)
+            .cloned();
         visibility.reliability = ByMeasure::default();
-        visibility.reliability.set(Measure::PositionalEntropy, exact);
+        visibility
+            .reliability
+            .set(Measure::PositionalEntropy, exact);
     }
     let (mut estimates, mut reliability) = (visibility.estimates, visibility.reliability);
     if let Some(r) = &radiosity_readings {

@@ -269,7 +269,11 @@ pub(super) fn visibility_estimates(
         lines: sphere_lines,
         // Enclosed, the escapes are pairs with the environment (I_s^c has their terms too), and only back
         // sides still lose segments.
-        pairs: if enclose { c.pairs + c.escapes } else { c.pairs },
+        pairs: if enclose {
+            c.pairs + c.escapes
+        } else {
+            c.pairs
+        },
         open: c.absorbed > 0 || (c.escapes > 0 && !enclose),
         short_chords: c.short_chords,
     };

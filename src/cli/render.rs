@@ -499,7 +499,10 @@ mod tests {
         use clap::CommandFactory;
         let cli = super::super::commands::Cli::command();
         let render = cli.find_subcommand("render").unwrap();
-        let size = render.get_arguments().find(|a| a.get_id() == "size").unwrap();
+        let size = render
+            .get_arguments()
+            .find(|a| a.get_id() == "size")
+            .unwrap();
         let help = size.get_help().unwrap().to_string();
         for says in [
             format!("({PANEL} pixels)"),

@@ -9,8 +9,8 @@ use clap::ValueEnum;
 use scene_complexity::report::{
     bundle, positive_zero, rows, skipped_reason, Context, Process, Row,
 };
-use scene_complexity::{quantity_text, Scene};
 use scene_complexity::VerdictRule;
+use scene_complexity::{quantity_text, Scene};
 use scene_complexity::{sphere_lines, ErrorMethod, LineBound, Sampler, Shard, StopReason, Tracing};
 use scene_complexity::{
     Analysis, LinesAdvice, RadiosityOutcome, Reliability, SamplingReport, TargetOutcome, Verdict,

@@ -153,6 +153,8 @@ pub struct TableReport {
     pub lines: u64,
     /// Runs taken from an earlier table instead of being cast again.
     pub reused: usize,
+    /// Runs this table asks for twice (the same scene and lines), cast once.
+    pub repeated: usize,
     /// Wall-clock seconds spent on this table.
     pub seconds: f64,
 }
@@ -174,9 +176,20 @@ impl TableReport {
             let verdict = if f.holds { "holds" } else { "does NOT hold" };
             let _ = writeln!(s, "- *{}*: **{verdict}** ({})", f.claim, f.detail);
         }
-        let reused = match self.reused {
-            0 => String::new(),
-            n => format!(" ({n} run(s) shared with an earlier table, not cast again)"),
+        let mut shared = Vec::new();
+        if self.reused > 0 {
+            shared.push(format!(
+                "{} run(s) shared with an earlier table",
+                self.reused
+            ));
+        }
+        if self.repeated > 0 {
+            shared.push(format!("{} run(s) repeated within it", self.repeated));
+        }
+        let reused = if shared.is_empty() {
+            String::new()
+        } else {
+            format!(" ({}, not cast again)", shared.join(", "))
         };
         let _ = writeln!(
             s,
@@ -232,15 +245,19 @@ pub fn reproduce(
         cache: HashMap::new(),
         lines_cast: 0,
         reused: 0,
+        repeated: 0,
+        table: 0,
         log,
     };
     let mut reports = Vec::new();
     for &t in &cfg.tables {
         let start = Instant::now();
-        let (before, reused) = (session.lines_cast, session.reused);
+        let (before, reused, repeated) = (session.lines_cast, session.reused, session.repeated);
+        session.table = t;
         let mut report = tables::table(&mut session, t)?;
         report.lines = session.lines_cast - before;
         report.reused = session.reused - reused;
+        report.repeated = session.repeated - repeated;
         report.seconds = start.elapsed().as_secs_f64();
         on_table(&report);
         reports.push(report);
@@ -281,9 +298,15 @@ struct Run {
 /// The state of one `reproduce` call: its configuration, the runs so far, the log.
 struct Session<'a> {
     cfg: &'a ReproduceConfig,
-    cache: HashMap<(String, u64, Want), Run>,
+    /// The runs so far, each with the table that cast it.
+    cache: HashMap<(String, u64, Want), (Run, u8)>,
     lines_cast: u64,
+    /// Runs taken from an earlier table.
     reused: usize,
+    /// Runs the current table had cast already.
+    repeated: usize,
+    /// The table being made.
+    table: u8,
     log: &'a mut dyn FnMut(&str),
 }
 
@@ -297,13 +320,17 @@ impl Session<'_> {
     fn run(&mut self, spec: &str, paper: u64, want: Want) -> Result<Run, ReproduceError> {
         let lines = self.lines(paper);
         let key = (spec.to_string(), lines, want);
-        if let Some(r) = self.cache.get(&key) {
-            self.reused += 1;
+        if let Some((r, table)) = self.cache.get(&key) {
+            if *table == self.table {
+                self.repeated += 1;
+            } else {
+                self.reused += 1;
+            }
             return Ok(r.clone());
         }
         let scene = scenes::load(spec)?;
         let run = self.run_scene(&scene, lines, want)?;
-        self.cache.insert(key, run.clone());
+        self.cache.insert(key, (run.clone(), self.table));
         Ok(run)
     }
 

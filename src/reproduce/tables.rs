@@ -37,6 +37,7 @@ fn report(number: u8, title: &str, header: &[&str]) -> TableReport {
         findings: Vec::new(),
         lines: 0,
         reused: 0,
+        repeated: 0,
         seconds: 0.0,
     }
 }

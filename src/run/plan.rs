@@ -245,7 +245,11 @@ mod tests {
             }
         }
         for k in 1..=100u64 {
-            assert_eq!(BatchPlan::lines_for_batches(k, false), first_with[k as usize], "{k}");
+            assert_eq!(
+                BatchPlan::lines_for_batches(k, false),
+                first_with[k as usize],
+                "{k}"
+            );
             let open = BatchPlan::lines_for_batches(k, true);
             assert!(BatchPlan::open_ended(open, LineSource::default()).batches() >= k);
             assert!(BatchPlan::open_ended(open - 1, LineSource::default()).batches() < k);

@@ -532,10 +532,16 @@ impl SceneBuilder {
             .map(|p| length_without_overflow(p - center))
             .fold(0.0f64, f64::max);
         if radius == 0.0 {
-            return Err(self.geometry_error("the scene has no extent: every vertex is one point".into()));
+            return Err(
+                self.geometry_error("the scene has no extent: every vertex is one point".into())
+            );
         }
         if !(MIN_RADIUS..=MAX_RADIUS).contains(&radius) {
-            let size = if radius > MAX_RADIUS { "large" } else { "small" };
+            let size = if radius > MAX_RADIUS {
+                "large"
+            } else {
+                "small"
+            };
             // Each coordinate is finite (checked before), but areas, the square of the size, and the sums
             // over them must stay well inside f64's range.
             return Err(self.geometry_error(format!(

@@ -366,13 +366,7 @@ fn the_lines_advice_says_when_it_is_a_lower_bound() {
 /// I_s^c are worth no more than it.
 #[test]
 fn i_s_c_is_judged_on_the_pairs_it_is_read_from() {
-    let enclosed = json_run(&[
-        "@cube:2",
-        "--flip-normals",
-        "--enclose",
-        "--lines",
-        "1e5",
-    ]);
+    let enclosed = json_run(&["@cube:2", "--flip-normals", "--enclose", "--lines", "1e5"]);
     for m in [
         "entropy",
         "mutual_information",
@@ -380,7 +374,12 @@ fn i_s_c_is_judged_on_the_pairs_it_is_read_from() {
         "accuracy",
         "mse_per_line",
     ] {
-        assert_eq!(verdict(&enclosed, &[m]), "ok", "{m}: {}", enclosed["visibility"][m]);
+        assert_eq!(
+            verdict(&enclosed, &[m]),
+            "ok",
+            "{m}: {}",
+            enclosed["visibility"][m]
+        );
     }
 
     let out = scx(&["analyze", "@cube:1", "--lines", "300", "--tracer", "rust"]);
@@ -392,12 +391,16 @@ fn i_s_c_is_judged_on_the_pairs_it_is_read_from() {
         "{}",
         few["sampling"]
     );
-    assert_eq!(verdict(&few, &["continuous_mutual_information"]), "unusable");
+    assert_eq!(
+        verdict(&few, &["continuous_mutual_information"]),
+        "unusable"
+    );
     assert_eq!(verdict(&few, &["accuracy"]), "unusable");
     assert_eq!(verdict(&few, &["accuracy", "corrected"]), "unusable");
     assert_eq!(verdict(&few, &["mutual_information"]), "ok");
     assert!(
-        report.contains("I_s^c from fewer than 1000 visible pairs") && !report.contains("coverage below"),
+        report.contains("I_s^c from fewer than 1000 visible pairs")
+            && !report.contains("coverage below"),
         "{report}"
     );
 }
@@ -424,7 +427,11 @@ fn fewer_groups_than_asked_are_a_warning() {
     assert_eq!(enough["groups"], 16);
     assert!(fewer(&enough).is_none(), "{}", enough["warnings"]);
     let below = json_run(&["@cube:2", "--lines", &(needed - 1).to_string()]);
-    assert!(fewer(&below).is_some(), "{needed} is the least: {}", below["groups"]);
+    assert!(
+        fewer(&below).is_some(),
+        "{needed} is the least: {}",
+        below["groups"]
+    );
 
     let many = json_run(&["@cube:2", "--lines", "1e5", "--groups", "100"]);
     let w = fewer(&many).expect("a warning");
@@ -438,5 +445,9 @@ fn fewer_groups_than_asked_are_a_warning() {
         report.contains("standard errors: none") && !report.contains("± inf"),
         "{report}"
     );
-    assert!(stderr_of(&out).contains("no standard errors"), "{}", stderr_of(&out));
+    assert!(
+        stderr_of(&out).contains("no standard errors"),
+        "{}",
+        stderr_of(&out)
+    );
 }

@@ -72,3 +72,39 @@ fn scenes_lists_the_papers_scenes_with_their_parameters() {
         assert!(stdout.contains(usage), "{usage} missing:\n{stdout}");
     }
 }
+
+/// A table that asks twice for one run says it repeated it, not that it shared it with an earlier
+/// table (Table 1 alone did); a later table that reuses an earlier one's runs casts no line for them.
+#[test]
+fn runs_cast_once_are_told_apart_by_where_they_came_from() {
+    let out = scx(&[
+        "reproduce",
+        "--table",
+        "1,2,3",
+        "--lines",
+        "1e4",
+        "--tracer",
+        "rust",
+    ]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let casts: Vec<&str> = stdout
+        .lines()
+        .filter(|l| l.contains("lines cast for this table"))
+        .collect();
+    assert_eq!(casts.len(), 3, "{stdout}");
+    assert!(
+        casts[0].contains("repeated within it") && !casts[0].contains("earlier table"),
+        "{}",
+        casts[0]
+    );
+    assert!(
+        casts[2].starts_with("0 lines cast") && casts[2].contains("shared with an earlier table"),
+        "{}",
+        casts[2]
+    );
+}

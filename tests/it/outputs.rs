@@ -210,11 +210,39 @@ fn files_a_scene_reads_are_inputs() {
     let out = scx_in(d, &["export", "tri.gltf", "-o", "tri.obj"]);
     assert_eq!(code(&out), Some(0), "the glTF loads: {}", stderr(&out));
     let cases: Vec<(Vec<&str>, &str)> = vec![
-        (vec!["export", "q.obj", "-o", "out.obj"], "its MTL library out.mtl"),
+        (
+            vec!["export", "q.obj", "-o", "out.obj"],
+            "its MTL library out.mtl",
+        ),
         (vec!["export", "q.obj", "-o", "out.mtl.ply"], ""),
-        (vec!["refine", "q.obj", "-o", "out.obj", "--patches", "4", "--strategy", "uniform"], "its MTL library out.mtl"),
-        (vec!["analyze", "q.obj", "--lines", "1e4", "-o", "out.mtl"], "-o out.mtl"),
-        (vec!["render", "q.obj", "-o", "x.png", "--patches-mesh", "out.mtl"], ""),
+        (
+            vec![
+                "refine",
+                "q.obj",
+                "-o",
+                "out.obj",
+                "--patches",
+                "4",
+                "--strategy",
+                "uniform",
+            ],
+            "its MTL library out.mtl",
+        ),
+        (
+            vec!["analyze", "q.obj", "--lines", "1e4", "-o", "out.mtl"],
+            "-o out.mtl",
+        ),
+        (
+            vec![
+                "render",
+                "q.obj",
+                "-o",
+                "x.png",
+                "--patches-mesh",
+                "out.mtl",
+            ],
+            "",
+        ),
     ];
     for (args, names) in &cases {
         let out = scx_in(d, args);
@@ -228,9 +256,16 @@ fn files_a_scene_reads_are_inputs() {
         for name in [*names, "which the scene q.obj reads"] {
             assert!(err.contains(name), "{args:?} should say {name}: {err}");
         }
-        assert_eq!(read(&d.join("out.mtl")), mtl, "{args:?} replaced the library");
+        assert_eq!(
+            read(&d.join("out.mtl")),
+            mtl,
+            "{args:?} replaced the library"
+        );
     }
-    let out = scx_in(d, &["analyze", "tri.gltf", "--lines", "1e4", "-o", "tri.bin"]);
+    let out = scx_in(
+        d,
+        &["analyze", "tri.gltf", "--lines", "1e4", "-o", "tri.bin"],
+    );
     let err = stderr(&out);
     assert_eq!(code(&out), Some(2), "{err}");
     assert!(err.contains("which the scene tri.gltf reads"), "{err}");

@@ -258,7 +258,10 @@ fn inside_out_objects_are_diagnosed_and_flipped() {
     );
     // Undefined readings have no verdict either (nor lines to advise for them).
     let judged: Vec<Measure> = a.reliability.iter().map(|(m, _)| m).collect();
-    assert!(judged.iter().all(|&m| m == Measure::PositionalEntropy), "{judged:?}");
+    assert!(
+        judged.iter().all(|&m| m == Measure::PositionalEntropy),
+        "{judged:?}"
+    );
     let all = SceneOptions {
         flip_normals: ObjectSet::All,
         ..SceneOptions::default()
@@ -1050,10 +1053,14 @@ fn a_byte_order_mark_is_not_part_of_the_first_statement() {
     let obj = write(
         dir.path(),
         "lit.obj",
-        "\u{feff}mtllib lit.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nusemtl lamp\nf 1 2 3 4\n".as_bytes(),
+        "\u{feff}mtllib lit.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nusemtl lamp\nf 1 2 3 4\n"
+            .as_bytes(),
     );
     let scene = load_file(&obj, &SceneOptions::default());
     assert!(scene.warnings.is_empty(), "{}", messages(&scene.warnings));
     let lamp = &scene.materials[scene.patches[0].material as usize];
-    assert_eq!((lamp.name.as_str(), lamp.emission, lamp.reflectance), ("lamp", 2.0, 0.5));
+    assert_eq!(
+        (lamp.name.as_str(), lamp.emission, lamp.reflectance),
+        ("lamp", 2.0, 0.5)
+    );
 }
