@@ -16,7 +16,7 @@ use scene_complexity::{
     Analysis, LinesAdvice, RadiosityOutcome, Reliability, SamplingReport, TargetOutcome, Verdict,
     COVERAGE_OK, COVERAGE_UNUSABLE, MIN_PAIRS,
 };
-use scene_complexity::{Estimate, Family, Measure};
+use scene_complexity::{Estimate, Family, Measure, RunWarningKind};
 
 use super::table::{fixed, Align, Table};
 
@@ -310,10 +310,17 @@ pub fn table(run: &RunInfo, a: &Analysis) -> String {
         let _ = writeln!(s, "{n}");
     }
     if a.pairs == 0 && a.lines > 0 && a.environment_area.is_none() {
+        let met = if a.hits == 0 {
+            "no line met the scene: cast more lines"
+        } else if a.warnings.iter().any(|w| w.kind == RunWarningKind::NoPairs) {
+            "the warning says what the lines met"
+        } else {
+            "cast more lines"
+        };
         let _ = writeln!(
             s,
             "visibility measures undefined: no line segment joined two patches, so there are no form \
-             factors to measure (the warning says what the lines met)"
+             factors to measure ({met})"
         );
     }
     radiosity_lines(&mut s, &a.radiosity);
