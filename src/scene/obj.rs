@@ -668,11 +668,11 @@ pub fn to_text(scene: &Scene, mtl_name: &str) -> (String, String) {
     for v in &scene.vertices {
         let _ = writeln!(obj, "v {:?} {:?} {:?}", v[0], v[1], v[2]);
     }
-    let named_objects = scene.objects.len() > 1;
     let mut current = None;
     let mut current_object = None;
     for p in &scene.patches {
-        if named_objects && current_object != Some(p.object) {
+        // Every object is named, a scene of one too: read back, it keeps its name (`--flip-normals NAME`).
+        if current_object != Some(p.object) {
             let name = scene.objects[p.object as usize].trim();
             let _ = writeln!(obj, "o {}", if name.is_empty() { "unnamed" } else { name });
             current_object = Some(p.object);

@@ -365,6 +365,14 @@ fn scene_export_writes_the_format_its_extension_names() {
         "no MTL beside PLY or STL"
     );
 
+    // A scene of one object keeps its name through OBJ (it used to read back as tobj's
+    // `unnamed_object`): `--flip-normals` can name it.
+    let obj = dir.path().join("cube.obj");
+    let out = scx(&["export", "@cube:2", "-o", obj.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(0));
+    let back = scene_complexity::load(obj.to_str().unwrap()).unwrap();
+    assert_eq!(back.objects, ["@cube:2"]);
+
     for name in ["cornell.txt", "cornell", "cornell.mtl"] {
         let path = dir.path().join(name);
         let out = scx(&["export", "@cornell", "-o", path.to_str().unwrap()]);
