@@ -201,6 +201,18 @@ pub fn run(args: &RenderArgs) -> Result<Exit, Failure> {
     let patches = analysis.patches.as_ref().ok_or_else(|| {
         Failure::bad_input("no per-patch results: the run counted no patch pairs")
     })?;
+    if analysis.pairs == 0 && !analysis.enclosed && !args.color.needs_light() {
+        if let Quantity::Patch(_) = args.color {
+            // As the report says: without pairs there are no form factors, and a per-patch reading of 0
+            // would read as a measurement.
+            return Err(Failure::bad_input(format!(
+                "{}: no line segment joined two patches, so --color {} is undefined on every patch (the \
+                 warnings say what the lines met); --color segments shows where the lines left them",
+                runner.scene.name,
+                args.color.name()
+            )));
+        }
+    }
     let scene = &runner.scene;
     let values = patch_values(scene, patches, args.color, args.per_area);
     let areas: Vec<f64> = scene.patches.iter().map(|p| p.area).collect();

@@ -116,6 +116,9 @@ const OUTSIDE_FOV: f64 = 40.0;
 /// edges of an opening fall just outside the picture.
 const FRAMING: f64 = 0.88;
 
+/// The same for a flat scene (a cut-out figure, one sheet) seen face on: all of it, with a margin.
+const FLAT_FRAMING: f64 = 1.08;
+
 /// How much more another view must score to replace the classic view.
 const KEEP_CLASSIC: f64 = 1.1;
 
@@ -348,7 +351,10 @@ impl Bounds {
         };
         let horizontal = 3 - axis - vertical;
         let half = (0.5 * size[vertical]).max(0.5 * size[horizontal] / ASPECT);
-        let distance = FRAMING * half / (0.5 * OUTSIDE_FOV).to_radians().tan();
+        // A flat scene seen face on has no walls whose edges to hide: all of it shows, with a margin.
+        let flat = size[axis] <= 2.0 * THINNEST * size.max_element();
+        let framing = if flat { FLAT_FRAMING } else { FRAMING };
+        let distance = framing * half / (0.5 * OUTSIDE_FOV).to_radians().tan();
         let middle = self.middle();
         let mut eye = middle.to_array();
         eye[axis] = self.wall(axis, -sign) - sign * distance;

@@ -417,3 +417,45 @@ fn render_warns_when_the_colours_are_mostly_noise() {
     let err = render(dir.path(), "@cube:3", "1e6", &[]);
     assert!(!err.contains("noise"), "{err}");
 }
+
+/// A run without pairs (a cube seen from outside) has no per-patch visibility values: a picture of
+/// zeros would read as a measurement, so it is refused as the report leaves them out; the segments
+/// each patch sent are still there to show.
+#[test]
+fn undefined_values_are_not_drawn_as_zeros() {
+    let dir = tempfile::tempdir().unwrap();
+    let png = dir.path().join("p.png");
+    let run = |color: &str| {
+        scx(&[
+            "render",
+            "@cube:2",
+            "--flip-normals",
+            "--color",
+            color,
+            "--lines",
+            "1e4",
+            "--size",
+            "128x96",
+            "-o",
+            png.to_str().unwrap(),
+        ])
+    };
+    for color in [
+        "row-entropy",
+        "mutual-information",
+        "continuous-mutual-information",
+    ] {
+        let out = run(color);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{color}: {err}");
+        assert!(err.contains("undefined on every patch"), "{color}: {err}");
+        assert!(!png.exists(), "{color}");
+    }
+    let out = run("segments");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(png.exists());
+}
