@@ -222,11 +222,11 @@ pub(crate) fn coverage_verdict(report: &SamplingReport) -> Reliability {
 /// The verdict on an estimate unbiased whatever the coverage ([`VerdictRule::UnbiasedEstimate`]):
 /// `unusable` below [`COVERAGE_UNUSABLE`] (rows too thin to hold two segments each), else `ok`.
 fn unbiased_estimate_verdict(report: &SamplingReport) -> Reliability {
-    let mut r = coverage_verdict(report);
-    if r.verdict == Verdict::Undersampled {
-        r = Reliability::new(Verdict::Ok);
+    if report.sampling.coverage < COVERAGE_UNUSABLE {
+        coverage_verdict(report)
+    } else {
+        Reliability::new(Verdict::Ok)
     }
-    r
 }
 
 /// A plug-in reading with estimated bias `bias`.

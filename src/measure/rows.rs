@@ -388,8 +388,6 @@ mod tests {
             .collect()
     }
 
-    /// A row's integer sums counted straight from the keys (a map of outcomes per row, a segment from a
-    /// patch to itself twice), in both count layouts, with escapes; and the same as a full gather's.
     /// The unbiased `sum_j F_ij^2` has the row's exact `sum_j F_ij^2` as its expectation over every
     /// multinomial sample of 2 to 7 segments (three patches and the escapes as a fourth outcome, which
     /// is no patch), where the plug-in's is higher by `sum_j F_ij (1 - F_ij) / N`.
@@ -435,6 +433,8 @@ mod tests {
         }
     }
 
+    /// A row's integer sums counted straight from the keys (a map of outcomes per row, a segment from a
+    /// patch to itself twice), in both count layouts, with escapes; and the same as a full gather's.
     #[test]
     fn outcome_frequencies_count_each_rows_outcomes() {
         use std::collections::BTreeMap;
