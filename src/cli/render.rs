@@ -505,26 +505,6 @@ fn wrap(s: &str, width: usize) -> Vec<String> {
 mod tests {
     use super::*;
 
-    /// `--size`'s help says how much larger the file is than the picture: by these margins.
-    #[test]
-    fn the_size_help_names_the_margins() {
-        use clap::CommandFactory;
-        let cli = super::super::commands::Cli::command();
-        let render = cli.find_subcommand("render").unwrap();
-        let size = render
-            .get_arguments()
-            .find(|a| a.get_id() == "size")
-            .unwrap();
-        let help = size.get_help().unwrap().to_string();
-        for says in [
-            format!("({PANEL} pixels)"),
-            format!("above ({HEADER})"),
-            format!("a file of {}x{}", 800 + PANEL, 600 + HEADER),
-        ] {
-            assert!(help.contains(&says), "{says} not in: {help}");
-        }
-    }
-
     #[test]
     fn camera_size_and_range_parse_or_say_why_not() {
         let c = parse_camera("0.5,0.5,0.01, 0.5,0.5,1, 0,1,0, 60").unwrap();

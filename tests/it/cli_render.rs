@@ -459,3 +459,46 @@ fn undefined_values_are_not_drawn_as_zeros() {
     );
     assert!(png.exists());
 }
+
+/// `--size` is the scene's picture; the help says by how much the file is larger, and the file is.
+#[test]
+fn the_size_help_says_how_large_the_file_is() {
+    let help = String::from_utf8_lossy(&scx(&["render", "--help"]).stdout).into_owned();
+    let said = |pattern: &str| -> u32 {
+        let at = help
+            .find(pattern)
+            .unwrap_or_else(|| panic!("{pattern} not in: {help}"));
+        help[at + pattern.len()..]
+            .chars()
+            .take_while(char::is_ascii_digit)
+            .collect::<String>()
+            .parse()
+            .unwrap()
+    };
+    let (panel, header) = (said("on the right ("), said("strip above ("));
+    let dir = tempfile::tempdir().unwrap();
+    let png = dir.path().join("p.png");
+    let out = scx(&[
+        "render",
+        "@cube:2",
+        "--color",
+        "segments",
+        "--lines",
+        "1e4",
+        "--size",
+        "100x80",
+        "-o",
+        png.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let info = png::Decoder::new(std::fs::File::open(&png).unwrap())
+        .read_info()
+        .unwrap()
+        .info()
+        .clone();
+    assert_eq!((info.width, info.height), (100 + panel, 80 + header));
+}
