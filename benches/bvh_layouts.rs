@@ -20,6 +20,10 @@
 //! (the rooms of docs/performance.md's "Walls in grids").
 
 mod common;
+#[path = "../tests/common/meshed_room.rs"]
+mod meshed_room;
+
+use meshed_room::turned_meshed_room;
 
 use scene_complexity::internals::scenes;
 use std::time::Duration;
@@ -45,51 +49,8 @@ fn load(spec: &str, scratch: &std::path::Path) -> anyhow::Result<Scene> {
         anyhow::bail!("{spec}: expected room:N:TURN:GRADING");
     };
     let path = scratch.join(format!("{}.obj", spec.replace(':', "_")));
-    std::fs::write(&path, meshed_room(n as usize, turn, grading))?;
+    std::fs::write(&path, turned_meshed_room(n as usize, turn, false, grading))?;
     Ok(scenes::load(path.to_str().expect("a UTF-8 scratch path"))?)
-}
-
-/// The OBJ of `room:N:TURN:GRADING` (see the module doc): walls facing inward.
-fn meshed_room(n: usize, turn: f64, grading: f64) -> String {
-    let (s, c) = turn.sin_cos();
-    let rotate = |p: [f64; 3]| {
-        let q = [p[0], c * p[1] - s * p[2], s * p[1] + c * p[2]];
-        [c * q[0] - s * q[1], s * q[0] + c * q[1], q[2]]
-    };
-    let at = |i: usize| {
-        let share = if grading == 1.0 {
-            i as f64 / n as f64
-        } else {
-            (grading.powi(i as i32) - 1.0) / (grading.powi(n as i32) - 1.0)
-        };
-        -1.0 + 2.0 * share
-    };
-    let mut obj = String::from("o room\n");
-    let mut count = 0;
-    for axis in 0..3 {
-        for side in [-1.0, 1.0] {
-            let (u, v) = ((axis + 1) % 3, (axis + 2) % 3);
-            let point = |a: f64, b: f64| {
-                let mut p = [0.0; 3];
-                (p[axis], p[u], p[v]) = (side, a, b);
-                rotate(p)
-            };
-            for (i, j) in (0..n).flat_map(|i| (0..n).map(move |j| (i, j))) {
-                let (a0, a1, b0, b1) = (at(i), at(i + 1), at(j), at(j + 1));
-                let mut quad = [point(a0, b0), point(a1, b0), point(a1, b1), point(a0, b1)];
-                if side > 0.0 {
-                    quad.reverse();
-                }
-                for p in quad {
-                    obj.push_str(&format!("v {} {} {}\n", p[0], p[1], p[2]));
-                }
-                let f = [1, 2, 3, 4].map(|k| count + k);
-                obj.push_str(&format!("f {} {} {} {}\n", f[0], f[1], f[2], f[3]));
-                count += 4;
-            }
-        }
-    }
-    obj
 }
 
 fn main() -> anyhow::Result<()> {

@@ -1,6 +1,8 @@
 //! scx's integration tests: one test binary (the library and Embree are linked once), one module per
 //! concern. Modules that run the `scx` binary need the `cli` feature; the Embree backend's need `embree`.
 
+#[path = "../common/meshed_room.rs"]
+mod meshed_room;
 mod support;
 
 // The library against independent truth.
