@@ -513,7 +513,8 @@ fn verdict(
             if closed {
                 flag_unit_interval(&mut r, e, info.flag_name);
             }
-            if continuous.is_some_and(|c| c.value.abs() <= 3.0 * stderr(c)) {
+            // Without a standard error nothing is distinguishable, and the reading is unusable anyway.
+            if continuous.is_some_and(|c| c.stderr.is_some() && c.value.abs() <= 3.0 * stderr(c)) {
                 r.verdict = Verdict::Unusable;
                 r.flags
                     .push("I_s^c is not distinguishable from 0, so the ratio means nothing".into());

@@ -217,9 +217,27 @@ fn shown(n: u64) -> String {
     }
 }
 
+/// Refuses a value that is a flag (`--quiet`, `-q`): list flags take values that start with `-`
+/// (`--camera -1,0,2,...`), so a flag whose value was forgotten would take the next flag for it.
+pub fn not_a_flag(s: &str) -> Result<(), String> {
+    let mut chars = s.trim().chars();
+    let flag = chars.next() == Some('-')
+        && chars
+            .next()
+            .is_some_and(|c| c == '-' || c.is_ascii_alphabetic())
+        && s.trim().parse::<f64>().is_err();
+    if flag {
+        return Err(format!(
+            "`{s}` is a flag, not a value: the flag before it needs its value first"
+        ));
+    }
+    Ok(())
+}
+
 /// A whole number written as `1000000`, `1e6` or `2.5e6`, within `[min, max]` (`max` at most 1e15);
 /// `what` names it in messages, which always give the range.
 pub fn parse_whole_in(s: &str, what: &str, min: u64, max: u64) -> Result<u64, String> {
+    not_a_flag(s)?;
     let range = format!(
         "{what} must be a whole number from {} to {}",
         shown(min),

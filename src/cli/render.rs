@@ -108,6 +108,7 @@ fn quantity_parser() -> impl clap::builder::TypedValueParser<Value = Quantity> {
 }
 
 fn numbers(s: &str, count: usize, what: &str) -> Result<Vec<f64>, String> {
+    super::args::not_a_flag(s)?;
     let v: Vec<f64> = s
         .split(',')
         .map(|x| x.trim().parse::<f64>())
@@ -205,9 +206,16 @@ pub fn run(args: &RenderArgs) -> Result<Exit, Failure> {
         if let Quantity::Patch(_) = args.color {
             // As the report says: without pairs there are no form factors, and a per-patch reading of 0
             // would read as a measurement.
+            let what = if analysis.hits == 0 {
+                "no line met the scene: cast more lines".to_string()
+            } else {
+                "the warnings say what the lines met; --color segments shows where they left the \
+                 patches"
+                    .to_string()
+            };
             return Err(Failure::bad_input(format!(
-                "{}: no line segment joined two patches, so --color {} is undefined on every patch (the \
-                 warnings say what the lines met); --color segments shows where the lines left them",
+                "{}: no line segment joined two patches, so --color {} is undefined on every patch \
+                 ({what})",
                 runner.scene.name,
                 args.color.name()
             )));

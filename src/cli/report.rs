@@ -467,10 +467,10 @@ fn unusable_reasons(a: &Analysis) -> String {
     if coverage_low && unusable(Measure::Entropy) {
         reasons.push(format!("rows' coverage below {COVERAGE_UNUSABLE}"));
     }
-    if unusable(Measure::ContinuousMutualInformation) {
-        reasons.push(format!(
-            "I_s^c from fewer than {MIN_PAIRS} visible pairs, or without a standard error"
-        ));
+    if a.groups < 2 {
+        reasons.push("no standard error: fewer than two groups of lines".to_string());
+    } else if unusable(Measure::ContinuousMutualInformation) {
+        reasons.push(format!("I_s^c from fewer than {MIN_PAIRS} visible pairs"));
     }
     if reasons.is_empty() {
         String::new()

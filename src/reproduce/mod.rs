@@ -250,10 +250,10 @@ pub fn reproduce(
         log,
     };
     let mut reports = Vec::new();
-    for &t in &cfg.tables {
+    for (position, &t) in cfg.tables.iter().enumerate() {
         let start = Instant::now();
         let (before, reused, repeated) = (session.lines_cast, session.reused, session.repeated);
-        session.table = t;
+        session.table = position;
         let mut report = tables::table(&mut session, t)?;
         report.lines = session.lines_cast - before;
         report.reused = session.reused - reused;
@@ -298,15 +298,16 @@ struct Run {
 /// The state of one `reproduce` call: its configuration, the runs so far, the log.
 struct Session<'a> {
     cfg: &'a ReproduceConfig,
-    /// The runs so far, each with the table that cast it.
-    cache: HashMap<(String, u64, Want), (Run, u8)>,
+    /// The runs so far, each with the table that cast it (its place in the list asked for: a table
+    /// asked for twice reuses the runs of its first time).
+    cache: HashMap<(String, u64, Want), (Run, usize)>,
     lines_cast: u64,
     /// Runs taken from an earlier table.
     reused: usize,
     /// Runs the current table had cast already.
     repeated: usize,
-    /// The table being made.
-    table: u8,
+    /// The place of the table being made in the list asked for.
+    table: usize,
     log: &'a mut dyn FnMut(&str),
 }
 

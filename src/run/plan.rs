@@ -42,23 +42,23 @@ impl BatchPlan {
         BatchPlan { lines, batch_size }
     }
 
-    /// The fewest lines whose plan has at least `batches` batches (the standard-error groups a run can
-    /// have): [`BatchPlan::new`]'s, or with `open_ended` [`BatchPlan::open_ended`]'s full batches; for
-    /// bundled lines, about as many.
-    pub fn lines_for_batches(batches: u64, open_ended: bool) -> u64 {
+    /// The fewest lines (as `--lines` counts them, before rounding to whole bundles) whose plan for
+    /// `source` has at least `batches` batches, the standard-error groups a run can have: the plan of
+    /// [`BatchPlan::for_source`], or with `open_ended` [`BatchPlan::open_ended`]'s full batches.
+    pub fn lines_for_batches(batches: u64, source: LineSource, open_ended: bool) -> u64 {
         let k = batches.max(1);
+        let unit = source.lines_per_unit();
         if open_ended {
-            return (k - 1) * Self::MAX_BATCH + 1;
+            let batch = BatchPlan::open_ended(unit, source).batch_size;
+            return (k - 1) * batch + 1;
         }
-        if k <= Self::MIN_BATCHES {
-            (k - 1) * Self::MIN_BATCH + 1
-        } else if k == Self::MIN_BATCHES + 1 {
-            // One line past MIN_BATCHES full minimal batches starts one more; from there on the batch
-            // grows with the lines, and a 66th batch waits for full batches.
-            Self::MIN_BATCHES * Self::MIN_BATCH + 1
-        } else {
-            (k - 1) * Self::MAX_BATCH + 1
+        // The batches do not grow monotonically with the lines: walk the bundle counts (at most
+        // k * MAX_BATCH lines) to the first plan with k batches.
+        let mut bundles = 1;
+        while BatchPlan::for_source(bundles * unit, source).batches() < k {
+            bundles += 1;
         }
+        (bundles - 1) * unit + 1
     }
 
     /// The plan for lines from `source`: the line count is rounded up to whole bundles, and each batch
@@ -246,13 +246,24 @@ mod tests {
         }
         for k in 1..=100u64 {
             assert_eq!(
-                BatchPlan::lines_for_batches(k, false),
+                BatchPlan::lines_for_batches(k, LineSource::default(), false),
                 first_with[k as usize],
                 "{k}"
             );
-            let open = BatchPlan::lines_for_batches(k, true);
+            let open = BatchPlan::lines_for_batches(k, LineSource::default(), true);
             assert!(BatchPlan::open_ended(open, LineSource::default()).batches() >= k);
             assert!(BatchPlan::open_ended(open - 1, LineSource::default()).batches() < k);
+        }
+        // Bundles of 64 x 64 lines: a bundle a batch, so 16 groups need 15 bundles and a line.
+        let bundles = LineSource::Bundles { grid: 64 };
+        for open_ended in [false, true] {
+            let least = BatchPlan::lines_for_batches(16, bundles, open_ended);
+            assert_eq!(least, 15 * 4096 + 1);
+            let plan = |l| match open_ended {
+                true => BatchPlan::open_ended(l, bundles),
+                false => BatchPlan::for_source(l, bundles),
+            };
+            assert!(plan(least).batches() >= 16 && plan(least - 1).batches() < 16);
         }
     }
 

@@ -559,11 +559,12 @@ impl SceneBuilder {
     }
 }
 
-/// The smallest bounding radius of a scene scx measures, in its own units: areas (its square) down to
-/// 1e-200 stay far from where 64-bit numbers lose digits.
-pub const MIN_RADIUS: f64 = 1e-100;
-/// The largest bounding radius of a scene scx measures: areas up to 1e200 stay far from overflow.
-pub const MAX_RADIUS: f64 = 1e100;
+/// The smallest bounding radius of a scene scx measures, in its own units: areas, and the squares of
+/// the coordinates' products that compute them, stay far from where 64-bit numbers lose digits.
+pub const MIN_RADIUS: f64 = 1e-50;
+/// The largest bounding radius of a scene scx measures: areas and the squares behind them stay far from
+/// overflow (a radius of 1e78 made the area infinite).
+pub const MAX_RADIUS: f64 = 1e50;
 
 /// The length of `v`, scaled by its largest component where its square would overflow or underflow (in
 /// range, the plain length: the scenes scx measures keep their numbers bit for bit).

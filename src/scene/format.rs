@@ -68,7 +68,7 @@ pub fn detect(bytes: &[u8]) -> Option<Format> {
     if is_binary_stl(bytes) {
         return Some(Format::StlBinary);
     }
-    if looks_like_obj(text) {
+    if looks_like_obj(text.trim_start_matches('\u{feff}')) {
         return Some(Format::Obj);
     }
     None

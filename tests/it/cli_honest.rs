@@ -439,6 +439,13 @@ fn fewer_groups_than_asked_are_a_warning() {
     let enough = json_run(&["@cube:2", "--lines", &needed.to_string(), "--groups", "100"]);
     assert_eq!(enough["groups"], 100);
 
+    // Bundles of 64 x 64 lines: a bundle a batch, so 16 groups need 15 bundles and a line.
+    let bundled = json_run(&["@cube:2", "--lines", "3841", "--bundle", "64"]);
+    let w = fewer(&bundled).expect("a warning");
+    assert_eq!(w["numbers"]["lines_needed"], 61441.0);
+    let enough = json_run(&["@cube:2", "--lines", "61441", "--bundle", "64"]);
+    assert_eq!(enough["groups"], 16);
+
     let out = scx(&["analyze", "@cube:2", "--lines", "100", "--tracer", "rust"]);
     let report = String::from_utf8_lossy(&out.stdout).into_owned();
     assert!(

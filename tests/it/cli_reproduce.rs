@@ -107,4 +107,24 @@ fn runs_cast_once_are_told_apart_by_where_they_came_from() {
         "{}",
         casts[2]
     );
+    // A table asked for twice takes its runs from its first time.
+    let out = scx(&[
+        "reproduce",
+        "--table",
+        "1,1",
+        "--lines",
+        "1e4",
+        "--tracer",
+        "rust",
+    ]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let second = stdout
+        .lines()
+        .filter(|l| l.contains("lines cast for this table"))
+        .nth(1)
+        .unwrap_or_else(|| panic!("{stdout}"));
+    assert!(
+        second.starts_with("0 lines cast") && !second.contains("repeated within it"),
+        "{second}"
+    );
 }

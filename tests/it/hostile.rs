@@ -667,7 +667,7 @@ fn hostile_messages_name_the_real_problem() {
         &[
             &huge,
             "too large to measure",
-            "radius 1e-100 to 1e100",
+            "radius 1e-50 to 1e50",
             "rescale it",
         ],
     );
@@ -681,6 +681,23 @@ fn hostile_messages_name_the_real_problem() {
         &analyze(&tiny, &[]),
         &[&tiny, "too small to measure", "rescale it"],
     );
+    // Just inside the limits, areas (and the environment's, enclosed) are finite and positive.
+    for scale in ["1e49", "1e-49"] {
+        let obj = format!("v 0 0 0\nv {scale} 0 0\nv 0 {scale} 0\nf 1 2 3\n");
+        let path = write(dir.path(), "edge.obj", obj.as_bytes());
+        let out = analyze(&path, &["--enclose", "--format", "json"]);
+        assert_eq!(
+            out.status.code(),
+            Some(0),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        for area in [&doc["area"], &doc["environment_area"]["value"]] {
+            let a = area.as_f64().unwrap_or_else(|| panic!("{scale}: {area}"));
+            assert!(a.is_finite() && a > 0.0, "{scale}: {a}");
+        }
+    }
     let point = write(
         dir.path(),
         "point.obj",

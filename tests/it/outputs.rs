@@ -810,7 +810,7 @@ fn assert_usage(out: &Output, expected: &[&str]) {
 fn numeric_flags_name_their_range() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    let cases: [(&[&str], &[&str]); 9] = [
+    let cases: [(&[&str], &[&str]); 11] = [
         (
             &["analyze", "@cube:3", "--groups", "1e9"],
             &["--groups", "number of groups", "from 2 to 1024"],
@@ -843,6 +843,16 @@ fn numeric_flags_name_their_range() {
         (
             &["reproduce", "--table", "-1,2"],
             &["--table", "cannot be negative"],
+        ),
+        (
+            &[
+                "render", "@cube:2", "--color", "segments", "-o", "c.png", "--camera", "--quiet",
+            ],
+            &["--camera", "`--quiet` is a flag, not a value"],
+        ),
+        (
+            &["convergence", "@cube:2", "--lines", "1e3,-q"],
+            &["--lines", "`-q` is a flag, not a value"],
         ),
     ];
     for (args, expected) in cases {

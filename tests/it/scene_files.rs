@@ -1064,3 +1064,14 @@ fn a_byte_order_mark_is_not_part_of_the_first_statement() {
         ("lamp", 2.0, 0.5)
     );
 }
+
+/// A file holding a byte-order mark and a comment is an OBJ without faces, not a file of unknown format.
+#[test]
+fn a_byte_order_mark_alone_is_an_empty_obj() {
+    let dir = tempfile::tempdir().unwrap();
+    let obj = write(dir.path(), "bom.obj", "\u{feff}# a comment\r\n".as_bytes());
+    let e = load_with(obj.to_str().unwrap(), &SceneOptions::default())
+        .expect_err("no faces")
+        .to_string();
+    assert!(e.contains("no faces"), "{e}");
+}
