@@ -363,11 +363,13 @@ pub fn finish(
         &scene.name,
         (cfg.groups.max(2), visibility.groups),
         covered.len(),
-        BatchPlan::lines_for_batches(
-            cfg.groups.max(2) as u64,
-            cfg.source,
-            cfg.budget.is_open_ended(),
-        ),
+        || {
+            BatchPlan::lines_for_batches(
+                cfg.groups.max(2) as u64,
+                cfg.source,
+                cfg.budget.is_open_ended(),
+            )
+        },
     ));
     let mut visibility = visibility;
     if total.counters.pairs == 0 && !enclose {

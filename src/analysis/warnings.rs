@@ -126,13 +126,14 @@ pub(crate) fn of_run(
 }
 
 /// What a run whose lines are `batches` batches gets for standard errors when they fill fewer groups
-/// (`used`) than the `asked` ones: a group is made of whole batches. `needed` is how many lines (as
-/// `--lines` counts them) give every group a batch. `None` when it has the groups asked for.
+/// (`used`) than the `asked` ones: a group is made of whole batches. `needed` gives how many lines (as
+/// `--lines` counts them) give every group a batch (asked only then). `None` when it has the groups
+/// asked for.
 pub(crate) fn fewer_groups(
     scene: &str,
     (asked, used): (usize, usize),
     batches: u64,
-    needed: u64,
+    needed: impl FnOnce() -> u64,
 ) -> Option<RunWarning> {
     if used >= asked {
         return None;
@@ -152,6 +153,7 @@ pub(crate) fn fewer_groups(
             used - 1
         )
     };
+    let needed = needed();
     let message = format!(
         "{scene}: {what}; a group holds whole batches: {asked} groups need at least {needed} lines"
     );
