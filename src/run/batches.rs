@@ -2,6 +2,8 @@
 //! random stream, hand them (traced, when asked) to a visitor, in parallel, and collect the results in
 //! batch order, so that whatever is added up from them does not depend on the thread count.
 
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+
 use rayon::prelude::*;
 
 use super::plan::BatchPlan;
@@ -104,9 +106,16 @@ pub fn all_batches(stream: &LineStream) -> Vec<u64> {
 /// Draws the lines of `batches` (through `scene`'s region for the stream's bound) and hands each batch
 /// to `visit` with a per-thread scratch `S`, in parallel; returns the results in batch order.
 ///
+/// The threads take the batches in the order of the list, each the next one not taken yet, so a round
+/// stopped early has done the list's first batches (and those in flight): consecutive batches, which
+/// fall in different standard-error groups (batch `b` is in group `b mod G`) and keep each group's
+/// share of a Sobol' sequence a prefix. Cutting the list in halves among the threads, as a parallel
+/// iterator does, had a second thread start halfway: in a round of a multiple of 2G batches, the first
+/// batch of each half is in group 0.
+///
 /// `stop(b)` is asked before batch `b` starts; when it says yes the batch is skipped. Every batch that
 /// finished is kept (a stop keeps the work done, whichever batches it was); the flag says whether every
-/// batch ran.
+/// batch ran. The first error ends the work (batches already started finish) and is returned.
 pub fn map_batches<S, T, E>(
     stream: &LineStream,
     scene: &Scene,
@@ -120,30 +129,62 @@ where
     E: Send,
 {
     let region = LineRegion::of(scene, stream.bound);
-    let per_batch: Vec<Option<(u64, T)>> = batches
-        .par_iter()
-        .copied()
-        .map_init(
-            || (Vec::new(), S::default()),
-            |(lines, scratch), b| {
-                if stop(b) {
-                    return Ok(None);
+    let next = AtomicUsize::new(0);
+    let failed = AtomicBool::new(false);
+    let worker = |_| {
+        let (mut lines, mut scratch) = (Vec::new(), S::default());
+        let mut taken = Taken {
+            done: Vec::new(),
+            skipped: 0,
+        };
+        while !failed.load(Ordering::Relaxed) {
+            let at = next.fetch_add(1, Ordering::Relaxed);
+            let Some(&b) = batches.get(at) else { break };
+            if stop(b) {
+                taken.skipped += 1;
+                continue;
+            }
+            lines.clear();
+            stream.draw(b, &region, &mut lines);
+            let batch = Batch {
+                index: b,
+                first_line: stream.plan.first_line(b),
+                lines: &lines,
+            };
+            match visit(&mut scratch, batch) {
+                Ok(t) => taken.done.push((at, b, t)),
+                Err(e) => {
+                    failed.store(true, Ordering::Relaxed);
+                    return Err(e);
                 }
-                lines.clear();
-                stream.draw(b, &region, lines);
-                let batch = Batch {
-                    index: b,
-                    first_line: stream.plan.first_line(b),
-                    lines,
-                };
-                visit(scratch, batch).map(|t| Some((b, t)))
-            },
-        )
+            }
+        }
+        Ok(taken)
+    };
+    let workers = rayon::current_num_threads().clamp(1, batches.len().max(1));
+    let parts: Vec<Taken<T>> = (0..workers)
+        .into_par_iter()
+        .map(worker)
         .collect::<Result<_, _>>()?;
-    let all = per_batch.len();
-    let finished: Vec<(u64, T)> = per_batch.into_iter().flatten().collect();
-    let complete = finished.len() == all;
-    Ok((finished, complete))
+    let mut finished: Vec<(usize, u64, T)> = Vec::with_capacity(batches.len());
+    let mut skipped = 0;
+    for part in parts {
+        finished.extend(part.done);
+        skipped += part.skipped;
+    }
+    finished.sort_unstable_by_key(|&(at, _, _)| at);
+    let complete = skipped == 0 && finished.len() == batches.len();
+    Ok((
+        finished.into_iter().map(|(_, b, t)| (b, t)).collect(),
+        complete,
+    ))
+}
+
+/// What one thread of [`map_batches`] took from the list: the batches it finished (position in the
+/// list, batch, result) and how many it skipped at a stop.
+struct Taken<T> {
+    done: Vec<(usize, u64, T)>,
+    skipped: usize,
 }
 
 /// Buffers for tracing one batch, kept from batch to batch.
@@ -184,4 +225,44 @@ where
             Ok(visit(scratch, batch, &buffers.hits))
         },
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A round stopped after its first few batches keeps batches of as many groups: a run of 2 threads
+    /// with a round of 4G batches (the first round of a run with a budget) stopped after 2 batches had
+    /// both in group 0.
+    #[test]
+    fn a_round_stopped_early_keeps_batches_of_different_groups() {
+        let scene = crate::scenes::load("@cube:1").unwrap();
+        let groups = 16u64;
+        let stream = LineStream {
+            groups,
+            ..LineStream::independent(64 * 4096, 1)
+        };
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(2)
+            .build()
+            .unwrap();
+        for allowed in [2usize, 3, 5] {
+            let started = AtomicUsize::new(0);
+            let stop = |_: u64| started.fetch_add(1, Ordering::SeqCst) >= allowed;
+            let batches: Vec<u64> = (0..64).collect();
+            let (done, complete) = pool
+                .install(|| {
+                    map_batches(&stream, &scene, &batches, &stop, |_: &mut (), batch| {
+                        Ok::<_, ()>(batch.lines.len())
+                    })
+                })
+                .unwrap();
+            assert!(!complete);
+            assert_eq!(done.len(), allowed);
+            let mut in_groups: Vec<u64> = done.iter().map(|&(b, _)| b % groups).collect();
+            in_groups.dedup();
+            assert_eq!(in_groups.len(), allowed, "batches {done:?}");
+            assert!(done.windows(2).all(|w| w[0].0 < w[1].0), "in batch order");
+        }
+    }
 }
