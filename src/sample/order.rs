@@ -117,11 +117,15 @@ fn is_touch(window: &[Crossing]) -> bool {
     if arrivals == 0 || arrivals != departures || arrivals + departures != window.len() {
         return false;
     }
-    window.iter().any(|a| {
-        window
-            .iter()
-            .any(|b| a.normal.dot(b.normal).abs() < 1.0 - 1e-9)
-    })
+    let at_an_angle = |a: &Crossing, b: &Crossing| a.normal.dot(b.normal).abs() < 1.0 - 1e-9;
+    if window.len() > SMALL_WINDOW {
+        // Planes all parallel to the first are parallel to each other (to the tolerance's order):
+        // O(n) for the stacks of a hostile file.
+        return window[1..].iter().any(|b| at_an_angle(&window[0], b));
+    }
+    window
+        .iter()
+        .any(|a| window.iter().any(|b| at_an_angle(a, b)))
 }
 
 /// Orders the window `start..end` given its neighbours. The space the line is in before the window is
@@ -177,7 +181,22 @@ pub(super) fn at_one_place(a: &Crossing, b: &Crossing) -> bool {
 /// Orders one window: by plane distance, and crossings whose plane distances differ by at most
 /// `same_place` (times max(t, 1)) so that the line alternates between front and back space, starting
 /// `in_front` or not. Returns the overlaps met and whether the line ends in front.
-fn order_window(window: &mut [Crossing], mut in_front: bool, same_place: f64) -> (u64, bool) {
+fn order_window(window: &mut [Crossing], in_front: bool, same_place: f64) -> (u64, bool) {
+    if window.len() > SMALL_WINDOW {
+        order_large_window(window, in_front, same_place)
+    } else {
+        order_small_window(window, in_front, same_place)
+    }
+}
+
+/// Windows up to this many crossings are ordered by scanning the crossings at the current place for
+/// each slot; larger ones (thousands of coplanar triangles stacked in a hostile file) by
+/// [`order_large_window`], the same order at O(n log n).
+const SMALL_WINDOW: usize = 32;
+
+/// [`order_window`] by rescanning the crossings still to place: O(n^2), cheapest for the few crossings
+/// of a window in a real scene.
+fn order_small_window(window: &mut [Crossing], mut in_front: bool, same_place: f64) -> (u64, bool) {
     let mut rest: Vec<Crossing> = window.to_vec();
     rest.sort_by(|a, b| a.t.total_cmp(&b.t));
     let mut overlaps = 0;
@@ -189,6 +208,69 @@ fn order_window(window: &mut [Crossing], mut in_front: bool, same_place: f64) ->
             .count();
         let pick = choose(&rest[..here], in_front);
         let c = rest.remove(pick);
+        if slot > 0 {
+            let last = window[slot - 1];
+            let coincident = (c.t - last.t).abs() <= COINCIDENT * c.t.abs().max(1.0);
+            if coincident && c.patch != last.patch && c.cos * last.cos > 0.0 {
+                overlaps += 1;
+            }
+        }
+        if c.cos != 0.0 {
+            in_front = c.cos > 0.0;
+        }
+        window[slot] = c;
+    }
+    (overlaps, in_front)
+}
+
+/// [`order_window`] in O(n log n): the crossings sorted by plane distance enter the candidates at the
+/// current place (arrivals and departures apart, each ordered by triangle and then by sorted position,
+/// which is how [`choose`] breaks ties) as the place moves on, and each slot takes [`choose`]'s pick
+/// from them.
+fn order_large_window(window: &mut [Crossing], mut in_front: bool, same_place: f64) -> (u64, bool) {
+    use std::collections::BTreeSet;
+    let mut sorted: Vec<Crossing> = window.to_vec();
+    sorted.sort_by(|a, b| a.t.total_cmp(&b.t));
+    let n = sorted.len();
+    let mut placed = vec![false; n];
+    // The first crossing not placed yet (the current place), and the first not yet a candidate.
+    let (mut first, mut entered) = (0, 0);
+    let mut arrivals: BTreeSet<(u32, usize)> = BTreeSet::new();
+    let mut departures: BTreeSet<(u32, usize)> = BTreeSet::new();
+    let mut overlaps = 0;
+    for slot in 0..n {
+        while placed[first] {
+            first += 1;
+        }
+        let t0 = sorted[first].t;
+        entered = entered.max(first);
+        while entered < n && sorted[entered].t - t0 <= same_place * t0.abs().max(1.0) {
+            let c = &sorted[entered];
+            if c.cos < 0.0 {
+                arrivals.insert((c.triangle, entered));
+            } else if c.cos > 0.0 {
+                departures.insert((c.triangle, entered));
+            }
+            entered += 1;
+        }
+        let first_arrival = arrivals.first().copied();
+        let first_departure = departures.last().copied();
+        let (preferred, other) = if in_front {
+            (first_arrival, first_departure)
+        } else {
+            (first_departure, first_arrival)
+        };
+        let pick = match preferred.or(other) {
+            Some(key) => {
+                arrivals.remove(&key);
+                departures.remove(&key);
+                key.1
+            }
+            // Only crossings in their planes at this place: the nearest.
+            None => first,
+        };
+        placed[pick] = true;
+        let c = sorted[pick];
         if slot > 0 {
             let last = window[slot - 1];
             let coincident = (c.t - last.t).abs() <= COINCIDENT * c.t.abs().max(1.0);
@@ -376,5 +458,40 @@ mod tests {
         let mut up = vec![c(4, 0.5, 1.0), c(6, 0.5, 1.0), c(5, -0.5, 3.0)];
         assert_eq!(reorder(&mut up, &hits, |_| false), 1);
         assert_eq!(patches(&up), [6, 4, 5]);
+    }
+
+    /// The large-window order is the small-window order: random windows with many crossings at one
+    /// place, both facings and crossings in their planes, repeated triangles, both place tolerances and
+    /// both starting spaces.
+    #[test]
+    fn large_windows_are_ordered_as_small_ones() {
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = |n: u64| {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state % n
+        };
+        for size in 1..120usize {
+            for _ in 0..8 {
+                let places = 1 + next(4);
+                let window: Vec<Crossing> = (0..size)
+                    .map(|_| {
+                        let place = next(places) as f64;
+                        let t = 1.0 + place * 1e-11 + next(3) as f64 * 1e-13;
+                        let cos = [-0.5, 0.5, 0.0, -0.25, 0.25][next(5) as usize];
+                        c(next(40) as u32, cos, t)
+                    })
+                    .collect();
+                for same_place in [COINCIDENT, f64::INFINITY] {
+                    for in_front in [true, false] {
+                        let (mut small, mut large) = (window.clone(), window.clone());
+                        let a = order_small_window(&mut small, in_front, same_place);
+                        let b = order_large_window(&mut large, in_front, same_place);
+                        assert_eq!((a, &small), (b, &large), "{window:?}");
+                    }
+                }
+            }
+        }
     }
 }

@@ -131,38 +131,175 @@ impl HitRules {
             kept.push(cluster[0]);
             return;
         }
-        // Component labels by union over "same facing and shares a vertex" (clusters are tiny).
-        let n = cluster.len();
-        let mut label: Vec<usize> = (0..n).collect();
         let facing: Vec<Facing> = cluster
             .iter()
             .map(|h| self.facing(h.triangle, dir))
             .collect();
-        for a in 0..n {
-            for b in a + 1..n {
+        let first = if cluster.len() <= SMALL_CLUSTER {
+            self.first_members_pairwise(cluster, &facing)
+        } else {
+            self.first_members_by_keys(cluster, &facing)
+        };
+        kept.extend(
+            cluster
+                .iter()
+                .zip(first)
+                .filter_map(|(h, is_first)| is_first.then_some(*h)),
+        );
+    }
+
+    /// Which members of a cluster come first in their component (joined when they are one triangle,
+    /// or face the line the same way and share a vertex), by testing every two members: the cheapest
+    /// way for the few hits of a cluster in a real scene.
+    fn first_members_pairwise(&self, cluster: &[Hit], facing: &[Facing]) -> Vec<bool> {
+        let mut parts = Components::new(cluster.len());
+        for a in 0..cluster.len() {
+            for b in a + 1..cluster.len() {
                 let same_crossing = cluster[a].triangle == cluster[b].triangle
                     || (facing[a] == facing[b]
                         && self.share_vertex(cluster[a].triangle, cluster[b].triangle));
                 if same_crossing {
-                    let (la, lb) = (label[a], label[b]);
-                    let (lo, hi) = (la.min(lb), la.max(lb));
-                    for l in label.iter_mut() {
-                        if *l == hi {
-                            *l = lo;
-                        }
-                    }
+                    parts.join(a, b);
                 }
             }
         }
+        parts.first_members()
+    }
+
+    /// [`HitRules::first_members_pairwise`] in O(n log n): members with a key in common (their triangle,
+    /// or a vertex with their facing) are joined through the sorted keys. A hostile scene can stack
+    /// thousands of coplanar triangles on one line; testing every two of them, on every line, ran for
+    /// hours.
+    fn first_members_by_keys(&self, cluster: &[Hit], facing: &[Facing]) -> Vec<bool> {
+        let mut parts = Components::new(cluster.len());
+        let mut keys: Vec<(u64, usize)> = Vec::with_capacity(4 * cluster.len());
         for (m, h) in cluster.iter().enumerate() {
-            if label[m] == m {
-                kept.push(*h);
+            // Triangles and (vertex, facing) keys kept apart by the top bit.
+            keys.push(((1 << 63) | u64::from(h.triangle), m));
+            for &v in &self.vertices[h.triangle as usize] {
+                keys.push(((u64::from(v) << 2) | facing[m] as u64, m));
             }
         }
+        keys.sort_unstable();
+        for pair in keys.windows(2) {
+            if pair[0].0 == pair[1].0 {
+                parts.join(pair[0].1, pair[1].1);
+            }
+        }
+        parts.first_members()
+    }
+}
+
+/// Clusters up to this many hits are merged by testing every two members.
+const SMALL_CLUSTER: usize = 16;
+
+/// The components of a cluster's members (union-find), each led by its first member.
+struct Components {
+    parent: Vec<usize>,
+}
+
+impl Components {
+    fn new(n: usize) -> Self {
+        Components {
+            parent: (0..n).collect(),
+        }
+    }
+
+    fn root(&mut self, mut m: usize) -> usize {
+        while self.parent[m] != m {
+            self.parent[m] = self.parent[self.parent[m]];
+            m = self.parent[m];
+        }
+        m
+    }
+
+    /// Joins the components of `a` and `b`; the earlier root leads (so a root is its component's first
+    /// member).
+    fn join(&mut self, a: usize, b: usize) {
+        let (ra, rb) = (self.root(a), self.root(b));
+        let (lo, hi) = (ra.min(rb), ra.max(rb));
+        self.parent[hi] = lo;
+    }
+
+    /// Whether each member is the first of its component.
+    fn first_members(mut self) -> Vec<bool> {
+        (0..self.parent.len()).map(|m| self.root(m) == m).collect()
     }
 }
 
 /// Two hits closer than this along a line may be one crossing.
 fn tolerance(t: f32) -> f32 {
     DUPLICATE_ULPS * f32::EPSILON * t.abs().max(1.0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The two ways of finding a cluster's first members agree, on clusters whose triangles share
+    /// vertices from a small pool (many joins, long chains), repeat triangles and mix facings.
+    #[test]
+    fn merging_by_keys_equals_testing_every_two_members() {
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let mut next = |n: u64| {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state % n
+        };
+        let triangles = 200u32;
+        for pool in [4u64, 30, 600] {
+            let vertices: Vec<[u32; 3]> = (0..triangles)
+                .map(|_| [0; 3].map(|_| next(pool) as u32))
+                .collect();
+            let normals: Vec<Normal> = (0..triangles)
+                .map(|_| DVec3::new(0.0, 0.0, [-1.0, 1.0, 0.0][next(3) as usize]))
+                .collect();
+            let rules = HitRules { normals, vertices };
+            let dir = DVec3::new(0.0, 0.0, 1.0);
+            for size in 2..60usize {
+                let cluster: Vec<Hit> = (0..size)
+                    .map(|_| Hit {
+                        t: 0.5,
+                        triangle: next(u64::from(triangles)) as u32,
+                    })
+                    .collect();
+                let facing: Vec<Facing> = cluster
+                    .iter()
+                    .map(|h| rules.facing(h.triangle, dir))
+                    .collect();
+                assert_eq!(
+                    rules.first_members_by_keys(&cluster, &facing),
+                    rules.first_members_pairwise(&cluster, &facing),
+                    "pool {pool}, cluster {cluster:?}"
+                );
+            }
+        }
+    }
+
+    /// Thousands of coplanar triangles stacked on a line, all sharing a vertex, are one crossing, found
+    /// without testing every two of them.
+    #[test]
+    fn a_stack_of_coplanar_triangles_is_one_crossing() {
+        let n = 20_000u32;
+        let rules = HitRules {
+            normals: vec![DVec3::new(0.0, 0.0, 1.0); n as usize],
+            vertices: (0..n).map(|k| [0, 1 + 2 * k, 2 + 2 * k]).collect(),
+        };
+        let line = Line {
+            origin: [0.1, 0.1, -1.0],
+            dir: [0.0, 0.0, 1.0],
+            t_max: 2.0,
+        };
+        let mut row: Vec<Hit> = (0..n)
+            .map(|k| Hit {
+                t: 1.0,
+                triangle: n - 1 - k,
+            })
+            .collect();
+        let mut kept = Vec::new();
+        let kept_count = rules.canonicalize_row(&line, &mut row, &mut kept);
+        assert_eq!(kept_count, 1);
+        assert_eq!(row[0].triangle, 0, "the first by (t, triangle)");
+    }
 }

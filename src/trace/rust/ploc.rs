@@ -121,6 +121,9 @@ pub(super) fn build<const SEARCH_DISTANCE: usize>(
             placed.push(right.node());
             placed.push(left.node());
         }
+        if stalled(current.len(), next.len()) {
+            next = merged_in_pairs(next, &mut insert_index, &mut placed);
+        }
         current = next;
         depth += 1;
     }
@@ -128,6 +131,41 @@ pub(super) fn build<const SEARCH_DISTANCE: usize>(
     debug_assert_eq!(insert_index.saturating_sub(1), 0);
     placed.reverse();
     placed
+}
+
+/// Whether a round of PLOC made too little progress: it merges nodes whose best neighbours are each
+/// other, and where thousands of boxes are alike (coplanar triangles stacked in a hostile file) the
+/// neighbours' costs tie and a round merges a pair or two, so the build took time quadratic in the
+/// triangles. Real scenes merge a large share of their nodes every round and never stall.
+fn stalled(before: usize, after: usize) -> bool {
+    before >= 64 && (before - after) * 64 < before
+}
+
+/// The nodes merged two by two in their order (the last alone when odd): a round that always halves
+/// the nodes, for a stalled build ([`stalled`]); the tree is poorer there, and the build linearithmic.
+fn merged_in_pairs(
+    nodes: Vec<Pending>,
+    insert_index: &mut usize,
+    placed: &mut Vec<Bvh2Node>,
+) -> Vec<Pending> {
+    let mut next = Vec::with_capacity(nodes.len().div_ceil(2));
+    for pair in nodes.chunks(2) {
+        match pair {
+            [left, right] => {
+                *insert_index -= 2;
+                next.push(Pending::of(
+                    &left.aabb().union(&right.aabb()),
+                    0,
+                    *insert_index as u32,
+                ));
+                placed.push(right.node());
+                placed.push(left.node());
+            }
+            [alone] => next.push(*alone),
+            _ => unreachable!("chunks of one or two"),
+        }
+    }
+    next
 }
 
 /// The leaves in the order of their centres' Morton codes (obvhs's `sort_nodes_m64`/`_m128`: the same
