@@ -62,7 +62,7 @@ pub fn detect(bytes: &[u8]) -> Option<Format> {
     if trimmed.starts_with('{') && text.contains("\"asset\"") {
         return Some(Format::Gltf);
     }
-    if trimmed.starts_with("solid") && text.contains("facet") {
+    if super::stl::looks_like_ascii_stl(bytes) {
         return Some(Format::StlAscii);
     }
     if is_binary_stl(bytes) {

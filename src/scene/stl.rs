@@ -1,7 +1,7 @@
-//! STL scenes (ASCII and binary), read with `stl_io`.
+//! STL scenes: binary, read with `stl_io`, and ASCII, read here.
 //!
-//! An STL file is one object (named after the file) of triangles with one material, scx's default
-//! (reflectance 0.5, no emission): STL has no materials. Each triangle is a patch, facing the side its
+//! An STL file is one object (named after the file), or with several ASCII solids an object per solid,
+//! of triangles with one material, scx's default (reflectance 0.5, no emission): STL has no materials. Each triangle is a patch, facing the side its
 //! corners run counter-clockwise about (the STL rule; the stored facet normals are often zero or stale).
 //!
 //! Writing ([`to_bytes`]): binary STL with `stl_io`, every triangle with its patch's normal, f32
@@ -27,6 +27,27 @@ pub(crate) fn read_bytes(
     bytes: &[u8],
     path: &Path,
 ) -> Result<SceneBuilder, SceneError> {
+    if looks_like_ascii_stl(bytes) {
+        match read_ascii(shown, bytes, path) {
+            // A binary STL's header is free text and may start `solid` and name facets.
+            Err(_) if is_binary_stl(bytes) => read_binary(shown, bytes, path),
+            read => read,
+        }
+    } else {
+        read_binary(shown, bytes, path)
+    }
+}
+
+/// Whether bytes start like an ASCII STL: `solid` (in any case, after a byte-order mark and blank
+/// space), with `facet` or `endsolid` among the first 4 KiB.
+pub(crate) fn looks_like_ascii_stl(bytes: &[u8]) -> bool {
+    let head = String::from_utf8_lossy(&bytes[..bytes.len().min(4096)]).to_ascii_lowercase();
+    let text = head.trim_start_matches('\u{feff}').trim_start();
+    text.starts_with("solid") && (text.contains("facet") || text.contains("endsolid"))
+}
+
+/// A binary STL, read with `stl_io`.
+fn read_binary(shown: &str, bytes: &[u8], path: &Path) -> Result<SceneBuilder, SceneError> {
     let file_error = |message: String| SceneError::in_file(shown, message);
     // A binary STL's 80-byte header is free text, and some exporters start it with `solid`, which
     // stl_io would take for the ASCII form: hide the word from it (the header carries no geometry).
@@ -51,6 +72,100 @@ pub(crate) fn read_bytes(
         b.polygon(&corners, material, format!("triangle {}", k + 1));
     }
     Ok(b)
+}
+
+/// An ASCII STL: `solid NAME`, facets (`facet normal x y z`, `outer loop`, three or more `vertex x y
+/// z`, `endloop`, `endfacet`), `endsolid [NAME]`, keywords in any case, any blank space, and any
+/// number of solids one after another (CAD tools write an assembly so). A file of one solid is one
+/// object named after the file; of several, an object per solid, named after it. Read by hand:
+/// `stl_io` reads the first solid only, and takes indented, tabbed or upper-case files for binary.
+fn read_ascii(shown: &str, bytes: &[u8], path: &Path) -> Result<SceneBuilder, SceneError> {
+    let text = String::from_utf8_lossy(bytes);
+    let text = text.trim_start_matches('\u{feff}');
+    let solids = text
+        .lines()
+        .filter(|l| first_word(l).eq_ignore_ascii_case("solid"))
+        .count();
+    let mut b = SceneBuilder::new(shown);
+    let material = b.material(Material::default());
+    let (mut in_solid, mut in_facet, mut in_loop) = (false, false, false);
+    let mut corners: Vec<u32> = Vec::new();
+    let (mut facets, mut solid_count) = (0usize, 0usize);
+    for (k, line) in text.lines().enumerate() {
+        let at = |message: String| SceneError::in_file(shown, format!("line {}: {message}", k + 1));
+        let mut words = line.split_whitespace();
+        let Some(word) = words.next() else { continue };
+        let expected = |what: &str| at(format!("`{word}` where {what} was expected"));
+        match word.to_ascii_lowercase().as_str() {
+            "solid" if !in_solid => {
+                in_solid = true;
+                solid_count += 1;
+                let name = line.trim().get(5..).unwrap_or("").trim();
+                if solids > 1 {
+                    let name = if name.is_empty() {
+                        format!("solid {solid_count}")
+                    } else {
+                        name.to_string()
+                    };
+                    b.object(&name);
+                } else {
+                    b.object(&super::object_name(path));
+                }
+            }
+            "endsolid" if in_solid && !in_facet => in_solid = false,
+            "facet" if in_solid && !in_facet => {
+                in_facet = true;
+                corners.clear();
+            }
+            "outer" if in_facet && !in_loop => {
+                if !words.next().is_some_and(|w| w.eq_ignore_ascii_case("loop")) {
+                    return Err(at("`outer` without `loop`".into()));
+                }
+                in_loop = true;
+            }
+            "vertex" if in_loop => {
+                let mut c = [0.0f32; 3];
+                for v in &mut c {
+                    let w = words
+                        .next()
+                        .ok_or_else(|| at("a vertex with fewer than 3 coordinates".into()))?;
+                    *v = w
+                        .parse::<f32>()
+                        .ok()
+                        .filter(|v| v.is_finite())
+                        .ok_or_else(|| {
+                            at(format!("vertex coordinate `{w}` is not a finite number"))
+                        })?;
+                }
+                corners.push(b.vertex(c.map(f64::from)));
+            }
+            "endloop" if in_loop => in_loop = false,
+            "endfacet" if in_facet && !in_loop => {
+                in_facet = false;
+                facets += 1;
+                if corners.len() < 3 {
+                    return Err(at(format!("facet {facets} has {} corners", corners.len())));
+                }
+                b.polygon(&corners, material, format!("triangle {facets}"));
+            }
+            _ if !in_solid => return Err(expected("`solid`")),
+            _ if !in_facet => return Err(expected("`facet` or `endsolid`")),
+            _ if !in_loop => return Err(expected("`outer loop` or `endfacet`")),
+            _ => return Err(expected("`vertex` or `endloop`")),
+        }
+    }
+    if in_solid {
+        return Err(SceneError::in_file(
+            shown,
+            "the file ends inside a solid (no `endsolid`): it is cut short".into(),
+        ));
+    }
+    Ok(b)
+}
+
+/// The first word of a line.
+fn first_word(line: &str) -> &str {
+    line.split_whitespace().next().unwrap_or("")
 }
 
 /// Whether bytes are a binary STL by their size: an 80-byte header, a triangle count, and 50 bytes per

@@ -571,6 +571,100 @@ fn stl_and_ply_in_ascii_and_binary() {
     }
 }
 
+/// The unit cube's 12 triangles (counter-clockwise seen from outside), as an ASCII STL facet each:
+/// `facet` with the given indent and separator.
+fn cube_stl_facets(indent: &str, sep: &str) -> Vec<String> {
+    let corner = |i: usize| [(i & 1) as f32, (i >> 1 & 1) as f32, (i >> 2 & 1) as f32];
+    let quads = [
+        [0, 4, 6, 2],
+        [1, 3, 7, 5],
+        [0, 1, 5, 4],
+        [2, 6, 7, 3],
+        [0, 2, 3, 1],
+        [4, 5, 7, 6],
+    ];
+    quads
+        .iter()
+        .flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]])
+        .map(|t| {
+            let mut f =
+                format!("{indent}facet{sep}normal{sep}0{sep}0{sep}0\n{indent}{indent}outer loop\n");
+            for v in t {
+                let c = corner(v);
+                f.push_str(&format!(
+                    "{indent}{indent}{indent}vertex{sep}{}{sep}{}{sep}{}\n",
+                    c[0], c[1], c[2]
+                ));
+            }
+            f + &format!("{indent}{indent}endloop\n{indent}endfacet\n")
+        })
+        .collect()
+}
+
+/// ASCII STL as tools write it: several solids in one file (each an object, none dropped), a
+/// byte-order mark, blank lines, tabs, indentation, upper case; a file cut short, a facet of two
+/// corners and a coordinate that is not a number are refused by line.
+#[test]
+fn ascii_stl_in_the_forms_tools_write() {
+    let facets = cube_stl_facets(" ", " ");
+    let dir = tempfile::tempdir().unwrap();
+    let two_solids = format!(
+        "solid lower\n{}endsolid lower\nsolid upper half\n{}endsolid upper half\n",
+        facets[..6].concat(),
+        facets[6..].concat()
+    );
+    let spaced = format!(
+        "\u{feff}\n\n  solid\n{}\nendsolid\n",
+        cube_stl_facets("\t", " \t ").concat()
+    );
+    let upper = format!("solid cube\n{}endsolid cube\n", facets.concat()).to_uppercase();
+    for (name, text, objects) in [
+        ("two.stl", two_solids, vec!["lower", "upper half"]),
+        ("spaced.stl", spaced, vec!["spaced"]),
+        ("upper.stl", upper, vec!["upper"]),
+    ] {
+        let path = write(dir.path(), name, text.as_bytes());
+        let scene = load_file(&path, &SceneOptions::default());
+        assert_eq!(scene.patch_count(), 12, "{name}");
+        assert!(
+            (scene.total_area_scene_units() - 6.0).abs() < 1e-9,
+            "{name}"
+        );
+        assert_eq!(scene.objects, objects, "{name}");
+    }
+    let one = &facets[0];
+    for (text, says) in [
+        (format!("solid t\n{one}"), "cut short"),
+        (
+            format!(
+                "solid t\n{}endsolid\n",
+                one.replacen("vertex 0 0 0", "vertex 0 nan 0", 1)
+            ),
+            "line 4: vertex coordinate `nan` is not a finite number",
+        ),
+        (
+            format!(
+                "solid t\n{}endsolid\n",
+                one.replacen("   vertex 0 0 0\n", "", 1)
+            ),
+            "line 7: facet 1 has 2 corners",
+        ),
+        (
+            format!("solid t\n{one}junk\nendsolid\n"),
+            "line 9: `junk` where `facet` or `endsolid`",
+        ),
+    ] {
+        let path = write(dir.path(), "bad.stl", text.as_bytes());
+        let err = load_with(path.to_str().unwrap(), &SceneOptions::default())
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("bad.stl") && err.contains(says),
+            "{err}\n{text}"
+        );
+    }
+}
+
 /// I_s^c depends on the geometry only (paper sec. 3.2): the room with a box as quads, as triangles, as
 /// exported glTF and as PLY gives the same I_s^c within the combined standard errors (independent seeds).
 #[test]
