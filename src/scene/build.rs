@@ -92,6 +92,9 @@ pub struct SceneBuilder {
     objects: Vec<String>,
     current_object: Option<u32>,
     warnings: Vec<SceneWarning>,
+    /// Faces that went round their corners more than once (`f 1 2 3 1 2 3`), read once round: how many,
+    /// and the first's origin and number of rounds.
+    wound_again: (usize, Option<(String, usize)>),
 }
 
 #[derive(Clone, Copy, Debug)]
@@ -168,6 +171,7 @@ impl SceneBuilder {
             objects: Vec::new(),
             current_object: None,
             warnings: Vec::new(),
+            wound_again: (0, None),
         }
     }
 
@@ -232,6 +236,15 @@ impl SceneBuilder {
     ) {
         let object = self.current_object();
         let origin = origin.into();
+        let once = once_round(vertices);
+        if once.len() < vertices.len() {
+            self.wound_again.0 += 1;
+            let rounds = vertices.len() / once.len();
+            self.wound_again
+                .1
+                .get_or_insert_with(|| (origin.clone(), rounds));
+        }
+        let vertices = once;
         self.polygons.push(Polygon {
             start: self.corners.len(),
             len: vertices.len(),
@@ -244,6 +257,23 @@ impl SceneBuilder {
         });
         self.corners.extend_from_slice(vertices);
         self.origins.push_str(&origin);
+    }
+
+    /// The warning for faces that went round their corners more than once, if any did.
+    fn wound_again_warning(&mut self) {
+        let (count, Some((first, rounds))) = std::mem::take(&mut self.wound_again) else {
+            return;
+        };
+        let message = format!(
+            "{}: {count} face(s) list their corners more than once round (first: {first}, {rounds} \
+             times), read once round: each round again would lay the face on itself and count its area \
+             again",
+            self.name
+        );
+        self.warnings.push(
+            SceneWarning::new(SceneWarningKind::DuplicateFaces, message)
+                .with_numbers(&[("faces", count as f64)]),
+        );
     }
 
     /// Records a non-fatal problem to report with the scene.
@@ -268,6 +298,7 @@ impl SceneBuilder {
         if self.materials.is_empty() {
             self.materials.push(Material::default());
         }
+        self.wound_again_warning();
         if self.objects.is_empty() {
             let name = self.name.clone();
             self.object(&name);
@@ -600,6 +631,16 @@ fn weld_f32(traced: &[Point], polygons: &[Polygon], corners: &mut [u32]) -> Vec<
         }
     }
     old_of_new
+}
+
+/// A polygon's corners once round: the shortest prefix (of 3 corners or more) that the whole list
+/// repeats (`1 2 3 1 2 3` is `1 2 3` twice), or all of them.
+fn once_round(vertices: &[u32]) -> &[u32] {
+    let n = vertices.len();
+    (3..n)
+        .filter(|p| n % p == 0)
+        .find(|&p| (p..n).all(|i| vertices[i] == vertices[i - p]))
+        .map_or(vertices, |p| &vertices[..p])
 }
 
 /// Drops, with a warning, faces with the same corners in the same cyclic order as an earlier face: they

@@ -1169,3 +1169,35 @@ fn a_byte_order_mark_alone_is_an_empty_obj() {
         .to_string();
     assert!(e.contains("no faces"), "{e}");
 }
+
+/// A face that goes round its corners twice (`f 1 3 2 1 3 2`) is read once round, with a warning:
+/// read as listed it laid two copies of itself on one patch, whose area then counted twice.
+#[test]
+fn a_face_listing_its_corners_twice_counts_once() {
+    let dir = tempfile::tempdir().unwrap();
+    let tetrahedron = |first: &str| {
+        format!("v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf {first}\nf 1 2 4\nf 1 4 3\nf 2 3 4\n")
+    };
+    let once = load_file(
+        &write(dir.path(), "once.obj", tetrahedron("1 3 2").as_bytes()),
+        &SceneOptions::default(),
+    );
+    for corners in ["1 3 2 1 3 2", "1 3 2 1 3 2 1 3 2"] {
+        let path = write(dir.path(), "twice.obj", tetrahedron(corners).as_bytes());
+        let scene = load_file(&path, &SceneOptions::default());
+        assert_eq!(scene.patch_count(), 4, "{corners}");
+        assert_eq!(scene.triangles.len(), 4, "{corners}");
+        let area = scene.total_area_scene_units();
+        assert!(
+            (area - once.total_area_scene_units()).abs() < 1e-12,
+            "{area}"
+        );
+        assert!((area - (1.5 + 0.75f64.sqrt())).abs() < 1e-12, "{area}");
+        assert!(
+            messages(&scene.warnings).contains("list their corners more than once round"),
+            "{}",
+            messages(&scene.warnings)
+        );
+    }
+    assert!(once.warnings.is_empty(), "{}", messages(&once.warnings));
+}
