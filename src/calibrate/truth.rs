@@ -129,7 +129,7 @@ pub type FormFactorRows = Vec<Vec<f64>>;
 /// The exact values of a calibration scene.
 pub fn truth(scene: &CalibrationScene) -> Result<Truth, TruthError> {
     let values = match *scene {
-        CalibrationScene::Cube(n) => closed_values(cube_discrete(n), cube_pair_sums()),
+        CalibrationScene::Cube(n) => closed_values(cube_discrete(n)?, cube_pair_sums()),
         CalibrationScene::Solid(..) => solid_values(scene)?,
         CalibrationScene::ParallelSquares { distance, .. } => {
             open_values(&scene.build()?, squares_pair_sums(Some(distance)))?
@@ -139,7 +139,7 @@ pub fn truth(scene: &CalibrationScene) -> Result<Truth, TruthError> {
         }
         CalibrationScene::FlippedCube(n) => flipped_cube_values(&scene.build()?, n)?,
         CalibrationScene::LitCube(n) => {
-            let mut values = closed_values(cube_discrete(n), cube_pair_sums());
+            let mut values = closed_values(cube_discrete(n)?, cube_pair_sums());
             values.extend(radiosity_values(&scene.build()?)?);
             values
         }
@@ -393,18 +393,18 @@ fn cube_face_rows(n: usize) -> Result<(usize, FormFactorRows), SceneError> {
 /// Eqs. (17), (7), (21) and (22) of `@cube:n` from the rows of face 0: every patch has the same area and
 /// the cube's symmetry maps every face onto face 0, so H_s is the mean row entropy of face 0,
 /// H(X, Y) = H_p + H_s, I_s = H_p - H_s (eq. 20) and `sum_ij F_ij^2` is 6 times face 0's share.
-pub fn cube_discrete(n: usize) -> DiscreteExact {
-    let (patches, rows) = cube_face_rows(n).expect("@cube:N builds for every N >= 1");
+pub fn cube_discrete(n: usize) -> Result<DiscreteExact, SceneError> {
+    let (patches, rows) = cube_face_rows(n)?;
     let row_entropy = |row: &Vec<f64>| row.iter().map(|&f| neg_xlog2x(f)).sum::<f64>();
     let entropy = rows.iter().map(row_entropy).sum::<f64>() / rows.len() as f64;
     let sum_f2: f64 = rows.iter().flatten().map(|f| f * f).sum();
     let positional_entropy = (patches as f64).log2();
-    DiscreteExact {
+    Ok(DiscreteExact {
         entropy,
         joint_entropy: positional_entropy + entropy,
         mutual_information: positional_entropy - entropy,
         mse_per_line: Some(patches as f64 - 6.0 * sum_f2),
-    }
+    })
 }
 
 /// The patches of a scene as triangles (each polygon fanned from its first corner), scene units.
@@ -724,7 +724,7 @@ mod tests {
         let scene = CalibrationScene::Cube(n).build().unwrap();
         let (areas, rows) = rectangle_form_factors(&scene).unwrap();
         let full = discrete_per_area(&areas, &rows);
-        let shortcut = cube_discrete(n);
+        let shortcut = cube_discrete(n).unwrap();
         assert!((full.entropy - shortcut.entropy).abs() < 1e-12);
         assert!((full.mutual_information - shortcut.mutual_information).abs() < 1e-12);
         assert!((full.mse_per_line.unwrap() - shortcut.mse_per_line.unwrap()).abs() < 1e-10);

@@ -32,24 +32,24 @@ pub struct CalibrateArgs {
     #[arg(long, value_delimiter = ',', value_parser = parse_scene)]
     scene: Vec<CalibrationScene>,
     /// Lines per run, comma separated (with `--scene`; a cap with a target).
-    #[arg(long, value_delimiter = ',', value_parser = parse_count, default_value = "1e5")]
+    #[arg(long, requires = "scene", value_delimiter = ',', value_parser = parse_count, default_value = "1e5")]
     lines: Vec<u64>,
     /// Runs per cell (with `--scene`), seeds `first-seed..first-seed + seeds`.
-    #[arg(long, value_parser = parse_seed_count, default_value = "200")]
+    #[arg(long, requires = "scene", value_parser = parse_seed_count, default_value = "200")]
     seeds: u64,
     /// The first seed (with `--scene`).
-    #[arg(long, value_parser = parse_seed, default_value = "1")]
+    #[arg(long, requires = "scene", value_parser = parse_seed, default_value = "1")]
     first_seed: u64,
     /// Measures of the runs (with `--scene`): `all`, or `continuous` (I_s^c alone, as
     /// `scx analyze --measures continuous`).
-    #[arg(long, default_value = "all", value_parser = parse_measures)]
+    #[arg(long, requires = "scene", default_value = "all", value_parser = parse_measures)]
     measures: CellMeasures,
     /// A precision target for every run (with `--scene`): stop when the standard error of
     /// `--target-measure` reaches this on an ok reading, or at `--lines`.
-    #[arg(long, value_parser = parse_positive)]
+    #[arg(long, requires = "scene", value_parser = parse_positive)]
     target_stderr: Option<f64>,
-    /// The measure the target watches.
-    #[arg(long, default_value = Measure::DEFAULT_TARGET.key(), value_parser = target_measure_parser())]
+    /// The measure the target watches (with `--scene`).
+    #[arg(long, requires = "scene", default_value = Measure::DEFAULT_TARGET.key(), value_parser = target_measure_parser())]
     target_measure: Measure,
     /// How the runs draw their lines, for every cell (the suite's or `--scene`'s): `independent` or
     /// `sobol` (`scx analyze --sampler`).
@@ -165,6 +165,16 @@ pub fn run(args: &CalibrateArgs) -> Result<Exit, Failure> {
             .collect();
         output::emit(args.out.output.as_deref(), &list)?;
         return Ok(Exit::Ok);
+    }
+    // Every scene is built before the table starts: one that cannot be (a parameter beyond what the
+    // scene allows) is refused as the input it is, not after the header.
+    let mut built: Vec<String> = Vec::new();
+    for cell in &cells {
+        let name = cell.scene.name();
+        if !built.contains(&name) {
+            cell.scene.build().map_err(Failure::bad_input)?;
+            built.push(name);
+        }
     }
     let backend = TracerArg::backend(args.tracer.value);
     let (threads, pool) = thread_pool(args.threads.value)?;

@@ -299,6 +299,34 @@ fn the_command_prints_the_table_and_writes_csv() {
     let bad = crate::support::scx(&["calibrate", "--scene", "@sphere:2"]);
     assert_eq!(bad.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&bad.stderr).contains("exact values"));
+    // Parameters the scene cannot take are bad input before the table starts (they were an internal
+    // error, exit 101, and an error after the table's header).
+    for (scene, says) in [
+        ("@cube:3000", "from 1 to 2000"),
+        ("two-squares:parallel:2:1e9", "no faces of non-zero area"),
+    ] {
+        let bad = crate::support::scx(&["calibrate", "--scene", scene, "--seeds", "2"]);
+        let stderr = String::from_utf8_lossy(&bad.stderr);
+        assert_eq!(bad.status.code(), Some(2), "{scene}: {stderr}");
+        assert!(
+            stderr.contains(says) && !stderr.contains("internal error"),
+            "{stderr}"
+        );
+        assert!(bad.stdout.is_empty(), "{scene}");
+    }
+    // Options of `--scene`'s cells are refused without it (the suite's cells went on unchanged).
+    for option in [
+        ["--lines", "1e3"],
+        ["--seeds", "5"],
+        ["--first-seed", "7"],
+        ["--measures", "continuous"],
+    ] {
+        let args = [&["calibrate", "--list"][..], &option[..]].concat();
+        let bad = crate::support::scx(&args);
+        let stderr = String::from_utf8_lossy(&bad.stderr);
+        assert_eq!(bad.status.code(), Some(2), "{option:?}: {stderr}");
+        assert!(stderr.contains("--scene"), "{stderr}");
+    }
 }
 
 /// A cell's runs are `scx analyze`'s: its lines are the sphere's, and with the Sobol' sampler `auto`

@@ -105,7 +105,9 @@ fn corrected_readings_of_sobol_runs_are_debiased() {
 fn a_debiased_reading_that_the_plug_in_contradicts_is_not_ok() {
     let scene = scenes::load("@cube:10").unwrap();
     let tracer = make_tracer(Backend::Rust, &scene, Query::Single).unwrap();
-    let exact = scene_complexity::calibrate::truth::cube_discrete(10).mutual_information;
+    let exact = scene_complexity::calibrate::truth::cube_discrete(10)
+        .unwrap()
+        .mutual_information;
     let spec = RunSpec {
         measures: Measures {
             continuous: false,
