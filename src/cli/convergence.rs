@@ -5,6 +5,7 @@ use std::fmt::Write as _;
 use std::path::PathBuf;
 
 use clap::ValueEnum;
+use scene_complexity::report::reliability_json;
 use scene_complexity::Analysis;
 use scene_complexity::RunWarningKind;
 use scene_complexity::StopReason;
@@ -279,7 +280,12 @@ fn json_report(info: &report::RunInfo, levels: &[Level], repeats: u32) -> String
                     let info = m.info();
                     measures.insert(
                         info.symbol.replace(' ', "_"),
-                        json!({"value": e.value, "stderr": e.stderr, "unit": info.unit.name()}),
+                        json!({
+                            "value": e.value,
+                            "stderr": e.stderr,
+                            "unit": info.unit.name(),
+                            "reliability": reliability_json(a.reliability.get(m)),
+                        }),
                     );
                 }
             }

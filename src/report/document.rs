@@ -66,7 +66,9 @@ pub fn bundle(a: &Analysis) -> u32 {
     }
 }
 
-fn reliability_json(r: Option<&Reliability>) -> Value {
+/// A reading's verdict as JSON (`null` for none: an exact reading or none at all), as `analyze`'s report
+/// writes it.
+pub fn reliability_json(r: Option<&Reliability>) -> Value {
     match r {
         None => Value::Null,
         Some(r) => json!({

@@ -10,7 +10,9 @@ mod form_factors;
 mod rows;
 mod tables;
 
-pub use document::{bundle, json, skipped_reason, Context, Process, SCHEMA_VERSION};
+pub use document::{
+    bundle, json, reliability_json, skipped_reason, Context, Process, SCHEMA_VERSION,
+};
 pub use form_factors::{form_factor, FormFactors};
 pub use rows::{finite, positive_zero, rows, Row};
 pub use tables::{object_table, patch_table, Column, Table, Values};

@@ -308,6 +308,59 @@ fn convergence_writes_a_table_a_csv_and_a_plot() {
     );
 }
 
+/// `convergence --format json` carries every reading's verdict, as its help says, and the verdicts are
+/// the CSV's of the same runs.
+#[test]
+fn convergence_json_carries_the_verdicts_of_its_csv() {
+    let dir = tempfile::tempdir().unwrap();
+    let (json, csv) = (dir.path().join("c.json"), dir.path().join("c.csv"));
+    let out = scx(&[
+        "convergence",
+        "@cube:3",
+        "--lines",
+        "1e4,1e5",
+        "--format",
+        "json",
+        "-o",
+        json.to_str().unwrap(),
+        "--csv",
+        csv.to_str().unwrap(),
+    ]);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let doc: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let csv = std::fs::read_to_string(&csv).unwrap();
+    let header: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
+    let col = |name: &str| header.iter().position(|h| *h == name).unwrap();
+    let (lines, measure) = (col("lines"), col("measure"));
+    let (plain, corrected) = (col("reliability"), col("corrected_reliability"));
+    let mut checked = 0;
+    for run in doc["runs"].as_array().unwrap() {
+        let n = run["lines"].as_u64().unwrap().to_string();
+        for (symbol, key) in [("I_s", "mutual_information"), ("H_s", "entropy")] {
+            let row: Vec<&str> = csv
+                .lines()
+                .map(|l| l.split(',').collect::<Vec<_>>())
+                .find(|r| r[lines] == n && r[measure] == key)
+                .unwrap();
+            let verdict = |m: &str| run["measures"][m]["reliability"]["verdict"].clone();
+            assert_eq!(verdict(symbol), row[plain], "{symbol} at {n}");
+            assert_eq!(
+                verdict(&format!("{symbol}_corrected")),
+                row[corrected],
+                "{symbol} at {n}"
+            );
+            checked += 1;
+        }
+    }
+    assert_eq!(checked, 4);
+}
+
 /// One flat quad sees nothing of itself: `convergence` names the undefined measures and says why (the
 /// `no-pairs` warning, which knows the scene is flat), writes no plot and says so, and exits 0.
 #[test]
