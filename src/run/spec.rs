@@ -458,9 +458,10 @@ pub enum ExtendError {
     },
     /// The longer run would have other batches or groups.
     #[error(
-        "a run of {lines} lines (batches of {batch_size}) can be continued to more lines cut the same \
-         way: {asked} lines would be batches of {asked_batch_size} in {asked_groups} groups (from {} lines \
-         on, every run has batches of {})",
+        "a run of {lines} lines is cut into batches of {batch_size}, and a run can be continued only to \
+         line counts cut the same way: {asked} lines would be batches of {asked_batch_size} in \
+         {asked_groups} groups. Runs of {} lines or more all have batches of {} and can be continued to \
+         any count: start a run with at least that many lines to continue it freely",
         BatchPlan::FULL_FROM,
         BatchPlan::MAX_BATCH
     )]
