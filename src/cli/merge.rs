@@ -53,6 +53,30 @@ struct Merged {
     without_sums: Vec<String>,
 }
 
+/// The scene a state names, as it was named (from the folder `scx analyze` ran in): a built-in, a file
+/// found from here, or else the same relative path from the state's own folder (shards are often
+/// saved beside their scene; its fingerprint is checked all the same). Not found either way: a message
+/// saying what the name is and how to give the scene.
+fn saved_scene(name: &str, state: &Path) -> Result<String, Failure> {
+    let as_named = Path::new(name);
+    if name.starts_with('@') || name == "-" || as_named.exists() {
+        return Ok(name.to_string());
+    }
+    if as_named.is_relative() {
+        if let Some(beside) = state.parent().map(|dir| dir.join(as_named)) {
+            if beside.exists() {
+                return Ok(beside.to_string_lossy().into_owned());
+            }
+        }
+    }
+    Err(Failure::bad_input(format!(
+        "{name}: no such file: it is the scene the states were run on, named as it was from the \
+         folder `scx analyze` ran in (not found from here nor beside {}); run `scx merge` from that \
+         folder, or name the scene with --scene FILE",
+        state.display()
+    )))
+}
+
 /// Reads every state file, refusing, with the files named, states of different runs.
 fn read_states(args: &MergeArgs) -> Result<Vec<StateFile>, Failure> {
     let files = args
@@ -159,10 +183,10 @@ pub fn run(args: &MergeArgs) -> Result<Exit, Failure> {
     let _lock = output::lock_states(args.save.as_deref())?;
     let files = read_states(args)?;
     let first_identity = files[0].identity().clone();
-    let name = args
-        .scene
-        .clone()
-        .unwrap_or_else(|| first_identity.scene.name.clone());
+    let name = match &args.scene {
+        Some(scene) => scene.clone(),
+        None => saved_scene(&first_identity.scene.name, &args.states[0])?,
+    };
     let runner = Runner::with(
         &name,
         (&first_identity.scene.reading, &args.reading.policy()),

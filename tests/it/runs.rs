@@ -653,3 +653,59 @@ fn states_without_per_patch_sums_say_so() {
         assert!(out.stdout.is_empty() && !Path::new(&table).exists());
     }
 }
+
+/// Shards saved beside their scene, named relative to that folder, merge from another folder (the
+/// scene is found beside the states; it said only "cube.obj: no such file"); when it is not there
+/// either, the message says what the name is and how to give the scene.
+#[test]
+fn merge_finds_the_scene_beside_its_states() {
+    let dir = tempfile::tempdir().unwrap();
+    let shards = dir.path().join("shards");
+    std::fs::create_dir(&shards).unwrap();
+    let in_dir = |dir: &Path, args: &[&str]| {
+        Command::new(env!("CARGO_BIN_EXE_scx"))
+            .current_dir(dir)
+            .args(args)
+            .output()
+            .unwrap()
+    };
+    assert!(
+        in_dir(&shards, &["export", "@cube:3", "-o", "cube.obj", "-q"])
+            .status
+            .success()
+    );
+    for k in ["1/2", "2/2"] {
+        let save = format!("s{}.scx", &k[..1]);
+        let args = [
+            "analyze", "cube.obj", "--lines", "2e4", "--shard", k, "--save", &save, "-q",
+        ];
+        assert!(in_dir(&shards, &args).status.success());
+    }
+    let whole = json(&in_dir(
+        &shards,
+        &["analyze", "cube.obj", "--lines", "2e4", "--format", "json"],
+    ));
+    let merge = [
+        "merge",
+        "shards/s1.scx",
+        "shards/s2.scx",
+        "--format",
+        "json",
+    ];
+    let merged = json(&in_dir(dir.path(), &merge));
+    for key in [
+        "entropy",
+        "mutual_information",
+        "continuous_mutual_information",
+    ] {
+        assert_eq!(merged["visibility"][key], whole["visibility"][key], "{key}");
+    }
+    std::fs::rename(shards.join("cube.obj"), shards.join("moved.obj")).unwrap();
+    let lost = in_dir(dir.path(), &merge);
+    let err = String::from_utf8_lossy(&lost.stderr);
+    assert_eq!(lost.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("cube.obj: no such file") && err.contains("--scene"),
+        "{err}"
+    );
+}
