@@ -92,6 +92,7 @@ fn load_document(
     // Depth first in document order: objects come in the file's order.
     let tree = gltf_data::node_tree(root, &roots).map_err(|p| file_error(p.to_string()))?;
     let nodes: Vec<::gltf::Node> = gltf.nodes().collect();
+    check_placed_size(&tree, &nodes, budget.max()).map_err(|p| file_error(p.to_string()))?;
     let mut worlds: Vec<Matrix> = Vec::with_capacity(tree.len());
     let mut primitives_seen = 0usize;
     let mut skipped_modes = 0usize;
@@ -571,6 +572,34 @@ fn glb(document: &serde_json::Value, buffer: &[u8]) -> Vec<u8> {
     out.extend_from_slice(b"BIN\0");
     out.extend_from_slice(&bin);
     out
+}
+
+/// Refuses, before any mesh is read, nodes that place more bytes of positions and indices (by their
+/// accessors' counts) than `max`: the same limit the reading spends against, checked up front, since a
+/// small file can place one mesh from a hundred thousand nodes and the scene built up to the limit took
+/// gigabytes before the refusal came.
+fn check_placed_size(
+    tree: &[(usize, Option<usize>)],
+    nodes: &[::gltf::Node],
+    max: u64,
+) -> Result<(), gltf_data::AccessorProblem> {
+    let mut placed = 0u64;
+    for &(k, _) in tree {
+        let Some(mesh) = nodes[k].mesh() else {
+            continue;
+        };
+        for primitive in mesh.primitives() {
+            // What the reading spends: each accessor's elements at their size.
+            let bytes = |a: ::gltf::Accessor| (a.count() as u64).saturating_mul(a.size() as u64);
+            let positions = primitive.get(&Semantic::Positions).map_or(0, bytes);
+            let indices = primitive.indices().map_or(0, bytes);
+            placed = placed.saturating_add(positions).saturating_add(indices);
+            if placed > max {
+                return Err(gltf_data::AccessorProblem::OverBudget { max });
+            }
+        }
+    }
+    Ok(())
 }
 
 #[cfg(test)]

@@ -222,6 +222,11 @@ impl Budget {
         Budget { left: max, max }
     }
 
+    /// The budget in all, in bytes.
+    pub fn max(&self) -> u64 {
+        self.max
+    }
+
     /// Spends `bytes`, or says that the meshes hold too much.
     fn spend(&mut self, bytes: u64) -> Result<(), AccessorProblem> {
         self.left = self
