@@ -589,8 +589,12 @@ fn check_placed_size(
             continue;
         };
         for primitive in mesh.primitives() {
-            // What the reading spends: each accessor's elements at their size.
-            let bytes = |a: ::gltf::Accessor| (a.count() as u64).saturating_mul(a.size() as u64);
+            // What the reading spends: each accessor's elements at their size, at most its view's
+            // length (an accessor that claims more is refused by the reading, with that reason).
+            let bytes = |a: ::gltf::Accessor| {
+                let claimed = (a.count() as u64).saturating_mul(a.size() as u64);
+                a.view().map_or(claimed, |v| claimed.min(v.length() as u64))
+            };
             let positions = primitive.get(&Semantic::Positions).map_or(0, bytes);
             let indices = primitive.indices().map_or(0, bytes);
             placed = placed.saturating_add(positions).saturating_add(indices);
