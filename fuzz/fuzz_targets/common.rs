@@ -1,9 +1,9 @@
 //! What every fuzz target does with a scene that loaded: trace it a little and check its measures.
 #![allow(dead_code)]
 
-use scene_complexity::{analyze, Measure, RunControl, RunSpec};
 use scene_complexity::internals::scene::{ReadPolicy, Scene};
 use scene_complexity::internals::trace::{make_tracer, Backend, Query};
+use scene_complexity::{analyze, Measure, RunControl, RunSpec};
 
 /// The reading policy of the fuzz targets: references inside a folder that does not exist (so no input
 /// reads a file), and a small size limit (so that no input may ask for much memory and slow the run).

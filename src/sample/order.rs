@@ -208,17 +208,7 @@ fn order_small_window(window: &mut [Crossing], mut in_front: bool, same_place: f
             .count();
         let pick = choose(&rest[..here], in_front);
         let c = rest.remove(pick);
-        if slot > 0 {
-            let last = window[slot - 1];
-            let coincident = (c.t - last.t).abs() <= COINCIDENT * c.t.abs().max(1.0);
-            if coincident && c.patch != last.patch && c.cos * last.cos > 0.0 {
-                overlaps += 1;
-            }
-        }
-        if c.cos != 0.0 {
-            in_front = c.cos > 0.0;
-        }
-        window[slot] = c;
+        overlaps += place(window, slot, c, &mut in_front);
     }
     (overlaps, in_front)
 }
@@ -270,20 +260,27 @@ fn order_large_window(window: &mut [Crossing], mut in_front: bool, same_place: f
             None => first,
         };
         placed[pick] = true;
-        let c = sorted[pick];
-        if slot > 0 {
-            let last = window[slot - 1];
-            let coincident = (c.t - last.t).abs() <= COINCIDENT * c.t.abs().max(1.0);
-            if coincident && c.patch != last.patch && c.cos * last.cos > 0.0 {
-                overlaps += 1;
-            }
-        }
-        if c.cos != 0.0 {
-            in_front = c.cos > 0.0;
-        }
-        window[slot] = c;
+        overlaps += place(window, slot, sorted[pick], &mut in_front);
     }
     (overlaps, in_front)
+}
+
+/// Puts crossing `c` in `window[slot]` and moves the line into the space it leads to; returns 1 when
+/// it overlaps the crossing before it (coincident, another patch, facing the same way), else 0.
+fn place(window: &mut [Crossing], slot: usize, c: Crossing, in_front: &mut bool) -> u64 {
+    let mut overlap = 0;
+    if slot > 0 {
+        let last = window[slot - 1];
+        let coincident = (c.t - last.t).abs() <= COINCIDENT * c.t.abs().max(1.0);
+        if coincident && c.patch != last.patch && c.cos * last.cos > 0.0 {
+            overlap = 1;
+        }
+    }
+    if c.cos != 0.0 {
+        *in_front = c.cos > 0.0;
+    }
+    window[slot] = c;
+    overlap
 }
 
 /// Which of the crossings at one place comes next: one that closes the current space (arriving at a
