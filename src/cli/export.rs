@@ -32,10 +32,10 @@ pub fn run(args: &ExportArgs) -> Result<Exit, Failure> {
     check_not_read(&args.output, format, &scene)?;
     let beside = write_scene(&scene, format, &args.output)?;
     output::note(&format!(
-        "wrote {} as {}, {} patches{beside}",
+        "wrote {} as {}, {}{beside}",
         args.output.display(),
         format.name(),
-        scene.patch_count(),
+        format.patches_written(&scene),
     ));
     Ok(Exit::Ok)
 }

@@ -120,10 +120,10 @@ pub fn run(args: &RefineArgs) -> Result<Exit, Failure> {
     let beside = super::export::write_scene(&refined.scene, format, &args.output)?;
     let lines: u64 = refined.rounds.iter().map(|r| r.lines).sum();
     output::note(&format!(
-        "wrote {} as {}, {} patches{beside}: {} rounds, {lines} lines, {:.2} s",
+        "wrote {} as {}, {}{beside}: {} rounds, {lines} lines, {:.2} s",
         args.output.display(),
         format.name(),
-        refined.scene.patch_count(),
+        format.patches_written(&refined.scene),
         refined.rounds.len(),
         started.elapsed().as_secs_f64()
     ));

@@ -79,6 +79,21 @@ impl WriteFormat {
         }
     }
 
+    /// How many patches a file in this format holds of `scene`, for messages: its patches in OBJ and PLY;
+    /// in STL and glTF, which keep triangles only, the triangles too when there are more of them, since
+    /// the file reads back as a patch per triangle.
+    pub fn patches_written(self, scene: &Scene) -> String {
+        let (patches, triangles) = (scene.patch_count(), scene.triangles.len());
+        match self {
+            WriteFormat::Stl | WriteFormat::Gltf | WriteFormat::Glb if triangles > patches => {
+                format!(
+                    "{patches} patches as {triangles} triangles (read back: a patch per triangle)"
+                )
+            }
+            _ => format!("{patches} patches"),
+        }
+    }
+
     /// The file written beside `path` in this format, if any: an OBJ's MTL library.
     pub fn companion(self, path: &Path) -> Option<PathBuf> {
         (self == WriteFormat::Obj).then(|| path.with_extension("mtl"))

@@ -415,3 +415,38 @@ fn scene_help_texts_list_the_formats() {
     let help = String::from_utf8_lossy(&scx(&["--help"]).stdout).into_owned();
     assert!(help.contains("OBJ + MTL, PLY, STL or glTF/GLB"), "{help}");
 }
+
+/// The count `export` prints is what the file reads back as: STL and glTF keep triangles only, so the
+/// Cornell box's 29 patches (52 triangles) are said to go out as 52 triangles, a patch each when read
+/// back (the message said "29 patches", the file read as 52); OBJ keeps the patches.
+#[test]
+fn export_says_how_many_patches_the_file_reads_back_as() {
+    let dir = tempfile::tempdir().unwrap();
+    for (name, says, reads_back) in [
+        (
+            "c.stl",
+            "29 patches as 52 triangles (read back: a patch per triangle)",
+            52,
+        ),
+        (
+            "c.glb",
+            "29 patches as 52 triangles (read back: a patch per triangle)",
+            52,
+        ),
+        ("c.obj", "29 patches and", 29),
+    ] {
+        let path = dir.path().join(name);
+        let out = scx(&["export", "@cornell", "-o", path.to_str().unwrap()]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(out.status.success() && err.contains(says), "{name}: {err}");
+        let report = json_of(&scx(&[
+            "analyze",
+            path.to_str().unwrap(),
+            "--lines",
+            "1e3",
+            "--format",
+            "json",
+        ]));
+        assert_eq!(report["patches"], reads_back, "{name}");
+    }
+}
