@@ -482,14 +482,7 @@ fn stl_and_ply_in_ascii_and_binary() {
     let corners: Vec<[f32; 3]> = (0..8)
         .map(|i| [(i & 1) as f32, (i >> 1 & 1) as f32, (i >> 2 & 1) as f32])
         .collect();
-    let quads = [
-        [0, 4, 6, 2],
-        [1, 3, 7, 5],
-        [0, 1, 5, 4],
-        [2, 6, 7, 3],
-        [0, 2, 3, 1],
-        [4, 5, 7, 6],
-    ];
+    let quads = crate::support::CUBE_QUADS;
     let triangles: Vec<[usize; 3]> = quads
         .iter()
         .flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]])
@@ -575,15 +568,7 @@ fn stl_and_ply_in_ascii_and_binary() {
 /// `facet` with the given indent and separator.
 fn cube_stl_facets(indent: &str, sep: &str) -> Vec<String> {
     let corner = |i: usize| [(i & 1) as f32, (i >> 1 & 1) as f32, (i >> 2 & 1) as f32];
-    let quads = [
-        [0, 4, 6, 2],
-        [1, 3, 7, 5],
-        [0, 1, 5, 4],
-        [2, 6, 7, 3],
-        [0, 2, 3, 1],
-        [4, 5, 7, 6],
-    ];
-    quads
+    crate::support::CUBE_QUADS
         .iter()
         .flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]])
         .map(|t| {

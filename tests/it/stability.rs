@@ -113,15 +113,7 @@ fn add_box(b: &mut SceneBuilder, lo: [f64; 3], hi: [f64; 3], inward: bool, m: u3
             if k & 4 == 0 { lo[2] } else { hi[2] },
         ]
     };
-    // Counter-clockwise seen from outside.
-    let quads = [
-        [0, 4, 6, 2],
-        [1, 3, 7, 5],
-        [0, 1, 5, 4],
-        [2, 6, 7, 3],
-        [0, 2, 3, 1],
-        [4, 5, 7, 6],
-    ];
+    let quads = crate::support::CUBE_QUADS;
     for (f, q) in quads.iter().enumerate() {
         let mut idx: Vec<u32> = q.iter().map(|&k| b.vertex(corner(k))).collect();
         if inward {

@@ -65,16 +65,7 @@ pub fn room_with_box_obj(scale: f64) -> String {
                 if i & 4 == 0 { lo[2] } else { hi[2] },
             ]);
         }
-        // Outward-facing quads of a box with corner bits (x=1, y=2, z=4).
-        let quads = [
-            [0, 4, 6, 2],
-            [1, 3, 7, 5],
-            [0, 1, 5, 4],
-            [2, 6, 7, 3],
-            [0, 2, 3, 1],
-            [4, 5, 7, 6],
-        ];
-        for q in quads {
+        for q in CUBE_QUADS {
             let mut f: Vec<usize> = q.iter().map(|&k| base + k + 1).collect();
             if inward {
                 f.reverse();
@@ -508,3 +499,14 @@ pub fn lines_grazing_triangles(
         })
         .collect()
 }
+
+/// The faces of a box whose corner `i` has bits x = 1, y = 2, z = 4: quads counter-clockwise seen from
+/// outside.
+pub const CUBE_QUADS: [[usize; 4]; 6] = [
+    [0, 4, 6, 2],
+    [1, 3, 7, 5],
+    [0, 1, 5, 4],
+    [2, 6, 7, 3],
+    [0, 2, 3, 1],
+    [4, 5, 7, 6],
+];
