@@ -66,7 +66,8 @@ pub fn json(run: &RunInfo, a: &Analysis) -> String {
     s
 }
 
-/// One CSV row per reading, with the run's scene, lines, seed and tracer, so that files combine.
+/// One CSV row per reading, with the run's scene, lines, seed and tracer, so that files combine; a
+/// reading that breaks a bound of the theory says which in its `flags` (or `corrected_flags`) cell.
 pub fn csv(run: &RunInfo, a: &Analysis) -> String {
     let mut w = csv::Writer::from_writer(Vec::new());
     let header = [
@@ -86,10 +87,15 @@ pub fn csv(run: &RunInfo, a: &Analysis) -> String {
         "corrected",
         "corrected_stderr",
         "corrected_reliability",
+        "flags",
+        "corrected_flags",
     ];
     w.write_record(header).expect("writing to memory");
     let num = |x: Option<f64>| x.map(|v| positive_zero(v).to_string()).unwrap_or_default();
     let verdict = |r: Option<&Reliability>| r.map_or("", |r| r.verdict.name()).to_string();
+    // The bounds of the theory a reading breaks, as the table's `!` notes say them: one cell, the
+    // sentences joined by "; " (the CSV writer quotes a cell that holds a comma).
+    let flags = |r: Option<&Reliability>| r.map(|r| r.flags.join("; ")).unwrap_or_default();
     let mut families = vec![Family::Visibility];
     if let RadiosityOutcome::Computed(_) = &a.radiosity {
         families.push(Family::Radiosity);
@@ -116,6 +122,8 @@ pub fn csv(run: &RunInfo, a: &Analysis) -> String {
             num(r.corrected.map(|c| c.value)),
             num(r.corrected.and_then(|c| c.stderr)),
             verdict(r.corrected_reliability),
+            flags(r.reliability),
+            flags(r.corrected_reliability),
         ])
         .expect("writing to memory");
     }

@@ -124,6 +124,47 @@ fn impossible_readings_are_flagged_not_printed_bare() {
     assert!(text.contains("! the accuracy is outside [0, 1]"), "{text}");
 }
 
+/// The CSV report carries the same flags as the JSON document: a reading that breaks a bound of the
+/// theory is not a bare number in a spreadsheet either.
+#[test]
+fn csv_rows_carry_the_flags_of_their_readings() {
+    let args = ["@cube:6", "--lines", "1e4", "--seed", "3"];
+    let doc = json_run(&args);
+    let mut all = vec!["analyze"];
+    all.extend_from_slice(&args);
+    all.extend_from_slice(&["--format", "csv", "--tracer", "rust"]);
+    let out = scx(&all);
+    assert_eq!(out.status.code(), Some(0), "{}", stderr_of(&out));
+    let mut reader = csv::Reader::from_reader(out.stdout.as_slice());
+    let header = reader.headers().unwrap().clone();
+    let col = |name: &str| header.iter().position(|h| h == name).unwrap();
+    let (measure, plain, corrected) = (col("measure"), col("flags"), col("corrected_flags"));
+    let mut flagged = 0;
+    for row in reader.records() {
+        let row = row.unwrap();
+        let key = &row[measure];
+        let v = &doc["visibility"][key];
+        let json_flags = |r: &serde_json::Value| -> String {
+            r["flags"].as_array().map_or(String::new(), |f| {
+                f.iter()
+                    .map(|s| s.as_str().unwrap())
+                    .collect::<Vec<_>>()
+                    .join("; ")
+            })
+        };
+        assert_eq!(row[plain], json_flags(&v["reliability"]), "{key}");
+        assert_eq!(
+            row[corrected],
+            json_flags(&v["corrected"]["reliability"]),
+            "{key}"
+        );
+        flagged += usize::from(!row[plain].is_empty()) + usize::from(!row[corrected].is_empty());
+    }
+    // The plug-in I_s above I_s^c (Proposition 2) and the accuracy above 1, at least.
+    assert!(flagged >= 2, "{flagged} flagged cells");
+    assert!(String::from_utf8_lossy(&out.stdout).contains("outside [0, 1]"));
+}
+
 /// Every output path is checked before any line is cast: a run of 10^12 lines to a folder that does
 /// not exist fails at once with exit code 3, naming the path and the reason.
 #[test]
