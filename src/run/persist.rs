@@ -677,10 +677,16 @@ pub fn decode(path: &str, bytes: &[u8]) -> Result<StateFile, PersistError> {
         path: path.to_string(),
         problem,
     };
-    if bytes.len() < HEADER || &bytes[..8] != MAGIC {
+    if bytes.len() < MAGIC.len() || &bytes[..MAGIC.len()] != MAGIC {
         return Err(bad(
             "not an scx run state (it does not start with SCXSTATE)".into(),
         ));
+    }
+    if bytes.len() < HEADER {
+        return Err(bad(format!(
+            "truncated: {} bytes, shorter than a run state's {HEADER}-byte header",
+            bytes.len()
+        )));
     }
     let version = u32::from_le_bytes(bytes[8..12].try_into().expect("4 bytes"));
     if version != FORMAT_VERSION {
@@ -989,6 +995,12 @@ mod tests {
             flipped[bytes.len() / 2] ^= 0x10;
             assert!(message(&flipped).contains("checksum"));
             assert!(message(b"v 0 0 0\nf 1 2 3\n").contains("not an scx run state"));
+            // A state cut inside its header is a truncated state, not a stranger.
+            for cut in [8, 16, HEADER - 1] {
+                let m = message(&bytes[..cut]);
+                assert!(m.contains("truncated") && m.contains("header"), "{m}");
+            }
+            assert!(message(&bytes[..5]).contains("not an scx run state"));
         }
     }
 
