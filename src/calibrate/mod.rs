@@ -33,7 +33,7 @@ pub use driver::{Reading, SeedReadings};
 pub use scenes::CalibrationScene;
 pub use suite::{suite, Cell, CellMeasures, CellTarget, SuiteLevel};
 pub use summary::Summary;
-pub use truth::{truth, Basis, ExactValue, Truth, TruthError};
+pub use truth::{check_computable, truth, Basis, ExactValue, Truth, TruthError};
 
 use crate::analysis::AnalysisError;
 use crate::measure::Measure;

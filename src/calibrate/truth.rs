@@ -377,27 +377,77 @@ pub fn cube_pair_sums() -> PairSums {
     }
 }
 
-/// The exact rows of face 0's patches of `@cube:n` (over all `6 n^2` patches).
-fn cube_face_rows(n: usize) -> Result<(usize, FormFactorRows), SceneError> {
-    let scene = crate::scenes::load(&format!("@cube:{n}"))?;
-    let rects: Vec<AxisRect> = (0..scene.patch_count())
-        .map(|p| AxisRect::of_patch(&scene, p).expect("@cube:N has square patches"))
-        .collect();
-    let rows = (0..n * n)
-        .into_par_iter()
-        .map(|i| form_factor_row(&rects, i))
-        .collect();
-    Ok((scene.patch_count(), rows))
+/// The largest `n` of `@cube:n` whose exact values calibrate computes: face 0's rows are `6 n^4` closed-form
+/// factors (6 x 10^8 at 100, a minute or two on two cores), and the count grows as the fourth power.
+pub const MAX_CUBE_DIVISIONS: usize = 100;
+
+/// Whether the exact values of `scene` (built as `built`) are within what [`truth`] computes: `@cube:n`
+/// and `lit-cube:n` up to [`MAX_CUBE_DIVISIONS`], every other scene (and `lit-cube`'s radiosity) up to
+/// [`MAX_DENSE_PATCHES`] patches. Checked before a calibration starts, so that a scene too large is
+/// refused at once rather than after the work of the cells before it.
+pub fn check_computable(scene: &CalibrationScene, built: &Scene) -> Result<(), TruthError> {
+    let dense = || {
+        if built.patch_count() > MAX_DENSE_PATCHES {
+            return Err(TruthError::TooManyPatches {
+                scene: built.name.clone(),
+                patches: built.patch_count(),
+            });
+        }
+        Ok(())
+    };
+    match *scene {
+        CalibrationScene::Cube(n) => Ok(cube_within_limit(n)?),
+        CalibrationScene::LitCube(n) => {
+            cube_within_limit(n)?;
+            dense()
+        }
+        _ => dense(),
+    }
 }
+
+/// Errors when `@cube:n`'s exact values are beyond [`MAX_CUBE_DIVISIONS`].
+fn cube_within_limit(n: usize) -> Result<(), SceneError> {
+    if n > MAX_CUBE_DIVISIONS {
+        return Err(SceneError::Builtin(format!(
+            "@cube:{n}: its exact values need 6 n^4 = {:.1e} closed-form factors; calibrate computes \
+             them for @cube:N up to N = {MAX_CUBE_DIVISIONS}",
+            6.0 * (n as f64).powi(4)
+        )));
+    }
+    Ok(())
+}
+
+/// Face 0's rows computed and consumed this many at a time: the memory stays a few rows' worth (a
+/// row of `@cube:100` is 60,000 factors) instead of all `n^2` of them.
+const CUBE_ROWS_AT_ONCE: usize = 64;
 
 /// Eqs. (17), (7), (21) and (22) of `@cube:n` from the rows of face 0: every patch has the same area and
 /// the cube's symmetry maps every face onto face 0, so H_s is the mean row entropy of face 0,
 /// H(X, Y) = H_p + H_s, I_s = H_p - H_s (eq. 20) and `sum_ij F_ij^2` is 6 times face 0's share.
+///
+/// Errors when `n` is above [`MAX_CUBE_DIVISIONS`].
 pub fn cube_discrete(n: usize) -> Result<DiscreteExact, SceneError> {
-    let (patches, rows) = cube_face_rows(n)?;
+    cube_within_limit(n)?;
+    let scene = crate::scenes::load(&format!("@cube:{n}"))?;
+    let rects: Vec<AxisRect> = (0..scene.patch_count())
+        .map(|p| AxisRect::of_patch(&scene, p).expect("@cube:N has square patches"))
+        .collect();
     let row_entropy = |row: &Vec<f64>| row.iter().map(|&f| neg_xlog2x(f)).sum::<f64>();
-    let entropy = rows.iter().map(row_entropy).sum::<f64>() / rows.len() as f64;
-    let sum_f2: f64 = rows.iter().flatten().map(|f| f * f).sum();
+    // Summed in row order, one entry after the other, as one pass over every row would.
+    let (mut entropy_sum, mut sum_f2) = (0.0, 0.0);
+    let face: Vec<usize> = (0..n * n).collect();
+    for chunk in face.chunks(CUBE_ROWS_AT_ONCE) {
+        let rows: Vec<Vec<f64>> = chunk
+            .par_iter()
+            .map(|&i| form_factor_row(&rects, i))
+            .collect();
+        for row in &rows {
+            entropy_sum += row_entropy(row);
+            sum_f2 = row.iter().fold(sum_f2, |acc, f| acc + f * f);
+        }
+    }
+    let entropy = entropy_sum / (n * n) as f64;
+    let patches = scene.patch_count();
     let positional_entropy = (patches as f64).log2();
     Ok(DiscreteExact {
         entropy,

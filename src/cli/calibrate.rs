@@ -5,7 +5,8 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use scene_complexity::calibrate::{
-    self, report, suite, CalibrationScene, Cell, CellMeasures, CellReport, CellTarget, SuiteLevel,
+    self, check_computable, report, suite, CalibrationScene, Cell, CellMeasures, CellReport,
+    CellTarget, SuiteLevel,
 };
 use scene_complexity::{LinesThrough, Measure, Sampler};
 
@@ -166,13 +167,15 @@ pub fn run(args: &CalibrateArgs) -> Result<Exit, Failure> {
         output::emit(args.out.output.as_deref(), &list)?;
         return Ok(Exit::Ok);
     }
-    // Every scene is built before the table starts: one that cannot be (a parameter beyond what the
-    // scene allows) is refused as the input it is, not after the header.
+    // Every scene is built, and its exact values checked to be within reach, before the table starts:
+    // one that cannot be (a parameter beyond what the scene allows, a scene too large for its exact
+    // values) is refused as the input it is, not after the header.
     let mut built: Vec<String> = Vec::new();
     for cell in &cells {
         let name = cell.scene.name();
         if !built.contains(&name) {
-            cell.scene.build().map_err(Failure::bad_input)?;
+            let scene = cell.scene.build().map_err(Failure::bad_input)?;
+            check_computable(&cell.scene, &scene).map_err(Failure::bad_input)?;
             built.push(name);
         }
     }
