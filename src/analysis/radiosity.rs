@@ -141,6 +141,8 @@ pub(crate) fn estimates(
         pairs: c.pairs,
         open: c.escapes + c.absorbed > 0,
         short_chords: c.short_chords,
+        // Radiosity readings take their errors from the groups (`spread`), whatever `--errors` says.
+        jackknifed: false,
     };
     let reliability = reliability::verdicts(&estimates, Some(sampling), None, facts);
     let solve = RadiositySolve {

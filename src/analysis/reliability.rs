@@ -219,13 +219,19 @@ pub(crate) fn coverage_verdict(report: &SamplingReport) -> Reliability {
     r
 }
 
-/// The verdict on an estimate unbiased whatever the coverage ([`VerdictRule::UnbiasedEstimate`]):
-/// `unusable` below [`COVERAGE_UNUSABLE`] (rows too thin to hold two segments each), else `ok`.
-fn unbiased_estimate_verdict(report: &SamplingReport) -> Reliability {
-    if report.sampling.coverage < COVERAGE_UNUSABLE {
-        coverage_verdict(report)
-    } else {
+/// The verdict on an estimate unbiased whatever the coverage ([`VerdictRule::UnbiasedEstimate`]): `ok`
+/// at a coverage of [`COVERAGE_UNUSABLE`] and above; below it, `ok` only when its standard error is the
+/// jackknife's and every row holds two segments (else as the coverage says, `unusable`). A group holds a
+/// sixteenth of the lines, and rows of a few segments there make the groups' values scatter far more
+/// than 4 times the run's (batch means read 4-6 times the real error on `@cube:10` to `@cube:30`), where
+/// the jackknife's replicates, 15/16 of the lines each, scatter like the run (docs/results.md); and a
+/// row of one segment has no unbiased estimate at all ([`Sampling::thin_rows`]).
+fn unbiased_estimate_verdict(report: &SamplingReport, jackknifed: bool) -> Reliability {
+    let s = &report.sampling;
+    if s.coverage >= COVERAGE_UNUSABLE || (jackknifed && s.thin_rows == 0) {
         Reliability::new(Verdict::Ok)
+    } else {
+        coverage_verdict(report)
     }
 }
 
@@ -341,6 +347,9 @@ pub struct RunFacts {
     pub open: bool,
     /// Pairs whose points are [`crate::sample::tally::SHORT_CHORD`] apart ([`f32_floor`]).
     pub short_chords: u64,
+    /// Whether the discrete readings' standard errors are the delete-a-group jackknife's
+    /// (`--errors jackknife`) rather than batch means of the groups.
+    pub jackknifed: bool,
 }
 
 /// Bits of eq. (27) lost per short chord counted ([`RunFacts::short_chords`]) when f32 tracing misses the
@@ -372,6 +381,8 @@ struct Evidence<'a> {
     lines: u64,
     pairs: u64,
     open: bool,
+    /// [`RunFacts::jackknifed`].
+    jackknifed: bool,
     /// [`f32_floor`].
     f32_floor: f64,
 }
@@ -406,6 +417,7 @@ pub fn verdicts(
         lines: facts.lines,
         pairs: facts.pairs,
         open: facts.open,
+        jackknifed: facts.jackknifed,
         f32_floor: f32_floor(facts.pairs, facts.short_chords),
     };
     let mut out = ByMeasure::default();
@@ -469,7 +481,8 @@ fn verdict(
             r
         }
         VerdictRule::UnbiasedEstimate => {
-            let r = unbiased_estimate_verdict(evidence.discrete(info.family)?.0);
+            let r =
+                unbiased_estimate_verdict(evidence.discrete(info.family)?.0, evidence.jackknifed);
             match evidence.bias.and_then(|b| b.of(m)) {
                 Some(bias) => corrected(r, e, bias, evidence.lines),
                 None => r,
@@ -544,6 +557,7 @@ mod tests {
                 coverage,
                 singleton_share: 0.1,
                 mse_bias: -0.001,
+                thin_rows: 0,
             },
             lines_for_coverage: Some(5_000_000),
             from_half: HalfRun::NotComputed,
@@ -575,6 +589,7 @@ mod tests {
             pairs,
             open: false,
             short_chords: 0,
+            jackknifed: false,
         }
     }
 
@@ -679,25 +694,39 @@ mod tests {
     /// makes it `undersampled`.
     #[test]
     fn the_unbiased_e_mse_is_ok_below_the_coverage_of_corrected_entropies() {
-        let at = |coverage: f64, bias: Option<f64>| {
+        let judged = |coverage: f64, bias: Option<f64>, thin_rows: usize, jackknifed: bool| {
             let bias = bias
                 .map(|b| ByMeasure::from_fn(|m| (m == Measure::MsePerLineCorrected).then_some(b)));
+            let mut sampling = report(coverage);
+            sampling.sampling.thin_rows = thin_rows;
             let r = verdicts(
                 &readings(7.6, 7.8, 1.6),
-                Some(&report(coverage)),
+                Some(&sampling),
                 bias.as_ref(),
-                closed(1_000_000, 1_000_000),
+                RunFacts {
+                    jackknifed,
+                    ..closed(1_000_000, 1_000_000)
+                },
             );
             (
                 of(&r, Measure::MsePerLineCorrected).verdict,
                 of(&r, Measure::EntropyCorrected).verdict,
             )
         };
+        let at = |coverage: f64, bias: Option<f64>| judged(coverage, bias, 0, false);
         assert_eq!(at(0.8, None), (Verdict::Ok, Verdict::Undersampled));
         assert_eq!(at(0.999, None), (Verdict::Ok, Verdict::Ok));
         assert_eq!(at(0.4, None), (Verdict::Unusable, Verdict::Unusable));
         assert_eq!(at(0.8, Some(0.005)).0, Verdict::Ok);
         assert_eq!(at(0.8, Some(0.05)).0, Verdict::Undersampled);
+        // Below the coverage of 0.5, batch means overstate its error and leave it unusable; the
+        // jackknife's error makes it ok, while every row holds the two segments its estimate needs and
+        // the jackknife's bias stays within the error.
+        let thin = |rows: usize, jackknifed: bool| judged(0.3, Some(0.001), rows, jackknifed).0;
+        assert_eq!(thin(0, false), Verdict::Unusable);
+        assert_eq!(thin(0, true), Verdict::Ok);
+        assert_eq!(thin(3, true), Verdict::Unusable);
+        assert_eq!(judged(0.3, Some(0.05), 0, true).0, Verdict::Undersampled);
     }
 
     /// Readings beyond the theory's bounds are flagged and never ok.
@@ -735,10 +764,8 @@ mod tests {
     #[test]
     fn open_scenes_may_read_below_zero() {
         let open = RunFacts {
-            lines: 1_000_000,
-            pairs: 1_000_000,
             open: true,
-            short_chords: 0,
+            ..closed(1_000_000, 1_000_000)
         };
         let mut v = readings(7.8, 7.8, -0.5);
         v.set(Measure::MutualInformation, est(-0.6, 0.01));

@@ -276,6 +276,7 @@ pub(super) fn visibility_estimates(
         },
         open: c.absorbed > 0 || (c.escapes > 0 && !enclose),
         short_chords: c.short_chords,
+        jackknifed: spread.replicates.is_some(),
     };
     let mut reliability = reliability::verdicts(&estimates, sampling.as_ref(), Some(&bias), facts);
     if debias && replicates.is_none() {

@@ -32,6 +32,10 @@ pub struct Sampling {
     pub singleton_share: f64,
     /// The estimated bias of E(MSE) per line (eq. 22): plug-in minus unbiased (<= 0).
     pub mse_bias: f64,
+    /// Rows of fewer than two segments, unsampled ones included: their `sum_j F_ij^2` has no unbiased
+    /// estimate ([`RowSums::unbiased_sum_of_squares`] lets the plug-in's stand in, 1 for a row of one
+    /// segment), so the corrected E(MSE) is biased by up to 1 per such row.
+    pub thin_rows: usize,
 }
 
 impl Sampling {
@@ -40,6 +44,7 @@ impl Sampling {
         let (mut weight, mut segments, mut coverage) = (0.0, 0.0, 0.0);
         let (mut sampled_rows, mut seen, mut singletons) = (0usize, 0u64, 0u64);
         let mut mse_bias = 0.0;
+        let thin_rows = rows.iter().filter(|r| r.n() < 2.0).count();
         for (&a_i, row) in a.iter().zip(rows) {
             weight += a_i;
             seen += row.seen;
@@ -73,6 +78,7 @@ impl Sampling {
                 0.0
             },
             mse_bias,
+            thin_rows,
         }
     }
 }

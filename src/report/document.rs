@@ -129,6 +129,7 @@ fn sampling_json(a: &Analysis) -> Value {
             "segments_per_row": finite(s.sampling.segments_per_row),
             "coverage": finite(s.sampling.coverage),
             "singleton_share": finite(s.sampling.singleton_share),
+            "thin_rows": s.sampling.thin_rows,
             "lines_for_coverage_0_99": s.lines_for_coverage,
             "lines_for_coverage_0_99_from_half": match s.from_half {
                 HalfRun::Lines(n) => Some(n),
