@@ -187,7 +187,10 @@ fn the_corrected_e_mse_of_thin_rows_is_ok_with_the_jackknife() {
             "--errors",
             errors,
         ]);
-        assert!(doc["sampling"]["coverage"].as_f64().unwrap() < 0.5, "{lines}");
+        assert!(
+            doc["sampling"]["coverage"].as_f64().unwrap() < 0.5,
+            "{lines}"
+        );
         let e = doc["visibility"]["mse_per_line"]["corrected"].clone();
         let value = e["value"].as_f64().unwrap();
         let se = e["stderr"].as_f64().unwrap();
