@@ -374,6 +374,9 @@ impl SceneBuilder {
                 )));
             }
             let pts: Vec<Point> = poly_corners.iter().map(|&v| traced[v as usize]).collect();
+            // Zero-area triangles of this polygon: counted in the scene's only when the polygon keeps
+            // others (a polygon of nothing but zero-area triangles is a dropped face).
+            let mut dropped_here = 0usize;
             let deviation = planarity_deviation(&pts);
             let created = if deviation > options.planarity.tolerance {
                 if options.planarity.strict {
@@ -397,7 +400,7 @@ impl SceneBuilder {
                         poly,
                         &corners,
                         &[[0, 1, 2]],
-                        &mut dropped_triangles,
+                        &mut dropped_here,
                     );
                 }
                 any
@@ -410,10 +413,13 @@ impl SceneBuilder {
                     poly,
                     poly_corners,
                     &triangles,
-                    &mut dropped_triangles,
+                    &mut dropped_here,
                 )
             };
-            if !created {
+            if created {
+                dropped_triangles += dropped_here;
+            } else {
+                // The face's triangles go with it: one warning about the face, not a second about them.
                 dropped_polygons.0 += 1;
                 dropped_polygons.1.get_or_insert_with(|| origin.to_string());
             }

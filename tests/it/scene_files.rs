@@ -1186,3 +1186,37 @@ fn a_face_listing_its_corners_twice_counts_once() {
     }
     assert!(once.warnings.is_empty(), "{}", messages(&once.warnings));
 }
+
+/// A zero-area STL triangle is one zero-area face, warned about once (it was warned about twice: as a
+/// zero-area triangle and as a zero-area face); a quad keeping a triangle after dropping another still
+/// gets the triangle warning.
+#[test]
+fn a_zero_area_stl_triangle_is_warned_about_once() {
+    let dir = tempfile::tempdir().unwrap();
+    let facet = |v: [[f32; 3]; 3]| {
+        let corners: String = v
+            .iter()
+            .map(|c| format!("vertex {} {} {}\n", c[0], c[1], c[2]))
+            .collect();
+        format!("facet normal 0 0 0\nouter loop\n{corners}endloop\nendfacet\n")
+    };
+    let stl = format!(
+        "solid t\n{}{}endsolid t\n",
+        facet([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]),
+        facet([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [2.0, 0.0, 0.0]])
+    );
+    let scene = load_file(
+        &write(dir.path(), "flat.stl", stl.as_bytes()),
+        &SceneOptions::default(),
+    );
+    let codes: Vec<&str> = scene.warnings.iter().map(|w| w.kind.code()).collect();
+    assert_eq!(codes, ["zero-area-faces"]);
+    assert_eq!(
+        messages(&scene.warnings),
+        format!(
+            "{}: dropped 1 zero-area face(s), first: triangle 2",
+            dir.path().join("flat.stl").display()
+        )
+    );
+    assert_eq!(scene.warnings[0].numbers, [("faces", 1.0)]);
+}
