@@ -520,17 +520,22 @@ impl SceneBuilder {
         }
     }
 
+    /// Every corner of every polygon at a finite point. Readers that know the file's own numbering of
+    /// vertices check theirs as they read; this names the corner within its polygon, since the
+    /// builder's vertex numbers (welded) are not the file's.
     fn check_finite(&self) -> Result<(), SceneError> {
         for poly in &self.polygons {
-            for &v in poly.corners(&self.corners) {
+            let corners = poly.corners(&self.corners);
+            for (k, &v) in corners.iter().enumerate() {
                 let origin = poly.origin(&self.origins);
                 let p = self.vertices.get(v as usize).ok_or_else(|| {
                     self.geometry_error(format!("{origin}: vertex index {v} out of range"))
                 })?;
                 if !p.is_finite() {
                     return Err(self.geometry_error(format!(
-                        "{origin}: vertex {} has a non-finite coordinate ({}, {}, {})",
-                        v + 1,
+                        "{origin}: corner {} of {} has a non-finite coordinate ({}, {}, {})",
+                        k + 1,
+                        corners.len(),
                         p.x,
                         p.y,
                         p.z
