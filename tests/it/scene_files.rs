@@ -1187,6 +1187,134 @@ fn a_face_listing_its_corners_twice_counts_once() {
     assert!(once.warnings.is_empty(), "{}", messages(&once.warnings));
 }
 
+/// A glTF of one triangle named `tri` whose positions are `positions`, edited by `edit`; its buffer in a
+/// data URI.
+fn triangle_gltf(positions: [f32; 9], edit: impl FnOnce(&mut serde_json::Value)) -> String {
+    use base64::Engine as _;
+    let buffer: Vec<u8> = positions.iter().flat_map(|x| x.to_le_bytes()).collect();
+    let uri = format!(
+        "data:application/octet-stream;base64,{}",
+        base64::engine::general_purpose::STANDARD.encode(&buffer)
+    );
+    let mut doc = serde_json::json!({
+        "asset": {"version": "2.0"},
+        "scene": 0,
+        "scenes": [{"nodes": [0]}],
+        "nodes": [{"mesh": 0}],
+        "meshes": [{"name": "tri", "primitives": [{"attributes": {"POSITION": 0}}]}],
+        "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
+                       "min": [0, 0, 0], "max": [1, 1, 1]}],
+        "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 36}],
+        "buffers": [{"byteLength": 36, "uri": uri}],
+    });
+    edit(&mut doc);
+    doc.to_string()
+}
+
+const TRIANGLE: [f32; 9] = [0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0];
+
+/// The error of loading `text` as `name` in `dir`.
+fn load_error(dir: &Path, name: &str, text: &[u8]) -> String {
+    let path = write(dir, name, text);
+    match load_with(path.to_str().unwrap(), &SceneOptions::default()) {
+        Ok(_) => panic!("{name} was read"),
+        Err(e) => format!("{e}").replace(&format!("{}/", dir.display()), ""),
+    }
+}
+
+/// A glTF vertex with one NaN coordinate shows its own values, not `(NaN, NaN, NaN)` (the node's
+/// transform spread the NaN to every coordinate), and names its vertex as glTF numbers it.
+#[test]
+fn a_gltf_vertex_with_a_nan_shows_its_own_coordinates() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut positions = TRIANGLE;
+    positions[6] = f32::NAN;
+    positions[7] = 0.5;
+    positions[8] = 1.0;
+    let e = load_error(
+        dir.path(),
+        "nan.gltf",
+        triangle_gltf(positions, |_| {}).as_bytes(),
+    );
+    assert_eq!(
+        e,
+        "nan.gltf: mesh `tri` primitive 0: triangle 0: its vertex 2 (of POSITION accessor 0) has a \
+         non-finite coordinate (NaN, 0.5, 1) (numbered from 0, as glTF numbers them)"
+    );
+}
+
+/// A glTF of points or lines only says so, naming the mesh and the mode (it said "the scene is empty:
+/// no faces"); mixed with triangles, the warning names them too.
+#[test]
+fn gltf_points_and_lines_are_named_with_their_mode() {
+    let dir = tempfile::tempdir().unwrap();
+    for (mode, name) in [(0, "POINTS"), (1, "LINES"), (3, "LINE_STRIP")] {
+        let doc = triangle_gltf(TRIANGLE, |d| {
+            d["meshes"][0]["primitives"][0]["mode"] = mode.into()
+        });
+        let e = load_error(dir.path(), "lines.gltf", doc.as_bytes());
+        assert_eq!(
+            e,
+            format!(
+                "lines.gltf: the scene has no triangles: its meshes hold only primitives of points \
+                 or lines (mesh `tri` primitive 0: mode {mode} {name}), which scx does not read: they \
+                 have no area; scx reads triangles (modes 4 TRIANGLES, 5 TRIANGLE_STRIP, 6 \
+                 TRIANGLE_FAN)"
+            )
+        );
+    }
+    let mixed = triangle_gltf(TRIANGLE, |d| {
+        let triangles = d["meshes"][0]["primitives"][0].clone();
+        let mut lines = triangles.clone();
+        lines["mode"] = 1.into();
+        d["meshes"][0]["primitives"] = serde_json::json!([triangles, lines]);
+    });
+    let path = write(dir.path(), "mixed.gltf", mixed.as_bytes());
+    let scene = load_file(&path, &SceneOptions::default());
+    assert_eq!(scene.patch_count(), 1);
+    assert!(
+        messages(&scene.warnings).ends_with(
+            "mixed.gltf: ignored 1 primitive(s) of points or lines (mesh `tri` primitive 1: mode 1 \
+             LINES): they have no area"
+        ),
+        "{}",
+        messages(&scene.warnings)
+    );
+}
+
+/// A buffer view must fit in its buffer as `byteLength` gives it, even when the data URI holds more
+/// (it was read silently); a node matrix must be affine (a projective one was applied as if it were).
+#[test]
+fn gltf_byte_lengths_and_projective_matrices_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let short = triangle_gltf(TRIANGLE, |d| d["buffers"][0]["byteLength"] = 10.into());
+    assert_eq!(
+        load_error(dir.path(), "short.gltf", short.as_bytes()),
+        "short.gltf: mesh `tri` primitive 0: its POSITION accessor 0: its buffer view 0 (bytes 0 to \
+         36) does not fit in buffer 0 of 10 bytes (its byteLength)"
+    );
+    let projective = triangle_gltf(TRIANGLE, |d| {
+        d["nodes"][0]["name"] = "camera rig".into();
+        d["nodes"][0]["matrix"] =
+            serde_json::json!([1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0.5, 0, 0, 0, 1]);
+    });
+    assert_eq!(
+        load_error(dir.path(), "projective.gltf", projective.as_bytes()),
+        "projective.gltf: node 0 (`camera rig`): its matrix is not affine (its last row is 0 0 0.5 \
+         1, not 0 0 0 1): a projective matrix cannot place a mesh"
+    );
+    // An affine matrix (a translation) places the mesh.
+    let moved = triangle_gltf(TRIANGLE, |d| {
+        d["nodes"][0]["matrix"] =
+            serde_json::json!([1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 5, 0, 0, 1]);
+    });
+    let scene = load_file(
+        &write(dir.path(), "moved.gltf", moved.as_bytes()),
+        &SceneOptions::default(),
+    );
+    assert_eq!(scene.vertices[0].x, 5.0);
+}
+
 /// A zero-area STL triangle is one zero-area face, warned about once (it was warned about twice: as a
 /// zero-area triangle and as a zero-area face); a quad keeping a triangle after dropping another still
 /// gets the triangle warning.
