@@ -277,11 +277,7 @@ pub(crate) enum FormatProblem {
     #[error("the file is empty")]
     Empty,
     /// A file named `.stl` whose size is not the one its binary STL header gives.
-    #[error(
-        "a binary STL of the wrong size: its header says {count} triangles ({expected} bytes), the \
-         file has {size} bytes: {}",
-        stl_size_why(*.size, *.expected, *.count)
-    )]
+    #[error("{}", stl::wrong_size_text(*.count, *.expected, *.size))]
     StlSize {
         /// The triangle count in the header.
         count: u64,
@@ -329,23 +325,6 @@ pub(crate) enum FormatProblem {
         /// The offset of the NUL byte.
         at: usize,
     },
-}
-
-/// Why a binary STL's size may be wrong, from the size it has, the one its header gives and the
-/// header's triangle count.
-fn stl_size_why(size: u64, expected: u64, count: u64) -> String {
-    if size < expected {
-        format!(
-            "it holds {} bytes fewer than its header's {count} triangles need (cut short?)",
-            expected - size
-        )
-    } else {
-        format!(
-            "it holds {} bytes more than its header's {count} triangles need (a wrong count, or data \
-             after the triangles)",
-            size - expected
-        )
-    }
 }
 
 /// A file's extension in a message: ` (extension `.obj`)`, or nothing.
