@@ -1348,3 +1348,55 @@ fn a_zero_area_stl_triangle_is_warned_about_once() {
     );
     assert_eq!(scene.warnings[0].numbers, [("faces", 1.0)]);
 }
+
+/// OBJ and MTL names and comments in Latin-1, as tools write them, are read (the file was refused
+/// whole: "not a text file (invalid UTF-8 at byte 2)"): objects keep their names (two names that differ
+/// in an accented letter stay two objects), a material named in Latin-1 in both files is found, and a
+/// library named in Latin-1 is found under its UTF-8 name. A byte that is not text in a number is still
+/// an error naming the line, and a library name still may not leave the scene's folder.
+#[test]
+fn latin_1_names_and_comments_are_read() {
+    let dir = tempfile::tempdir().unwrap();
+    write(
+        dir.path(),
+        "caf\u{e9}.mtl",
+        b"# r\xf6t\nnewmtl r\xf6t\nKd 0.8 0.1 0.1\n",
+    );
+    let obj =
+        b"# \xa9 1999 Soci\xe9t\xe9\nmtllib caf\xe9.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n\
+                o caf\xe9\nusemtl r\xf6t\nf 1 2 3\no caf\xe8\nf 1 3 4\n";
+    let scene = load_file(
+        &write(dir.path(), "latin.obj", obj),
+        &SceneOptions::default(),
+    );
+    assert_eq!(scene.objects, ["caf\u{e9}", "caf\u{e8}"]);
+    assert!(scene.warnings.is_empty(), "{}", messages(&scene.warnings));
+    let red = &scene.materials[scene.patches[0].material as usize];
+    assert_eq!(
+        (red.name.as_str(), red.reflectance_rgb),
+        ("r\u{f6}t", [0.8, 0.1, 0.1])
+    );
+
+    let e = load_error(dir.path(), "bad.obj", b"o caf\xe9\nv 0 0 0\nv 1 \xe9 0\n");
+    assert_eq!(
+        e,
+        "bad.obj:3: byte 0xE9 at column 5 is not text (UTF-8) in a `v` statement; only names (`o`, \
+         `g`, `usemtl`, `mtllib`, `maplib`, `usemap`) and comments may hold other bytes"
+    );
+    let scenes = dir.path().join("scenes");
+    std::fs::create_dir(&scenes).unwrap();
+    let outside = b"mtllib ../caf\xe9.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl r\xf6t\nf 1 2 3\n";
+    let scene = load_file(
+        &write(&scenes, "out.obj", outside),
+        &SceneOptions::default(),
+    );
+    let warning = messages(&scene.warnings);
+    assert!(
+        warning.contains("`../caf\u{e9}.mtl` climbs out with `..`, outside the scene's folder"),
+        "{warning}"
+    );
+    assert_eq!(
+        scene.materials[scene.patches[0].material as usize].name,
+        "default"
+    );
+}
