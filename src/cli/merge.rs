@@ -88,7 +88,7 @@ fn read_states(args: &MergeArgs) -> Result<Vec<StateFile>, Failure> {
     for file in &files[1..] {
         if let Some(d) = first.identity().difference(file.identity(), false) {
             return Err(Failure::bad_input(format!(
-                "{} and {} are not parts of one run: their {} differs ({} against {})",
+                "{} and {} are not parts of one run: they differ in {} ({} against {})",
                 file.path(),
                 first.path(),
                 d.setting,

@@ -713,12 +713,38 @@ pub fn decode(path: &str, bytes: &[u8]) -> Result<StateFile, PersistError> {
             "corrupted: its checksum does not match its contents (a damaged or edited file)".into(),
         ));
     }
-    let wire: Wire = ciborium::from_reader(payload)
-        .map_err(|e| bad(format!("cannot be read as a run state ({e})")))?;
+    let wire: Wire = ciborium::from_reader(payload).map_err(|e| {
+        bad(format!(
+            "cannot be read as a run state: {}",
+            cbor_problem(&e)
+        ))
+    })?;
     Ok(StateFile {
         path: path.to_string(),
         wire,
     })
+}
+
+/// Why a state's CBOR did not decode, in words: ciborium's own text is its debug form
+/// (`Syntax(141)`). Offsets are counted in the file, header included.
+fn cbor_problem(e: &ciborium::de::Error<std::io::Error>) -> String {
+    use ciborium::de::Error;
+    let in_file = |at: usize| at + HEADER;
+    match e {
+        Error::Syntax(at) => format!(
+            "its contents are not well-formed CBOR (a malformed item at byte {})",
+            in_file(*at)
+        ),
+        Error::Semantic(Some(at), what) => format!(
+            "its contents are not those of a run state: {what} (in the item at byte {})",
+            in_file(*at)
+        ),
+        Error::Semantic(None, what) => {
+            format!("its contents are not those of a run state: {what}")
+        }
+        Error::Io(_) => "its contents end in the middle of an item".into(),
+        Error::RecursionLimitExceeded => "its contents nest deeper than any run state does".into(),
+    }
 }
 
 /// The run a decoded state holds, checked for meaning against the scene's size.
@@ -1043,6 +1069,37 @@ mod tests {
         )
         .unwrap();
         (scene, state)
+    }
+
+    /// A payload whose checksum matches but whose CBOR is malformed, cut short or of another shape is
+    /// refused in words, with the byte in the file (it said `cannot be read as a run state
+    /// (Syntax(0))`, ciborium's debug text).
+    #[test]
+    fn malformed_contents_are_described_in_words() {
+        let message = |payload: &[u8]| match decode("s.scx", &framed(payload)) {
+            Err(e) => e.to_string(),
+            Ok(_) => panic!("read"),
+        };
+        // 0x1c: a reserved additional-information value, malformed in CBOR.
+        assert_eq!(
+            message(&[0x1c]),
+            format!(
+                "s.scx: cannot be read as a run state: its contents are not well-formed CBOR (a \
+                 malformed item at byte {HEADER})"
+            )
+        );
+        // A map announcing one entry and ending.
+        assert_eq!(
+            message(&[0xa1]),
+            "s.scx: cannot be read as a run state: its contents end in the middle of an item"
+        );
+        let e = message(&[0x01]);
+        assert!(
+            e.starts_with(
+                "s.scx: cannot be read as a run state: its contents are not those of a run state: "
+            ) && !e.contains("Semantic("),
+            "{e}"
+        );
     }
 
     /// The bytes of a state file around a CBOR payload (what `encode` adds).

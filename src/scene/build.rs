@@ -374,6 +374,9 @@ impl SceneBuilder {
                 )));
             }
             let pts: Vec<Point> = poly_corners.iter().map(|&v| traced[v as usize]).collect();
+            // Zero-area triangles of this polygon: counted in the scene's only when the polygon keeps
+            // others (a polygon of nothing but zero-area triangles is a dropped face).
+            let mut dropped_here = 0usize;
             let deviation = planarity_deviation(&pts);
             let created = if deviation > options.planarity.tolerance {
                 if options.planarity.strict {
@@ -397,7 +400,7 @@ impl SceneBuilder {
                         poly,
                         &corners,
                         &[[0, 1, 2]],
-                        &mut dropped_triangles,
+                        &mut dropped_here,
                     );
                 }
                 any
@@ -410,10 +413,13 @@ impl SceneBuilder {
                     poly,
                     poly_corners,
                     &triangles,
-                    &mut dropped_triangles,
+                    &mut dropped_here,
                 )
             };
-            if !created {
+            if created {
+                dropped_triangles += dropped_here;
+            } else {
+                // The face's triangles go with it: one warning about the face, not a second about them.
                 dropped_polygons.0 += 1;
                 dropped_polygons.1.get_or_insert_with(|| origin.to_string());
             }
@@ -514,17 +520,22 @@ impl SceneBuilder {
         }
     }
 
+    /// Every corner of every polygon at a finite point. Readers that know the file's own numbering of
+    /// vertices check theirs as they read; this names the corner within its polygon, since the
+    /// builder's vertex numbers (welded) are not the file's.
     fn check_finite(&self) -> Result<(), SceneError> {
         for poly in &self.polygons {
-            for &v in poly.corners(&self.corners) {
+            let corners = poly.corners(&self.corners);
+            for (k, &v) in corners.iter().enumerate() {
                 let origin = poly.origin(&self.origins);
                 let p = self.vertices.get(v as usize).ok_or_else(|| {
                     self.geometry_error(format!("{origin}: vertex index {v} out of range"))
                 })?;
                 if !p.is_finite() {
                     return Err(self.geometry_error(format!(
-                        "{origin}: vertex {} has a non-finite coordinate ({}, {}, {})",
-                        v + 1,
+                        "{origin}: corner {} of {} has a non-finite coordinate ({}, {}, {})",
+                        k + 1,
+                        corners.len(),
                         p.x,
                         p.y,
                         p.z

@@ -175,11 +175,7 @@ fn load_detected(
     let file_error = |problem: FormatProblem| SceneError::in_file(shown, problem.to_string());
     let format = detect(&bytes).ok_or_else(|| file_error(unknown_format(path, &bytes)))?;
     if format == Format::Obj {
-        let text = String::from_utf8(bytes).map_err(|e| {
-            file_error(FormatProblem::InvalidUtf8 {
-                at: e.utf8_error().valid_up_to(),
-            })
-        })?;
+        let text = obj::text_of(&bytes).map_err(|e| e.in_file(shown))?;
         return obj::load_obj_text(shown, &text, folder, options);
     }
     // A single-object file is read whole before its scene is built: the file's bytes can go first, as a
@@ -204,13 +200,8 @@ fn load_format(
 ) -> Result<Scene, SceneError> {
     match format {
         Format::Obj => {
-            let text = std::str::from_utf8(bytes).map_err(|e| {
-                let problem = FormatProblem::InvalidUtf8 {
-                    at: e.valid_up_to(),
-                };
-                SceneError::in_file(shown, problem.to_string())
-            })?;
-            obj::load_obj_text(shown, text, folder, options)
+            let text = obj::text_of(bytes).map_err(|e| e.in_file(shown))?;
+            obj::load_obj_text(shown, &text, folder, options)
         }
         Format::Gltf | Format::Glb => gltf::load_bytes(shown, bytes, folder, options),
         Format::Ply => ply::load_bytes(shown, bytes, path, options),
@@ -236,7 +227,7 @@ fn read_stream(stream: impl Read, path: &Path, max_bytes: u64) -> Result<Vec<u8>
     }
     let limit = match detect(&bytes) {
         Some(format) if format.is_text() => {
-            text_head(&bytes)?;
+            text_head(&bytes, format)?;
             max_bytes
         }
         Some(_) => max_bytes,
@@ -277,11 +268,7 @@ pub(crate) enum FormatProblem {
     #[error("the file is empty")]
     Empty,
     /// A file named `.stl` whose size is not the one its binary STL header gives.
-    #[error(
-        "a binary STL of the wrong size: its header says {count} triangles ({expected} bytes), the \
-         file has {size} bytes: {}",
-        stl_size_why(*.size, *.expected, *.count)
-    )]
+    #[error("{}", stl::wrong_size_text(*.count, *.expected, *.size))]
     StlSize {
         /// The triangle count in the header.
         count: u64,
@@ -323,29 +310,15 @@ pub(crate) enum FormatProblem {
         /// The offset of the first invalid byte.
         at: usize,
     },
+    /// OBJ text with bytes that are not text outside its names and comments.
+    #[error("line {line}: {0}", line = .0.line)]
+    NotText(super::obj_check::NotText),
     /// Text with a NUL byte: its offset.
     #[error("not a text file (a NUL byte at byte {at})")]
     Nul {
         /// The offset of the NUL byte.
         at: usize,
     },
-}
-
-/// Why a binary STL's size may be wrong, from the size it has, the one its header gives and the
-/// header's triangle count.
-fn stl_size_why(size: u64, expected: u64, count: u64) -> String {
-    if size < expected {
-        format!(
-            "it holds {} bytes fewer than its header's {count} triangles need (cut short?)",
-            expected - size
-        )
-    } else {
-        format!(
-            "it holds {} bytes more than its header's {count} triangles need (a wrong count, or data \
-             after the triangles)",
-            size - expected
-        )
-    }
 }
 
 /// A file's extension in a message: ` (extension `.obj`)`, or nothing.
@@ -379,7 +352,18 @@ impl std::fmt::Display for Start<'_> {
 /// The first bytes of a stream in a text format must be text: valid UTF-8 (but for a character cut at
 /// the end) without NUL bytes. Anything else is refused before more is read (random bytes whose start
 /// is not even UTF-8 would otherwise be read to the size limit as an OBJ).
-fn text_head(head: &[u8]) -> Result<(), FormatProblem> {
+///
+/// An OBJ may hold names and comments in another encoding ([`obj::text_of`]): its whole lines in the
+/// head are checked as the OBJ reader checks them.
+fn text_head(head: &[u8], format: Format) -> Result<(), FormatProblem> {
+    if format == Format::Obj {
+        let lines = head.iter().rposition(|&b| b == b'\n').map_or(0, |k| k + 1);
+        obj::text_of(&head[..lines]).map_err(FormatProblem::NotText)?;
+        return match head.iter().position(|&b| b == 0) {
+            Some(at) => Err(FormatProblem::Nul { at }),
+            None => Ok(()),
+        };
+    }
     let valid = match std::str::from_utf8(head) {
         Ok(_) => head.len(),
         Err(e) if e.error_len().is_none() => e.valid_up_to(),

@@ -95,9 +95,11 @@ fn load_document(
     check_placed_size(&tree, &nodes, budget.max()).map_err(|p| file_error(p.to_string()))?;
     let mut worlds: Vec<Matrix> = Vec::with_capacity(tree.len());
     let mut primitives_seen = 0usize;
-    let mut skipped_modes = 0usize;
+    let mut triangles_read = 0usize;
+    let mut skipped = Skipped::default();
     for &(k, parent_at) in &tree {
         let node = &nodes[k];
+        check_affine(node).map_err(|p| file_error(p.to_string()))?;
         let parent = parent_at.map_or(IDENTITY, |p| worlds[p]);
         let world = multiply(&parent, &to_f64(node.transform().matrix()));
         worlds.push(world);
@@ -137,11 +139,12 @@ fn load_document(
             let Some(positions) = primitive.get(&Semantic::Positions) else {
                 return Err(at("no POSITION attribute".into()));
             };
-            let ids: Vec<u32> = data
+            let points = data
                 .positions(positions.index(), &mut budget)
-                .map_err(|p| at(p.to_string()))?
-                .into_iter()
-                .map(|p| b.vertex(transform_point(&world, p)))
+                .map_err(|p| at(p.to_string()))?;
+            let ids: Vec<u32> = points
+                .iter()
+                .map(|&p| b.vertex(transform_point(&world, p)))
                 .collect();
             let indices: Vec<u32> = match primitive.indices() {
                 Some(i) => data
@@ -162,15 +165,27 @@ fn load_document(
                 )));
             }
             let Some(triangles) = triangles(mode, &indices) else {
-                skipped_modes += 1;
+                skipped.add(&name, primitive.index(), mode);
                 continue;
             };
+            triangles_read += triangles.len();
             for (k, t) in triangles.into_iter().enumerate() {
                 let mut corners = [0u32; 3];
                 for (c, &i) in corners.iter_mut().zip(&t) {
                     *c = *ids
                         .get(i as usize)
                         .ok_or_else(|| at(format!("index {i} past its {} vertices", ids.len())))?;
+                    // Checked before the node's transform, which would spread a NaN to every
+                    // coordinate.
+                    let [x, y, z] = points[i as usize];
+                    if !(x.is_finite() && y.is_finite() && z.is_finite()) {
+                        return Err(at(format!(
+                            "triangle {k}: its vertex {i} (of POSITION accessor {}) has a \
+                             non-finite coordinate ({x}, {y}, {z}) (numbered from 0, as glTF \
+                             numbers them)",
+                            positions.index()
+                        )));
+                    }
                 }
                 if mirrored {
                     corners.swap(1, 2);
@@ -185,12 +200,22 @@ fn load_document(
             "the scene is empty: no node of its scene has a mesh".into(),
         ));
     }
-    if skipped_modes > 0 {
+    if triangles_read == 0 && skipped.count > 0 {
+        return Err(file_error(format!(
+            "the scene has no triangles: its meshes hold only primitives of points or lines ({}), \
+             which scx does not read: they have no area; scx reads triangles (modes 4 TRIANGLES, 5 \
+             TRIANGLE_STRIP, 6 TRIANGLE_FAN)",
+            skipped.examples()
+        )));
+    }
+    if skipped.count > 0 {
         b.warn(
             SceneWarningKind::NoArea,
             format!(
-            "{shown}: ignored {skipped_modes} primitive(s) of points or lines: they have no area"
-        ),
+                "{shown}: ignored {} primitive(s) of points or lines ({}): they have no area",
+                skipped.count,
+                skipped.examples()
+            ),
         );
     }
     if !textured.is_empty() {
@@ -204,6 +229,70 @@ fn load_document(
         );
     }
     b.build_with(options)
+}
+
+/// The primitives of points or lines skipped (no area): how many, and the first few for messages.
+#[derive(Default)]
+struct Skipped {
+    count: usize,
+    examples: Vec<String>,
+}
+
+impl Skipped {
+    /// How many skipped primitives a message names.
+    const SHOWN: usize = 3;
+
+    fn add(&mut self, mesh: &str, primitive: usize, mode: Mode) {
+        self.count += 1;
+        if self.examples.len() < Self::SHOWN {
+            self.examples.push(format!(
+                "mesh `{mesh}` primitive {primitive}: mode {} {}",
+                mode.as_gl_enum(),
+                mode_name(mode)
+            ));
+        }
+    }
+
+    /// The first few skipped primitives, and how many more.
+    fn examples(&self) -> String {
+        let more = self.count - self.examples.len();
+        let mut text = self.examples.join("; ");
+        if more > 0 {
+            text.push_str(&format!("; and {more} more"));
+        }
+        text
+    }
+}
+
+/// A primitive mode's name in the glTF specification.
+fn mode_name(mode: Mode) -> &'static str {
+    match mode {
+        Mode::Points => "POINTS",
+        Mode::Lines => "LINES",
+        Mode::LineLoop => "LINE_LOOP",
+        Mode::LineStrip => "LINE_STRIP",
+        Mode::Triangles => "TRIANGLES",
+        Mode::TriangleStrip => "TRIANGLE_STRIP",
+        Mode::TriangleFan => "TRIANGLE_FAN",
+    }
+}
+
+/// A node's `matrix` must be affine (last row 0 0 0 1), as glTF requires: a projective matrix cannot
+/// place a mesh, and applied as if affine it would put it somewhere else without a word.
+fn check_affine(node: &::gltf::Node) -> Result<(), DocumentProblem> {
+    let ::gltf::scene::Transform::Matrix { matrix } = node.transform() else {
+        return Ok(());
+    };
+    // Column-major: the last row is the fourth value of each column.
+    let row = matrix.map(|column| column[3]);
+    if row == [0.0, 0.0, 0.0, 1.0] {
+        return Ok(());
+    }
+    Err(DocumentProblem::NotAffine {
+        node: node.index(),
+        name: node.name().map(str::to_string),
+        row,
+    })
 }
 
 /// What is wrong with a glTF document as a whole, found before its meshes are read.
@@ -233,6 +322,21 @@ enum DocumentProblem {
     /// An asset version other than 2.x: the version.
     #[error("glTF version `{0}`: scx reads glTF 2.0")]
     Version(String),
+    /// A node whose matrix is not affine: the node, its name and the matrix's last row.
+    #[error(
+        "node {node}{}: its matrix is not affine (its last row is {} {} {} {}, not 0 0 0 1): a \
+         projective matrix cannot place a mesh",
+        .name.as_ref().map(|n| format!(" (`{n}`)")).unwrap_or_default(),
+        .row[0], .row[1], .row[2], .row[3]
+    )]
+    NotAffine {
+        /// The node's index.
+        node: usize,
+        /// Its name, if it has one.
+        name: Option<String>,
+        /// The matrix's last row.
+        row: [f32; 4],
+    },
     /// A `minVersion` other than 2.0: that version.
     #[error("the file needs a reader of glTF {0} (its minVersion): scx reads glTF 2.0")]
     MinVersion(String),

@@ -21,9 +21,26 @@ use super::read::{Escape, Folder, Reach, ReadError, RefError};
 /// A buffer's bytes, shared by the buffers that name the same file or chunk.
 pub(super) type Buffer = Rc<Vec<u8>>;
 
+/// A buffer's bytes and its `byteLength`, which may be less than the bytes (a .glb's binary chunk is
+/// padded; a file may hold more): the buffer is its first `byteLength` bytes.
+pub(super) struct BufferBytes {
+    bytes: Buffer,
+    length: usize,
+}
+
+impl BufferBytes {
+    /// The buffer's bytes, as many as its `byteLength` gives.
+    fn declared(&self) -> &[u8] {
+        &self.bytes[..self.length]
+    }
+}
+
 /// The bytes of every buffer: the binary chunk of a .glb, a base64 data URI, or a file in the glTF's
 /// folder (read as the folder's policy allows).
-pub(super) fn buffers(gltf: &::gltf::Gltf, folder: &Folder) -> Result<Vec<Buffer>, BufferProblem> {
+pub(super) fn buffers(
+    gltf: &::gltf::Gltf,
+    folder: &Folder,
+) -> Result<Vec<BufferBytes>, BufferProblem> {
     let blob = gltf.blob.clone().map(Rc::new);
     gltf.buffers()
         .map(|buffer| {
@@ -35,7 +52,10 @@ pub(super) fn buffers(gltf: &::gltf::Gltf, folder: &Folder) -> Result<Vec<Buffer
                     declared: buffer.length(),
                 });
             }
-            Ok(data)
+            Ok(BufferBytes {
+                bytes: data,
+                length: buffer.length(),
+            })
         })
         .collect()
 }
@@ -242,7 +262,7 @@ pub(super) struct Data<'a> {
     /// The document's JSON.
     pub root: &'a json::Root,
     /// Every buffer's bytes, by index.
-    pub buffers: &'a [Buffer],
+    pub buffers: &'a [BufferBytes],
 }
 
 /// An accessor as messages name it: what a primitive reads from it, its index, and whether the
@@ -371,7 +391,7 @@ pub(super) enum AccessorProblem {
     /// A buffer view reaching past the end of its buffer.
     #[error(
         "{role}: its buffer view {view} (bytes {start} to {}) does not fit in buffer {buffer} of \
-         {buffer_length} bytes",
+         {buffer_length} bytes (its byteLength)",
         .start.saturating_add(*.length)
     )]
     ViewOutside {
@@ -385,7 +405,7 @@ pub(super) enum AccessorProblem {
         length: u64,
         /// The buffer's index.
         buffer: usize,
-        /// The buffer's length in bytes.
+        /// The buffer's length in bytes (its byteLength).
         buffer_length: usize,
     },
     /// Elements reaching past the end of their buffer view.
@@ -577,10 +597,13 @@ impl Data<'_> {
             });
         }
         let b = v.buffer.value();
+        // A view must fit in the buffer as its byteLength gives it, whatever bytes follow in the
+        // file or data URI.
         let data = self
             .buffers
             .get(b)
-            .ok_or(AccessorProblem::NoBuffer { role, buffer: b })?;
+            .ok_or(AccessorProblem::NoBuffer { role, buffer: b })?
+            .declared();
         let start = v.byte_offset.map_or(0, |o| o.0);
         let length = v.byte_length.0;
         let end = start

@@ -6,6 +6,7 @@
 
 use std::path::Path;
 
+use super::obj_check::NotText;
 use super::read::{self, Escape, Fetched, Folder, ReadError, ReadPolicy, RefError};
 use super::{Material, Scene, SceneBuilder, SceneError, SceneOptions, SceneWarningKind};
 
@@ -30,12 +31,7 @@ pub fn load_with_policy(
     let file_error = |message: String| SceneError::in_file(&shown, message);
     let bytes =
         read::read_scene_file(path, policy.max_bytes).map_err(|e| file_error(e.to_string()))?;
-    let text = String::from_utf8(bytes).map_err(|e| {
-        file_error(format!(
-            "not a text file (invalid UTF-8 at byte {})",
-            e.utf8_error().valid_up_to()
-        ))
-    })?;
+    let text = text_of(&bytes).map_err(|e| e.in_file(&shown))?;
     load_obj_text(&shown, &text, &Folder::of_file(path, *policy), options)
 }
 
@@ -54,6 +50,12 @@ pub(crate) fn load_obj_text(
     )?;
     scene.files_read = folder.files_read();
     Ok(scene)
+}
+
+/// OBJ bytes as text: names and comments in another encoding than UTF-8 are read (see
+/// [`super::obj_check::text_of`]); any other byte that is not text is an error naming its line.
+pub(crate) fn text_of(bytes: &[u8]) -> Result<std::borrow::Cow<'_, str>, NotText> {
+    super::obj_check::text_of(bytes, super::obj_check::OBJ_NAMES)
 }
 
 /// Text without the byte-order mark some editors put first: left in, it would glue itself to the first
@@ -129,13 +131,9 @@ fn library_text(fetched: Fetched) -> Result<(String, String), MtlError> {
     if !fetched.first {
         return Ok((name, String::new()));
     }
-    match String::from_utf8(fetched.bytes.to_vec()) {
+    match super::obj_check::text_of(&fetched.bytes, super::obj_check::MTL_NAMES) {
         Ok(text) => Ok((name, without_bom(&text).to_string())),
-        Err(e) => Err(MtlErrorKind::NotText {
-            at: e.utf8_error().valid_up_to(),
-            name,
-        }
-        .into()),
+        Err(problem) => Err(MtlErrorKind::NotText { problem, name }.into()),
     }
 }
 
@@ -201,13 +199,13 @@ enum MtlErrorKind {
         /// The base name looked for.
         base: String,
     },
-    /// The file is not UTF-8 text: its name for messages, and the offset of the first invalid byte.
-    #[error("`{name}` is not a text file (invalid UTF-8 at byte {at})")]
+    /// The file is not text where it must be: its name for messages, and where.
+    #[error("`{name}` line {}: {problem}", .problem.line)]
     NotText {
         /// The library's name for messages.
         name: String,
-        /// The offset of the first invalid byte.
-        at: usize,
+        /// The line and byte that are not text.
+        problem: NotText,
     },
     /// A reason a [`MaterialSource`] gave.
     #[error(transparent)]

@@ -11,6 +11,109 @@ use std::borrow::Cow;
 
 use super::SceneError;
 
+/// The OBJ statements whose arguments are names (of objects, groups, materials, libraries), which tools
+/// write in their own encoding.
+pub(crate) const OBJ_NAMES: &[&str] = &["o", "g", "usemtl", "mtllib", "maplib", "usemap"];
+
+/// The MTL statements whose arguments are names: the material's, and texture files' (which scx does not
+/// read).
+pub(crate) const MTL_NAMES: &[&str] = &[
+    "newmtl", "map_Ka", "map_Kd", "map_Ks", "map_Ke", "map_Ns", "map_d", "map_bump", "bump",
+    "disp", "decal", "refl", "norm",
+];
+
+/// Where OBJ or MTL bytes are not text: a byte that is not UTF-8 outside a name or a comment. The
+/// message leaves the line out: it goes with the file's name (`room.obj:12`).
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error(
+    "{}byte 0x{byte:02X} at column {column} is not text (UTF-8){}; only names ({names}) and comments \
+     may hold other bytes",
+    // A line whose first word is not text either is no statement: binary bytes, most likely.
+    if .statement.is_none() { "not a text file: " } else { "" },
+    .statement.as_ref().map(|k| format!(" in a `{k}` statement")).unwrap_or_default()
+)]
+pub(crate) struct NotText {
+    /// The line (1-based).
+    pub line: usize,
+    /// The column of the byte (1-based, in bytes).
+    pub column: usize,
+    /// The byte.
+    pub byte: u8,
+    /// The statement's keyword, when it is text.
+    pub statement: Option<String>,
+    /// The statements whose names may hold any byte, as the message lists them.
+    pub names: String,
+}
+
+/// OBJ or MTL bytes as text. Tools write names and comments in their own encoding (Latin-1 and the
+/// like), and a file refused whole for one accented name is a file the user cannot read: a byte that is
+/// not UTF-8 in a comment or in the arguments of a statement of `names` is read as the Latin-1
+/// character of its value. Distinct bytes stay distinct characters (U+FFFD for each would merge two
+/// names), and a name written in Latin-1 reads as the same name written in UTF-8. Such bytes anywhere
+/// else (a number, a keyword, a face) are an error naming the line.
+pub(crate) fn text_of<'a>(bytes: &'a [u8], names: &[&str]) -> Result<Cow<'a, str>, NotText> {
+    let first_bad = match std::str::from_utf8(bytes) {
+        Ok(text) => return Ok(Cow::Borrowed(text)),
+        Err(e) => e.valid_up_to(),
+    };
+    // The lines before the first bad byte are text: copied as they are.
+    let start = bytes[..first_bad]
+        .iter()
+        .rposition(|&b| b == b'\n')
+        .map_or(0, |k| k + 1);
+    let mut text = String::with_capacity(bytes.len() + 16);
+    text.push_str(std::str::from_utf8(&bytes[..start]).expect("checked above"));
+    let before = bytes[..start].iter().filter(|&&b| b == b'\n').count();
+    for (k, line) in bytes[start..].split_inclusive(|&b| b == b'\n').enumerate() {
+        check_line(line, names).map_err(|(column, byte, statement)| NotText {
+            line: before + k + 1,
+            column,
+            byte,
+            statement,
+            names: names
+                .iter()
+                .map(|n| format!("`{n}`"))
+                .collect::<Vec<_>>()
+                .join(", "),
+        })?;
+        for chunk in line.utf8_chunks() {
+            text.push_str(chunk.valid());
+            text.extend(chunk.invalid().iter().map(|&b| char::from(b)));
+        }
+    }
+    Ok(Cow::Owned(text))
+}
+
+/// Whether a line's bytes that are not UTF-8 are all in a comment or in a name statement's arguments;
+/// `Err` gives the first other one: its column (1-based), the byte, and the statement's keyword.
+fn check_line(line: &[u8], names: &[&str]) -> Result<(), (usize, u8, Option<String>)> {
+    let Err(e) = std::str::from_utf8(line) else {
+        return Ok(());
+    };
+    let at = e.valid_up_to();
+    let keyword = line
+        .split(|b| b.is_ascii_whitespace())
+        .find(|w| !w.is_empty())
+        .and_then(|w| std::str::from_utf8(w).ok());
+    let in_name = keyword.is_some_and(|k| names.contains(&k));
+    // `#` is ASCII: no byte of a multi-byte character is one, so the comment starts at the first.
+    let code = line.split(|&b| b == b'#').next().unwrap_or(line);
+    if in_name || std::str::from_utf8(code).is_ok() {
+        return Ok(());
+    }
+    Err((at + 1, line[at], keyword.map(str::to_string)))
+}
+
+impl NotText {
+    /// The error for OBJ bytes read from `shown`, naming the line as the other OBJ errors do.
+    pub(crate) fn in_file(self, shown: &str) -> SceneError {
+        SceneError::File {
+            path: format!("{shown}:{}", self.line),
+            message: self.to_string(),
+        }
+    }
+}
+
 /// OBJ text as scx reads it, and what the scan found on the way.
 pub(crate) struct Prepared<'a> {
     /// The line numbers (1-based) of the `f` statements, in file order.
@@ -272,6 +375,36 @@ mod tests {
     }
 
     use super::*;
+
+    /// Bytes that are not UTF-8 in names and comments are read as Latin-1 characters, each its own
+    /// (U+FFFD for all would merge `caf\xe9` and `caf\xe8`); anywhere else they are an error naming
+    /// the line, the column and the statement (the whole file was "not a text file").
+    #[test]
+    fn names_and_comments_may_be_in_latin_1() {
+        let bytes =
+            b"# \xa9 1999\no caf\xe9\ng caf\xe8 # \xff\nv 0 0 0 # d\xe9j\xe0\nusemtl r\xf6t\n";
+        assert_eq!(
+            text_of(bytes, OBJ_NAMES).unwrap(),
+            "# \u{a9} 1999\no caf\u{e9}\ng caf\u{e8} # \u{ff}\nv 0 0 0 # d\u{e9}j\u{e0}\nusemtl r\u{f6}t\n"
+        );
+        assert!(matches!(
+            text_of(b"v 0 0 0\n", OBJ_NAMES),
+            Ok(Cow::Borrowed(_))
+        ));
+        let e = text_of(b"o caf\xe9\nv 0 \xe9 0\n", OBJ_NAMES).unwrap_err();
+        assert_eq!(e.line, 2);
+        assert_eq!(
+            e.to_string(),
+            "byte 0xE9 at column 5 is not text (UTF-8) in a `v` statement; only names (`o`, `g`, \
+             `usemtl`, `mtllib`, `maplib`, `usemap`) and comments may hold other bytes"
+        );
+        assert_eq!(
+            text_of(b"newmtl \xe9\nKd 1 \xe9 1\n", MTL_NAMES)
+                .unwrap_err()
+                .line,
+            2
+        );
+    }
 
     #[test]
     fn problems_are_found_on_their_line() {

@@ -48,10 +48,11 @@ pub(crate) fn read_bytes(
     path: &Path,
 ) -> Result<SceneBuilder, SceneError> {
     let file_error = |message: String| SceneError::in_file(shown, message);
-    let mut cursor = std::io::Cursor::new(bytes);
+    let bytes = with_text_comments(bytes).map_err(file_error)?;
+    let mut cursor = std::io::Cursor::new(bytes.as_ref());
     let ply = Parser::<Item>::new()
         .read_ply(&mut cursor)
-        .map_err(|e| file_error(format!("not a readable PLY file: {e}")))?;
+        .map_err(|e| file_error(format!("not a readable PLY file: {}", ply_problem(&e))))?;
     let vertices = ply.payload.get("vertex").map(Vec::as_slice).unwrap_or(&[]);
     let sources: Vec<(&str, Kind, &[Item])> = ply
         .header
@@ -95,7 +96,7 @@ pub(crate) fn read_bytes(
             let material = materials.of(&mut b, item);
             match kind {
                 Kind::Faces => {
-                    let corners = corners(indices, &ids).map_err(at)?;
+                    let corners = corners(indices, &ids, vertices).map_err(at)?;
                     if corners.len() < 3 {
                         return Err(at(format!(
                             "a face needs at least 3 vertices, it has {}",
@@ -106,7 +107,7 @@ pub(crate) fn read_bytes(
                 }
                 Kind::Strips => {
                     for (t, triangle) in strip_triangles(indices).into_iter().enumerate() {
-                        let corners = corners(&triangle, &ids).map_err(at)?;
+                        let corners = corners(&triangle, &ids, vertices).map_err(at)?;
                         b.polygon(&corners, material, format!("{element} {k} triangle {t}"));
                     }
                 }
@@ -114,6 +115,104 @@ pub(crate) fn read_bytes(
         }
     }
     Ok(b)
+}
+
+/// The bytes with the header's comments made text: tools write comments (`comment`, `obj_info`) in
+/// their own encoding (Latin-1 and the like), which ply-rs-bw, reading the header as UTF-8, would refuse
+/// with the whole file. scx does not use comments, so their other bytes become U+FFFD. Any other header
+/// line must be text: `Err` names the first that is not.
+fn with_text_comments(bytes: &[u8]) -> Result<std::borrow::Cow<'_, [u8]>, String> {
+    let lines = || bytes.split_inclusive(|&b| b == b'\n');
+    // Without `end_header` it is no PLY header at all: the parser says so.
+    let Some(count) = lines().position(|l| l.trim_ascii() == b"end_header") else {
+        return Ok(std::borrow::Cow::Borrowed(bytes));
+    };
+    let mut rewrite = false;
+    for (k, line) in lines().take(count).enumerate() {
+        let Err(e) = std::str::from_utf8(line) else {
+            continue;
+        };
+        if !(line.starts_with(b"comment") || line.starts_with(b"obj_info")) {
+            let at = e.valid_up_to();
+            return Err(format!(
+                "header line {}: byte 0x{:02X} at column {} is not text (UTF-8); of a PLY header \
+                 only the comments may hold other bytes",
+                k + 1,
+                line[at],
+                at + 1
+            ));
+        }
+        rewrite = true;
+    }
+    if !rewrite {
+        return Ok(std::borrow::Cow::Borrowed(bytes));
+    }
+    let end: usize = lines().take(count + 1).map(<[u8]>::len).sum();
+    let mut out = String::from_utf8_lossy(&bytes[..end])
+        .into_owned()
+        .into_bytes();
+    out.extend_from_slice(&bytes[end..]);
+    Ok(std::borrow::Cow::Owned(out))
+}
+
+/// What ply-rs-bw's error says, in plain words: its messages hold the line read, Rust debug text of
+/// the errors below (`Custom { kind: InvalidInput, ... }`, a parser's expected sets) and tabs and line
+/// breaks. Kept: the line number, the line's text, and the cause where it is known.
+fn ply_problem(e: &std::io::Error) -> String {
+    let text = e.to_string();
+    if e.kind() == std::io::ErrorKind::UnexpectedEof || text.contains("failed to fill whole buffer")
+    {
+        if text.contains("missing 'end_header'") {
+            return "the header has no `end_header` line (cut short, or no PLY header)".into();
+        }
+        return format!(
+            "{}the file ends before all the items its header announces are read (cut short?)",
+            line_prefix(&text)
+        );
+    }
+    let Some(written) = quoted(&text, "String: '") else {
+        // A message of ply-rs-bw's own without debug text: its first sentence.
+        return text.lines().next().unwrap_or("").to_string();
+    };
+    let written = written.trim();
+    let cause = if let Some(value) = quoted(&text, "Value: '") {
+        format!("`{value}` is not a number of its property's type (or out of its range)")
+    } else if text.contains("but found nothing") {
+        "fewer values than the element's properties".into()
+    } else if text.contains("list elements, but found only") {
+        "a list with fewer values than its count".into()
+    } else if text.contains("Couldn't parse line") {
+        "not a header statement (`format`, `element`, `property`, `comment`, `obj_info`, \
+         `end_header`)"
+            .into()
+    } else if let Some(token) = written.split_whitespace().find(|t| !is_ply_number(t)) {
+        format!("`{token}` is not a number")
+    } else {
+        text.lines().next().unwrap_or("").to_string()
+    };
+    format!("{}`{written}`: {cause}", line_prefix(&text))
+}
+
+/// `line N: ` from ply-rs-bw's `Line N:` (the file's line, from 1), or nothing.
+fn line_prefix(text: &str) -> String {
+    text.strip_prefix("Line ")
+        .and_then(|rest| rest.split_once(':'))
+        .filter(|(n, _)| n.parse::<u64>().is_ok())
+        .map(|(n, _)| format!("line {n}: "))
+        .unwrap_or_default()
+}
+
+/// The text between `start` and the next `'` in ply-rs-bw's message.
+fn quoted<'a>(text: &'a str, start: &str) -> Option<&'a str> {
+    let (_, rest) = text.split_once(start)?;
+    Some(rest.split_once('\'').map_or(rest, |(q, _)| q))
+}
+
+/// Whether a value is a number as PLY writes them (ply-rs-bw reads no `nan` or `inf`).
+fn is_ply_number(token: &str) -> bool {
+    token
+        .chars()
+        .all(|c| c.is_ascii_digit() || "+-.eE".contains(c))
 }
 
 /// What scx reads of one item of any element: the coordinates of a vertex, the index list and colour of a
@@ -224,20 +323,28 @@ fn strip_triangles(list: &[i64]) -> Vec<[i64; 3]> {
     triangles
 }
 
-/// A polygon's corners as the builder's vertex ids, each index checked against the vertex count.
-fn corners(indices: &[i64], ids: &[u32]) -> Result<Vec<u32>, String> {
+/// A polygon's corners as the builder's vertex ids, each index checked against the vertex count and
+/// its vertex for finite coordinates. Messages number vertices from 0, as the index lists do (and as
+/// every PLY message numbers items).
+fn corners(indices: &[i64], ids: &[u32], vertices: &[Item]) -> Result<Vec<u32>, String> {
     indices
         .iter()
         .map(|&i| {
-            usize::try_from(i)
-                .ok()
-                .and_then(|i| ids.get(i).copied())
-                .ok_or_else(|| {
-                    format!(
-                        "refers to vertex {i}, but the file has {} vertices (0-based)",
-                        ids.len()
-                    )
-                })
+            let k = usize::try_from(i).ok().filter(|&k| k < ids.len());
+            let Some(k) = k else {
+                return Err(format!(
+                    "refers to vertex {i}, but the file has {} vertices (numbered from 0)",
+                    ids.len()
+                ));
+            };
+            let [x, y, z] = vertices[k].xyz;
+            if ![x, y, z].iter().all(|c| c.is_finite()) {
+                return Err(format!(
+                    "its vertex {k} has a non-finite coordinate ({x}, {y}, {z}) (items numbered \
+                     from 0, as the file's index lists number them)"
+                ));
+            }
+            Ok(ids[k])
         })
         .collect()
 }
@@ -400,4 +507,117 @@ pub fn to_bytes(scene: &Scene) -> Vec<u8> {
         }
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A PLY header of three float vertices and one triangle, in `format`, with `extra` header lines.
+    fn header(format: &str, extra: &str) -> Vec<u8> {
+        format!(
+            "ply\nformat {format} 1.0\n{extra}element vertex 3\nproperty float x\nproperty float y\n\
+             property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
+        )
+        .into_bytes()
+    }
+
+    fn error_of(bytes: &[u8]) -> String {
+        read_bytes("t.ply", bytes, Path::new("t.ply"))
+            .and_then(SceneBuilder::build)
+            .unwrap_err()
+            .to_string()
+    }
+
+    /// A NaN coordinate is named as the file numbers it: the face's item and the vertex's index, both
+    /// from 0 (it said "face 0: vertex 3", the second counted from 1 among the welded vertices).
+    #[test]
+    fn a_non_finite_vertex_is_named_as_the_file_numbers_it() {
+        let mut bytes = header("binary_little_endian", "");
+        for c in [0.0f32, 0.0, 0.0, 1.0, 0.0, 0.0, f32::NAN, 1.0, 0.0] {
+            bytes.extend(c.to_le_bytes());
+        }
+        bytes.push(3);
+        for i in [0i32, 1, 2] {
+            bytes.extend(i.to_le_bytes());
+        }
+        assert_eq!(
+            error_of(&bytes),
+            "t.ply: face 0: its vertex 2 has a non-finite coordinate (NaN, 1, 0) (items numbered \
+             from 0, as the file's index lists number them)"
+        );
+    }
+
+    /// ply-rs-bw's errors come out in words, with the line and its text: no tabs, line breaks or
+    /// Rust debug text (`Custom { kind: InvalidInput, ... }`, `failed to fill whole buffer`).
+    #[test]
+    fn parser_errors_read_as_plain_words() {
+        let ascii = |body: &str| [header("ascii", ""), body.as_bytes().to_vec()].concat();
+        let cases: Vec<(Vec<u8>, &str)> = vec![
+            (
+                ascii("0 0 0\n1 0 0\nnan 1 0\n3 0 1 2\n"),
+                "line 12: `nan 1 0`: `nan` is not a number",
+            ),
+            (
+                ascii("0 0 0\n1 0\n0 1 0\n3 0 1 2\n"),
+                "line 11: `1 0`: fewer values than the element's properties",
+            ),
+            (
+                ascii("0 0 0\n1 0 0\n0 1 0\n"),
+                "line 13: the file ends before all the items its header announces are read",
+            ),
+            (
+                b"ply\nformat ascii 1.0\nelement vertex 3\nproprty float x\nend_header\n".to_vec(),
+                "line 4: `proprty float x`: not a header statement",
+            ),
+            (
+                b"ply\nformat ascii 1.0\nelement vertex 3\n".to_vec(),
+                "the header has no `end_header` line",
+            ),
+            (
+                [header("binary_little_endian", ""), vec![0; 30]].concat(),
+                "the file ends before all the items its header announces are read (cut short?)",
+            ),
+        ];
+        for (bytes, expected) in cases {
+            let e = error_of(&bytes);
+            assert!(
+                e.starts_with("t.ply: not a readable PLY file: ") && e.contains(expected),
+                "{e}"
+            );
+            for raw in ["\n", "\t", "Error", "{", "fill whole buffer"] {
+                assert!(!e.contains(raw), "{raw:?} in {e}");
+            }
+        }
+    }
+
+    /// Comments in Latin-1 (as tools write them) are read; a byte that is not text elsewhere in the
+    /// header is an error naming the line (the whole file was refused: "stream did not contain valid
+    /// UTF-8").
+    #[test]
+    fn comments_in_another_encoding_are_read() {
+        let body = b"0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+        let latin = [
+            header("ascii", "comment caf\u{e9}\nobj_info \u{e9}\n").as_slice(),
+            body,
+        ]
+        .concat();
+        let latin: Vec<u8> = String::from_utf8(latin)
+            .unwrap()
+            .chars()
+            .map(|c| c as u32 as u8)
+            .collect();
+        let scene = read_bytes("t.ply", &latin, Path::new("t.ply"))
+            .and_then(SceneBuilder::build)
+            .unwrap();
+        assert_eq!(scene.patch_count(), 1);
+        let mut bad = header("ascii", "").to_vec();
+        bad.splice(21..21, [b'\xe9']);
+        bad.extend_from_slice(body);
+        assert_eq!(
+            error_of(&bad),
+            "t.ply: header line 3: byte 0xE9 at column 1 is not text (UTF-8); of a PLY header only \
+             the comments may hold other bytes"
+        );
+    }
 }

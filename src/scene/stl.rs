@@ -27,7 +27,15 @@ pub(crate) fn read_bytes(
     bytes: &[u8],
     path: &Path,
 ) -> Result<SceneBuilder, SceneError> {
-    if looks_like_ascii_stl(bytes) {
+    // A file of a binary STL's exact size is read as ASCII only when it looks so in full (a binary
+    // header may start with `solid` too); any other file that starts `solid` is ASCII, read by scx's
+    // reader whatever its first 4 KiB hold (stl_io's would take it, with messages of its own).
+    let ascii = if is_binary_stl(bytes) {
+        looks_like_ascii_stl(bytes)
+    } else {
+        starts_with_solid(bytes)
+    };
+    if ascii {
         match read_ascii(shown, bytes, path) {
             // A binary STL's header is free text and may start `solid` and name facets.
             Err(_) if is_binary_stl(bytes) => read_binary(shown, bytes, path),
@@ -46,9 +54,21 @@ pub(crate) fn looks_like_ascii_stl(bytes: &[u8]) -> bool {
     text.starts_with("solid") && (text.contains("facet") || text.contains("endsolid"))
 }
 
-/// A binary STL, read with `stl_io`.
+/// Whether bytes start `solid` (in any case, after a byte-order mark and blank space).
+fn starts_with_solid(bytes: &[u8]) -> bool {
+    let head = String::from_utf8_lossy(&bytes[..bytes.len().min(64)]).to_ascii_lowercase();
+    head.trim_start_matches('\u{feff}')
+        .trim_start()
+        .starts_with("solid")
+}
+
+/// A binary STL, read with `stl_io`: only bytes of the size its header gives, so that stl_io's reader,
+/// whose messages are its own (`failed to fill whole buffer`), has nothing to refuse.
 fn read_binary(shown: &str, bytes: &[u8], path: &Path) -> Result<SceneBuilder, SceneError> {
     let file_error = |message: String| SceneError::in_file(shown, message);
+    if !is_binary_stl(bytes) {
+        return Err(file_error(binary_size_problem(bytes)));
+    }
     // A binary STL's 80-byte header is free text, and some exporters start it with `solid`, which
     // stl_io would take for the ASCII form: hide the word from it (the header carries no geometry).
     let binary_solid = is_binary_stl(bytes) && bytes.starts_with(b"solid");
@@ -72,6 +92,44 @@ fn read_binary(shown: &str, bytes: &[u8], path: &Path) -> Result<SceneBuilder, S
         b.polygon(&corners, material, format!("triangle {}", k + 1));
     }
     Ok(b)
+}
+
+/// Why bytes read as a binary STL are none: shorter than its header, or not of the size it gives.
+fn binary_size_problem(bytes: &[u8]) -> String {
+    let Some(count) = bytes.get(80..84) else {
+        return format!(
+            "not a binary STL: {} bytes, shorter than its 84-byte header and triangle count",
+            bytes.len()
+        );
+    };
+    let count = u64::from(u32::from_le_bytes([count[0], count[1], count[2], count[3]]));
+    wrong_size_text(count, 84 + 50 * count, bytes.len() as u64)
+}
+
+/// The message for a binary STL of `size` bytes whose header's `count` triangles need `expected`.
+pub(crate) fn wrong_size_text(count: u64, expected: u64, size: u64) -> String {
+    format!(
+        "a binary STL of the wrong size: its header says {count} triangles ({expected} bytes), the \
+         file has {size} bytes: {}",
+        size_why(size, expected, count)
+    )
+}
+
+/// Why a binary STL's size may be wrong, from the size it has, the one its header gives and the
+/// header's triangle count.
+fn size_why(size: u64, expected: u64, count: u64) -> String {
+    if size < expected {
+        format!(
+            "it holds {} bytes fewer than its header's {count} triangles need (cut short?)",
+            expected - size
+        )
+    } else {
+        format!(
+            "it holds {} bytes more than its header's {count} triangles need (a wrong count, or data \
+             after the triangles)",
+            size - expected
+        )
+    }
 }
 
 /// An ASCII STL: `solid NAME`, facets (`facet normal x y z`, `outer loop`, three or more `vertex x y
@@ -200,4 +258,57 @@ pub fn to_bytes(scene: &Scene) -> Vec<u8> {
     let mut out = Vec::with_capacity(84 + 50 * scene.triangles.len());
     stl_io::write_stl(&mut out, triangles).expect("writing to memory cannot fail");
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// An ASCII STL whose first line is longer than the 4 KiB the detection looks at went to stl_io's
+    /// reader, whose messages are its own ("triangle 1: expected finite f32, got NaN which is Nan"):
+    /// scx's reader reads it now, naming the line.
+    #[test]
+    fn a_long_first_line_is_read_by_scx_s_own_reader() {
+        let facet = "facet normal 0 0 0\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\n\
+                     endloop\nendfacet\n";
+        let name = "x".repeat(5000);
+        let fine = format!("solid {name}\n{facet}endsolid\n");
+        assert!(!looks_like_ascii_stl(fine.as_bytes()));
+        let scene = read_bytes("t.stl", fine.as_bytes(), Path::new("t.stl"))
+            .and_then(SceneBuilder::build)
+            .unwrap();
+        assert_eq!(scene.patch_count(), 1);
+        let nan = fine.replacen("vertex 0 0 0", "vertex nan 0 0", 1);
+        let e = read_bytes("t.stl", nan.as_bytes(), Path::new("t.stl"))
+            .unwrap_err()
+            .to_string();
+        assert_eq!(
+            e,
+            "t.stl: line 4: vertex coordinate `nan` is not a finite number"
+        );
+    }
+
+    /// Bytes read as binary STL that are not of the size its header gives are refused in scx's words
+    /// (stl_io said "failed to fill whole buffer").
+    #[test]
+    fn a_binary_stl_of_the_wrong_size_is_refused_in_words() {
+        let mut bytes = vec![0u8; 80];
+        bytes.extend(2u32.to_le_bytes());
+        bytes.extend([0u8; 50]);
+        let e = read_bytes("t.stl", &bytes, Path::new("t.stl"))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.starts_with("t.stl: a binary STL of the wrong size: its header says 2 triangles")
+                && e.contains("it holds 50 bytes fewer than its header's 2 triangles need"),
+            "{e}"
+        );
+        let e = read_bytes("t.stl", &[0u8; 20], Path::new("t.stl"))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("20 bytes, shorter than its 84-byte header"),
+            "{e}"
+        );
+    }
 }

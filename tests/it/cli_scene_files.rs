@@ -326,6 +326,58 @@ fn gltf_application_specific_attributes_are_ignored() {
     );
 }
 
+/// A change to a glTF's JSON.
+type GlbEdit = dyn Fn(&mut serde_json::Value);
+
+/// A .glb whose buffer's byteLength is less than its views need, and one with a projective node
+/// matrix, exit 2 naming the file and the buffer or node (both were read without a word); an OBJ with
+/// Latin-1 names and comments is read (it exited 2, "not a text file").
+#[test]
+fn inconsistent_gltf_is_bad_input_and_latin_1_obj_is_read() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = scene_complexity::load("@cornell").unwrap();
+    let glb = scene_complexity::gltf_bytes(&scene, true);
+    let cases: [(&str, &GlbEdit, &str); 2] = [
+        (
+            "short.glb",
+            &|d| d["buffers"][0]["byteLength"] = 12.into(),
+            "does not fit in buffer 0 of 12 bytes (its byteLength)",
+        ),
+        (
+            "projective.glb",
+            &|d| {
+                d["nodes"][0]["matrix"] =
+                    serde_json::json!([1, 0, 0, 0, 0, 1, 0, 2, 0, 0, 1, 0, 0, 0, 0, 1])
+            },
+            "its matrix is not affine (its last row is 0 2 0 1, not 0 0 0 1)",
+        ),
+    ];
+    for (name, edit, expected) in cases {
+        let path = dir.path().join(name);
+        std::fs::write(&path, edit_glb(&glb, edit)).unwrap();
+        let out = scx(&["analyze", path.to_str().unwrap(), "--lines", "1000"]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{err}");
+        assert!(
+            err.contains(&format!("{}: ", path.display())) && err.contains(expected),
+            "{err}"
+        );
+    }
+    let obj = dir.path().join("latin.obj");
+    std::fs::write(
+        &obj,
+        b"# Soci\xe9t\xe9\no caf\xe9\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 2 3\nf 1 3 4\n",
+    )
+    .unwrap();
+    let out = scx(&["analyze", obj.to_str().unwrap(), "--lines", "1000", "-q"]);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
 /// `scx export -o` writes the format its extension names (before: OBJ text whatever the extension, and
 /// an .mtl beside it): binary PLY (which reads back with the same patches and the same I_s^c bit for bit)
 /// and binary STL (84 + 50 bytes per triangle), with no .mtl; a warning says what each cannot keep. Any

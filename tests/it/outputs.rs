@@ -1020,10 +1020,10 @@ fn merge_differences_read_as_words() {
     let out = scx_in(d, &["merge", "s1.scx", "whole.scx"]);
     assert_usage(
         &out,
-        &["shard count differs (not sharded against 2 shards)"],
+        &["they differ in shard count (not sharded against 2 shards)"],
     );
     let out = scx_in(d, &["merge", "s1.scx", "enclosed.scx"]);
-    assert_usage(&out, &["enclose differs (on against off)"]);
+    assert_usage(&out, &["they differ in enclose (on against off)"]);
     assert!(!stderr(&out).contains("true"), "{}", stderr(&out));
 }
 

@@ -1186,3 +1186,217 @@ fn a_face_listing_its_corners_twice_counts_once() {
     }
     assert!(once.warnings.is_empty(), "{}", messages(&once.warnings));
 }
+
+/// A glTF of one triangle named `tri` whose positions are `positions`, edited by `edit`; its buffer in a
+/// data URI.
+fn triangle_gltf(positions: [f32; 9], edit: impl FnOnce(&mut serde_json::Value)) -> String {
+    use base64::Engine as _;
+    let buffer: Vec<u8> = positions.iter().flat_map(|x| x.to_le_bytes()).collect();
+    let uri = format!(
+        "data:application/octet-stream;base64,{}",
+        base64::engine::general_purpose::STANDARD.encode(&buffer)
+    );
+    let mut doc = serde_json::json!({
+        "asset": {"version": "2.0"},
+        "scene": 0,
+        "scenes": [{"nodes": [0]}],
+        "nodes": [{"mesh": 0}],
+        "meshes": [{"name": "tri", "primitives": [{"attributes": {"POSITION": 0}}]}],
+        "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
+                       "min": [0, 0, 0], "max": [1, 1, 1]}],
+        "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 36}],
+        "buffers": [{"byteLength": 36, "uri": uri}],
+    });
+    edit(&mut doc);
+    doc.to_string()
+}
+
+const TRIANGLE: [f32; 9] = [0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0];
+
+/// The error of loading `text` as `name` in `dir`.
+fn load_error(dir: &Path, name: &str, text: &[u8]) -> String {
+    let path = write(dir, name, text);
+    match load_with(path.to_str().unwrap(), &SceneOptions::default()) {
+        Ok(_) => panic!("{name} was read"),
+        Err(e) => format!("{e}").replace(&format!("{}/", dir.display()), ""),
+    }
+}
+
+/// A glTF vertex with one NaN coordinate shows its own values, not `(NaN, NaN, NaN)` (the node's
+/// transform spread the NaN to every coordinate), and names its vertex as glTF numbers it.
+#[test]
+fn a_gltf_vertex_with_a_nan_shows_its_own_coordinates() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut positions = TRIANGLE;
+    positions[6] = f32::NAN;
+    positions[7] = 0.5;
+    positions[8] = 1.0;
+    let e = load_error(
+        dir.path(),
+        "nan.gltf",
+        triangle_gltf(positions, |_| {}).as_bytes(),
+    );
+    assert_eq!(
+        e,
+        "nan.gltf: mesh `tri` primitive 0: triangle 0: its vertex 2 (of POSITION accessor 0) has a \
+         non-finite coordinate (NaN, 0.5, 1) (numbered from 0, as glTF numbers them)"
+    );
+}
+
+/// A glTF of points or lines only says so, naming the mesh and the mode (it said "the scene is empty:
+/// no faces"); mixed with triangles, the warning names them too.
+#[test]
+fn gltf_points_and_lines_are_named_with_their_mode() {
+    let dir = tempfile::tempdir().unwrap();
+    for (mode, name) in [(0, "POINTS"), (1, "LINES"), (3, "LINE_STRIP")] {
+        let doc = triangle_gltf(TRIANGLE, |d| {
+            d["meshes"][0]["primitives"][0]["mode"] = mode.into()
+        });
+        let e = load_error(dir.path(), "lines.gltf", doc.as_bytes());
+        assert_eq!(
+            e,
+            format!(
+                "lines.gltf: the scene has no triangles: its meshes hold only primitives of points \
+                 or lines (mesh `tri` primitive 0: mode {mode} {name}), which scx does not read: they \
+                 have no area; scx reads triangles (modes 4 TRIANGLES, 5 TRIANGLE_STRIP, 6 \
+                 TRIANGLE_FAN)"
+            )
+        );
+    }
+    let mixed = triangle_gltf(TRIANGLE, |d| {
+        let triangles = d["meshes"][0]["primitives"][0].clone();
+        let mut lines = triangles.clone();
+        lines["mode"] = 1.into();
+        d["meshes"][0]["primitives"] = serde_json::json!([triangles, lines]);
+    });
+    let path = write(dir.path(), "mixed.gltf", mixed.as_bytes());
+    let scene = load_file(&path, &SceneOptions::default());
+    assert_eq!(scene.patch_count(), 1);
+    assert!(
+        messages(&scene.warnings).ends_with(
+            "mixed.gltf: ignored 1 primitive(s) of points or lines (mesh `tri` primitive 1: mode 1 \
+             LINES): they have no area"
+        ),
+        "{}",
+        messages(&scene.warnings)
+    );
+}
+
+/// A buffer view must fit in its buffer as `byteLength` gives it, even when the data URI holds more
+/// (it was read silently); a node matrix must be affine (a projective one was applied as if it were).
+#[test]
+fn gltf_byte_lengths_and_projective_matrices_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let short = triangle_gltf(TRIANGLE, |d| d["buffers"][0]["byteLength"] = 10.into());
+    assert_eq!(
+        load_error(dir.path(), "short.gltf", short.as_bytes()),
+        "short.gltf: mesh `tri` primitive 0: its POSITION accessor 0: its buffer view 0 (bytes 0 to \
+         36) does not fit in buffer 0 of 10 bytes (its byteLength)"
+    );
+    let projective = triangle_gltf(TRIANGLE, |d| {
+        d["nodes"][0]["name"] = "camera rig".into();
+        d["nodes"][0]["matrix"] =
+            serde_json::json!([1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0.5, 0, 0, 0, 1]);
+    });
+    assert_eq!(
+        load_error(dir.path(), "projective.gltf", projective.as_bytes()),
+        "projective.gltf: node 0 (`camera rig`): its matrix is not affine (its last row is 0 0 0.5 \
+         1, not 0 0 0 1): a projective matrix cannot place a mesh"
+    );
+    // An affine matrix (a translation) places the mesh.
+    let moved = triangle_gltf(TRIANGLE, |d| {
+        d["nodes"][0]["matrix"] =
+            serde_json::json!([1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 5, 0, 0, 1]);
+    });
+    let scene = load_file(
+        &write(dir.path(), "moved.gltf", moved.as_bytes()),
+        &SceneOptions::default(),
+    );
+    assert_eq!(scene.vertices[0].x, 5.0);
+}
+
+/// A zero-area STL triangle is one zero-area face, warned about once (it was warned about twice: as a
+/// zero-area triangle and as a zero-area face); a quad keeping a triangle after dropping another still
+/// gets the triangle warning.
+#[test]
+fn a_zero_area_stl_triangle_is_warned_about_once() {
+    let dir = tempfile::tempdir().unwrap();
+    let facet = |v: [[f32; 3]; 3]| {
+        let corners: String = v
+            .iter()
+            .map(|c| format!("vertex {} {} {}\n", c[0], c[1], c[2]))
+            .collect();
+        format!("facet normal 0 0 0\nouter loop\n{corners}endloop\nendfacet\n")
+    };
+    let stl = format!(
+        "solid t\n{}{}endsolid t\n",
+        facet([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]),
+        facet([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [2.0, 0.0, 0.0]])
+    );
+    let scene = load_file(
+        &write(dir.path(), "flat.stl", stl.as_bytes()),
+        &SceneOptions::default(),
+    );
+    let codes: Vec<&str> = scene.warnings.iter().map(|w| w.kind.code()).collect();
+    assert_eq!(codes, ["zero-area-faces"]);
+    assert_eq!(
+        messages(&scene.warnings),
+        format!(
+            "{}: dropped 1 zero-area face(s), first: triangle 2",
+            dir.path().join("flat.stl").display()
+        )
+    );
+    assert_eq!(scene.warnings[0].numbers, [("faces", 1.0)]);
+}
+
+/// OBJ and MTL names and comments in Latin-1, as tools write them, are read (the file was refused
+/// whole: "not a text file (invalid UTF-8 at byte 2)"): objects keep their names (two names that differ
+/// in an accented letter stay two objects), a material named in Latin-1 in both files is found, and a
+/// library named in Latin-1 is found under its UTF-8 name. A byte that is not text in a number is still
+/// an error naming the line, and a library name still may not leave the scene's folder.
+#[test]
+fn latin_1_names_and_comments_are_read() {
+    let dir = tempfile::tempdir().unwrap();
+    write(
+        dir.path(),
+        "caf\u{e9}.mtl",
+        b"# r\xf6t\nnewmtl r\xf6t\nKd 0.8 0.1 0.1\n",
+    );
+    let obj =
+        b"# \xa9 1999 Soci\xe9t\xe9\nmtllib caf\xe9.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n\
+                o caf\xe9\nusemtl r\xf6t\nf 1 2 3\no caf\xe8\nf 1 3 4\n";
+    let scene = load_file(
+        &write(dir.path(), "latin.obj", obj),
+        &SceneOptions::default(),
+    );
+    assert_eq!(scene.objects, ["caf\u{e9}", "caf\u{e8}"]);
+    assert!(scene.warnings.is_empty(), "{}", messages(&scene.warnings));
+    let red = &scene.materials[scene.patches[0].material as usize];
+    assert_eq!(
+        (red.name.as_str(), red.reflectance_rgb),
+        ("r\u{f6}t", [0.8, 0.1, 0.1])
+    );
+
+    let e = load_error(dir.path(), "bad.obj", b"o caf\xe9\nv 0 0 0\nv 1 \xe9 0\n");
+    assert_eq!(
+        e,
+        "bad.obj:3: byte 0xE9 at column 5 is not text (UTF-8) in a `v` statement; only names (`o`, \
+         `g`, `usemtl`, `mtllib`, `maplib`, `usemap`) and comments may hold other bytes"
+    );
+    let scenes = dir.path().join("scenes");
+    std::fs::create_dir(&scenes).unwrap();
+    let outside = b"mtllib ../caf\xe9.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl r\xf6t\nf 1 2 3\n";
+    let scene = load_file(
+        &write(&scenes, "out.obj", outside),
+        &SceneOptions::default(),
+    );
+    let warning = messages(&scene.warnings);
+    assert!(
+        warning.contains("`../caf\u{e9}.mtl` climbs out with `..`, outside the scene's folder"),
+        "{warning}"
+    );
+    assert_eq!(
+        scene.materials[scene.patches[0].material as usize].name,
+        "default"
+    );
+}
