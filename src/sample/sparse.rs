@@ -468,7 +468,8 @@ fn dense_pieces(parts: &[&SparseCounts]) -> Option<Vec<(u64, u64)>> {
         .map(|p| packing.packed_of(p.entries[p.entries.len() - 1]))
         .max()?;
     let entries: u64 = parts.iter().map(|p| p.len() as u64).sum();
-    let span = hi - lo + 1;
+    // (A scene of 2^32 patches packs pairs into all 64 bits: its range's end would not be a `u64`.)
+    let span = (hi - lo).checked_add(1).filter(|_| hi < u64::MAX)?;
     if span / DENSE_SLOTS_PER_ENTRY > entries {
         return None;
     }
