@@ -11,7 +11,9 @@ use scene_complexity::report::{
 };
 use scene_complexity::VerdictRule;
 use scene_complexity::{quantity_text, Scene};
-use scene_complexity::{sphere_lines, ErrorMethod, LineBound, Sampler, Shard, StopReason, Tracing};
+use scene_complexity::{
+    sphere_lines, EntropyEstimator, ErrorMethod, LineBound, Sampler, Shard, StopReason, Tracing,
+};
 use scene_complexity::{
     Analysis, LinesAdvice, RadiosityOutcome, Reliability, SamplingReport, TargetOutcome, Verdict,
     COVERAGE_OK, COVERAGE_UNUSABLE, MIN_PAIRS,
@@ -455,10 +457,11 @@ fn reliability_summary(s: &mut String, a: &Analysis) {
     if worst.is_some_and(|v| v != Verdict::Ok) {
         let needed = corrected_needs(a);
         let why = unusable_reasons(a);
+        let jackknife = e_mse_by_jackknife(a);
         let _ = writeln!(
             s,
             "reliability: an `undersampled` reading is biased beyond its standard error, an `unusable` one \
-             cannot be trusted{why}{needed} (docs/results.md, \"Reading the reliability verdict\")."
+             cannot be trusted{why}{needed}{jackknife} (docs/results.md, \"Reading the reliability verdict\")."
         );
     }
 }
@@ -484,6 +487,28 @@ fn unusable_reasons(a: &Analysis) -> String {
         String::new()
     } else {
         format!(" ({})", reasons.join("; "))
+    }
+}
+
+/// When the corrected E(MSE) is `unusable` only for want of the jackknife's error: below a coverage of
+/// 0.5 it is still unbiased while every row holds two segments, but batch means overstate its error
+/// there, and `--errors jackknife` can make it `ok` (empty otherwise, and where the jackknife does not
+/// apply: `--enclose`, Chao-Shen, fewer than two groups).
+fn e_mse_by_jackknife(a: &Analysis) -> String {
+    let unusable = a.verdict(Measure::MsePerLineCorrected) == Some(Verdict::Unusable);
+    let thin_free = a.sampling.as_ref().is_some_and(|smp| {
+        smp.sampling.coverage < COVERAGE_UNUSABLE && smp.sampling.thin_rows == 0
+    });
+    let jackknife_applies = a.spec.errors == ErrorMethod::Groups
+        && !a.spec.enclose
+        && a.spec.estimator != EntropyEstimator::ChaoShen
+        && a.groups >= 2;
+    if unusable && thin_free && jackknife_applies {
+        "; the corrected E(MSE) is unbiased at this coverage (every row holds two segments), and \
+         `--errors jackknife` gives it the error bar that can make it ok"
+            .into()
+    } else {
+        String::new()
     }
 }
 

@@ -211,6 +211,16 @@ fn the_corrected_e_mse_of_thin_rows_is_ok_with_the_jackknife() {
     // 2000 lines leave rows of one segment, whose plug-in 1 biases the estimate.
     let (_, _, verdict, thin) = reading("2e3", 1, "jackknife");
     assert!(thin > 0 && verdict != "ok", "{thin} thin rows: {verdict}");
+    // The table says so where batch means left it unusable, and only there.
+    let advice = "`--errors jackknife` gives it the error bar that can make it ok";
+    let table = |extra: &[&str]| {
+        let mut all = vec!["analyze", "@cube:10", "--tracer", "rust"];
+        all.extend_from_slice(extra);
+        String::from_utf8_lossy(&scx(&all).stdout).into_owned()
+    };
+    assert!(table(&["--lines", "1e4"]).contains(advice));
+    assert!(!table(&["--lines", "1e4", "--errors", "jackknife"]).contains(advice));
+    assert!(!table(&["--lines", "2e3"]).contains(advice));
 }
 
 /// Every output path is checked before any line is cast: a run of 10^12 lines to a folder that does
