@@ -142,7 +142,8 @@ pub struct RunOptions {
     pub estimator: EntropyEstimator,
     /// Standard errors of the count-based measures: `groups` (batch means, conservative when rows are
     /// undersampled) or `jackknife` (delete-a-group, closer to the real scatter, ~15% slower on large
-    /// meshes). I_s^c always gets batch means.
+    /// meshes; below a row coverage of 0.5 only its error can make the corrected E(MSE) ok). I_s^c
+    /// always gets batch means.
     #[arg(long, default_value = "groups", value_parser = parse_errors)]
     pub errors: ErrorMethod,
 }
