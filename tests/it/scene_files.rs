@@ -170,14 +170,7 @@ fn boxes_obj(boxes: &[([f64; 3], [f64; 3], bool, &str)]) -> String {
             let c = |a: usize| if i >> a & 1 == 0 { lo[a] } else { hi[a] };
             s.push_str(&format!("v {} {} {}\n", c(0), c(1), c(2)));
         }
-        for q in [
-            [0, 4, 6, 2],
-            [1, 3, 7, 5],
-            [0, 1, 5, 4],
-            [2, 6, 7, 3],
-            [0, 2, 3, 1],
-            [4, 5, 7, 6],
-        ] {
+        for q in crate::support::CUBE_QUADS {
             let mut f: Vec<usize> = q.iter().map(|&k| base + k + 1).collect();
             if *inward {
                 f.reverse();
