@@ -89,7 +89,10 @@ pub struct AnalyzeArgs {
     enclose: bool,
     /// Output format: `table` (for people), `json` (one document with every field, units and verdicts),
     /// `csv` (one row per measure: scene, lines, seed, tracer, patches, escape_fraction, seconds, family,
-    /// measure, unit, value, stderr, reliability, corrected, corrected_stderr, corrected_reliability).
+    /// measure, unit, value, stderr, reliability, corrected, corrected_stderr, corrected_reliability,
+    /// then the bounds each reading breaks and the bias and lines behind an `undersampled` verdict:
+    /// flags, corrected_flags, estimated_bias, lines_needed, corrected_estimated_bias,
+    /// corrected_lines_needed).
     #[arg(long, value_enum, default_value_t = Format::Table)]
     format: Format,
     #[command(flatten)]

@@ -69,7 +69,8 @@ pub fn json(run: &RunInfo, a: &Analysis) -> String {
 }
 
 /// One CSV row per reading, with the run's scene, lines, seed and tracer, so that files combine; a
-/// reading that breaks a bound of the theory says which in its `flags` (or `corrected_flags`) cell.
+/// reading that breaks a bound of the theory says which in its `flags` (or `corrected_flags`) cell, and
+/// an `undersampled` one its estimated bias and the lines it would need, as the JSON report does.
 pub fn csv(run: &RunInfo, a: &Analysis) -> String {
     let mut w = csv::Writer::from_writer(Vec::new());
     let header = [
@@ -91,6 +92,10 @@ pub fn csv(run: &RunInfo, a: &Analysis) -> String {
         "corrected_reliability",
         "flags",
         "corrected_flags",
+        "estimated_bias",
+        "lines_needed",
+        "corrected_estimated_bias",
+        "corrected_lines_needed",
     ];
     w.write_record(header).expect("writing to memory");
     let num = |x: Option<f64>| x.map(|v| positive_zero(v).to_string()).unwrap_or_default();
@@ -98,6 +103,15 @@ pub fn csv(run: &RunInfo, a: &Analysis) -> String {
     // The bounds of the theory a reading breaks, as the table's `!` notes say them: one cell, the
     // sentences joined by "; " (the CSV writer quotes a cell that holds a comma).
     let flags = |r: Option<&Reliability>| r.map(|r| r.flags.join("; ")).unwrap_or_default();
+    // What an `undersampled` reading's verdict rests on (JSON's `estimated_bias` and `lines_needed`):
+    // empty where there is no estimate.
+    let bias =
+        |r: Option<&Reliability>| num(r.and_then(|r| r.estimated_bias).filter(|b| b.is_finite()));
+    let needed = |r: Option<&Reliability>| {
+        r.and_then(|r| r.lines_needed)
+            .map(|n| n.to_string())
+            .unwrap_or_default()
+    };
     let mut families = vec![Family::Visibility];
     if let RadiosityOutcome::Computed(_) = &a.radiosity {
         families.push(Family::Radiosity);
@@ -126,6 +140,10 @@ pub fn csv(run: &RunInfo, a: &Analysis) -> String {
             verdict(r.corrected_reliability),
             flags(r.reliability),
             flags(r.corrected_reliability),
+            bias(r.reliability),
+            needed(r.reliability),
+            bias(r.corrected_reliability),
+            needed(r.corrected_reliability),
         ])
         .expect("writing to memory");
     }

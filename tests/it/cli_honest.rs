@@ -127,8 +127,8 @@ fn impossible_readings_are_flagged_not_printed_bare() {
     assert!(text.contains("! the accuracy is outside [0, 1]"), "{text}");
 }
 
-/// The CSV report carries the same flags as the JSON document: a reading that breaks a bound of the
-/// theory is not a bare number in a spreadsheet either.
+/// The CSV report carries the same flags, estimated biases and lines needed as the JSON document: a
+/// reading that breaks a bound of the theory is not a bare number in a spreadsheet either.
 #[test]
 fn csv_rows_carry_the_flags_of_their_readings() {
     let args = ["@cube:6", "--lines", "1e4", "--seed", "3"];
@@ -142,7 +142,7 @@ fn csv_rows_carry_the_flags_of_their_readings() {
     let header = reader.headers().unwrap().clone();
     let col = |name: &str| header.iter().position(|h| h == name).unwrap();
     let (measure, plain, corrected) = (col("measure"), col("flags"), col("corrected_flags"));
-    let mut flagged = 0;
+    let (mut flagged, mut with_advice) = (0, 0);
     for row in reader.records() {
         let row = row.unwrap();
         let key = &row[measure];
@@ -162,7 +162,28 @@ fn csv_rows_carry_the_flags_of_their_readings() {
             "{key}"
         );
         flagged += usize::from(!row[plain].is_empty()) + usize::from(!row[corrected].is_empty());
+        // The estimated bias and the lines needed, the same numbers as JSON's (empty for null).
+        for (prefix, r) in [
+            ("", &v["reliability"]),
+            ("corrected_", &v["corrected"]["reliability"]),
+        ] {
+            let bias = &row[col(&format!("{prefix}estimated_bias"))];
+            match r["estimated_bias"].as_f64() {
+                Some(b) => assert_eq!(bias.parse::<f64>().unwrap(), b, "{key}"),
+                None => assert!(bias.is_empty(), "{key}: {bias}"),
+            }
+            let needed = &row[col(&format!("{prefix}lines_needed"))];
+            match r["lines_needed"].as_u64() {
+                Some(n) => {
+                    assert_eq!(needed.parse::<u64>().unwrap(), n, "{key}");
+                    with_advice += 1;
+                }
+                None => assert!(needed.is_empty(), "{key}: {needed}"),
+            }
+        }
     }
+    // Undersampled readings at 1e4 lines on 216 patches: the advice is there.
+    assert!(with_advice >= 4, "{with_advice} cells of lines needed");
     // The plug-in I_s above I_s^c (Proposition 2) and the accuracy above 1, at least.
     assert!(flagged >= 2, "{flagged} flagged cells");
     assert!(String::from_utf8_lossy(&out.stdout).contains("outside [0, 1]"));
