@@ -32,9 +32,9 @@ use crate::geom::uniform01;
 use crate::scene::Scene;
 use crate::trace::Line;
 
-/// How far the box reaches beyond the scene on every side, in bounding radii: lines start this far
-/// from any surface (so f32 rounding never puts an origin on a triangle), and a flat scene still gets
-/// a box with six faces of positive area.
+/// How far the box reaches beyond the scene on every side, in bounding radii ([`CONTAINER_MARGIN`]): a
+/// flat scene still gets a box with six faces of positive area. The traced segments start further
+/// out (a box's lead), so that f32 rounding never puts an origin on a triangle.
 const BOX_MARGIN: f64 = CONTAINER_MARGIN;
 
 /// Where the lines of a run are drawn.
@@ -87,6 +87,8 @@ pub struct BoundingBox {
     cumulative: [f64; 6],
     /// The faces, in the same order.
     faces: [Face; 6],
+    /// How far before its face a line's traced segment starts (a thousandth of the box's diagonal).
+    lead: f64,
 }
 
 /// One face of a [`BoundingBox`], as whole vectors, so that a line is made without indexing by axis.
@@ -144,11 +146,13 @@ impl BoundingBox {
             sum += side((axis + 1) % 3) * side((axis + 2) % 3);
             *c = sum;
         }
+        let lead = 1e-3 * (0..3).map(|k| side(k) * side(k)).sum::<f64>().sqrt();
         BoundingBox {
             lo,
             hi,
             cumulative,
             faces,
+            lead,
         }
     }
 
@@ -188,8 +192,8 @@ impl BoundingBox {
     /// rescaled within the face's share, the first coordinate on it, `u[1]` the second; `(u[2], u[3])`
     /// is mapped onto the unit disc (the concentric map, its sine and cosine the polynomials of
     /// the sphere's Sobol' lines) and lifted to the hemisphere about the face's inward normal, which
-    /// makes the direction cosine-distributed. The line starts on the face and ends where it leaves
-    /// the box.
+    /// makes the direction cosine-distributed. The traced segment runs from a little before the face
+    /// (the box's lead) to as far beyond where the line leaves the box.
     pub fn line(&self, u: [f64; 4]) -> Line {
         let (dx, dy) = concentric_discs(&[2.0 * u[2] - 1.0], &[2.0 * u[3] - 1.0]);
         self.line_with_disc(u[0], u[1], (dx[0], dy[0]))
@@ -213,10 +217,15 @@ impl BoundingBox {
         let dir: [f64; 3] = std::array::from_fn(|k| {
             dz * face.inward[k] + dx * face.unit_b[k] + dy * face.unit_c[k]
         });
+        // The traced segment starts a little before the face and ends a little beyond the exit: the box
+        // lies a millionth of the radius off the walls, within a few f32 steps, and an f32 origin or
+        // end on the face could round onto or past the wall the line enters or leaves by.
+        let back = self.lead;
+        let start: [f64; 3] = std::array::from_fn(|k| origin[k] - back * dir[k]);
         Line {
-            origin: origin.map(|x| x as f32),
+            origin: start.map(|x| x as f32),
             dir: dir.map(|x| x as f32),
-            t_max: self.exit(origin, dir) as f32,
+            t_max: (self.exit(origin, dir) + 2.0 * back) as f32,
         }
     }
 
@@ -395,6 +404,17 @@ mod tests {
         [("independent", independent), ("sobol", sobol)]
     }
 
+    /// Where a line through the box `LO..HI` enters it, and its chord of the box: the traced segment
+    /// reaches the box's lead beyond the chord at both ends.
+    fn entry_and_chord(l: &Line) -> ([f64; 3], f64) {
+        let lead = BoundingBox::new(LO, HI).lead;
+        let (o, d) = (l.origin.map(f64::from), l.dir.map(f64::from));
+        (
+            [0, 1, 2].map(|k| o[k] + lead * d[k]),
+            f64::from(l.t_max) - 2.0 * lead,
+        )
+    }
+
     fn on_the_surface(p: [f64; 3]) -> bool {
         let inside = (0..3).all(|k| p[k] >= LO[k] - 1e-6 && p[k] <= HI[k] + 1e-6);
         let on_a_face = (0..3).any(|k| (p[k] - LO[k]).abs() < 1e-6 || (p[k] - HI[k]).abs() < 1e-6);
@@ -409,8 +429,8 @@ mod tests {
         (mean, (var / n).sqrt())
     }
 
-    /// Every line starts on the box's surface, has a unit direction into the box, and ends on the
-    /// surface again; the chords' mean is Cauchy's 4 V / S for uniformly distributed lines meeting a
+    /// Every line enters the box's surface (its traced segment starts the box's lead before it), has
+    /// a unit direction into the box, and leaves by the surface again; the chords' mean is Cauchy's 4 V / S for uniformly distributed lines meeting a
     /// convex body (to 4 standard errors for independent lines; Sobol' lines, whose spread is not that
     /// of independent draws, to 1%).
     #[test]
@@ -423,12 +443,11 @@ mod tests {
         for (name, lines) in both_samplers() {
             let mut chords = Vec::with_capacity(lines.len());
             for l in &lines {
-                let o = l.origin.map(f64::from);
+                let (o, t) = entry_and_chord(l);
                 let d = l.dir.map(f64::from);
                 let norm = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
                 assert!((norm - 1.0).abs() < 1e-6, "{name}: {l:?}");
-                assert!(on_the_surface(o), "{name}: origin {l:?}");
-                let t = f64::from(l.t_max);
+                assert!(on_the_surface(o), "{name}: entry {o:?} of {l:?}");
                 let end = [0, 1, 2].map(|k| o[k] + t * d[k]);
                 assert!(on_the_surface(end), "{name}: end {end:?} of {l:?}");
                 let step = [0, 1, 2].map(|k| o[k] + 1e-3 * t * d[k]);
@@ -462,7 +481,7 @@ mod tests {
             let mut per_axis = [0.0; 3];
             let (mut cosines, mut squares) = (Vec::new(), Vec::new());
             for l in &lines {
-                let o = l.origin.map(f64::from);
+                let (o, _) = entry_and_chord(l);
                 let axis = (0..3)
                     .find(|&k| (o[k] - LO[k]).abs() < 1e-6 || (o[k] - HI[k]).abs() < 1e-6)
                     .unwrap();
@@ -534,7 +553,8 @@ mod tests {
     }
 
     /// The straightforward construction, coordinate by coordinate: the face by the running areas, the
-    /// origin and direction by axis index, the exit by the faces the line heads towards.
+    /// entry and direction by axis index, the exit by the faces the line heads towards, and the traced
+    /// segment reaching the lead beyond both.
     fn reference_line(b: &BoundingBox, u: [f64; 4]) -> ([f64; 3], [f64; 3], f64) {
         let at = u[0] * b.surface_area();
         let face = (0..5).filter(|&f| b.cumulative[f] <= at).count();
@@ -562,7 +582,9 @@ mod tests {
             .map(|a| ((if dir[a] > 0.0 { b.hi[a] } else { b.lo[a] }) - origin[a]) / dir[a])
             .filter(|t| *t >= 0.0)
             .fold(f64::INFINITY, f64::min);
-        (origin, dir, t)
+        // The traced segment: from the lead before the face to the lead beyond the exit.
+        let start = [0, 1, 2].map(|k| origin[k] - b.lead * dir[k]);
+        (start, dir, t + 2.0 * b.lead)
     }
 
     /// [`BoundingBox::line`] (whole face vectors, exits by selects) is the reference construction:

@@ -24,8 +24,13 @@ use crate::scene::Scene;
 use crate::trace::Line;
 
 /// How far the box and the polytope reach beyond the scene, in bounding radii: a flat scene still
-/// gets a container of positive volume, and the box's lines start off every surface.
-pub(super) const CONTAINER_MARGIN: f64 = 1e-3;
+/// gets a container of positive volume, and the scene stays inside it whatever the rounding of its
+/// planes. No more: where a scene's faces lie in the container's, the lines through the scene's edges
+/// (eq. 27's logarithmic singularity) enter the container along its own edges, which the Sobol'
+/// points stratify; a wider margin moves them into the container's faces at angles to the sequence's
+/// axes and into slivers of the polytope along the edges (a margin of 1e-3 left I_s^c's spread 1.5x
+/// wider on the octahedron, 1.3x on `@cube:30`, docs/sampling.md).
+pub(super) const CONTAINER_MARGIN: f64 = 1e-6;
 
 /// The traced chord reaches this factor beyond the bounding sphere (as the sphere's own lines do),
 /// so that f32 rounding never clips a vertex lying on the sphere.

@@ -25,7 +25,7 @@ fn through_the_box(lines: u64, seed: u64, sampler: Sampler) -> RunSpec {
 
 const SAMPLERS: [Sampler; 2] = [Sampler::Independent, Sampler::Sobol];
 
-/// The surface of `scene`'s bounding box as the run grows it (a thousandth of the bounding radius, 1 in
+/// The surface of `scene`'s bounding box as the run grows it (a millionth of the bounding radius, 1 in
 /// tracing space, on every side), from the vertices' extent.
 fn grown_box_surface(scene: &Scene) -> f64 {
     let side = |k: usize| {
@@ -35,7 +35,7 @@ fn grown_box_surface(scene: &Scene) -> f64 {
             .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| {
                 (lo.min(f64::from(p[k])), hi.max(f64::from(p[k])))
             });
-        hi - lo + 2e-3
+        hi - lo + 2e-6
     };
     let (x, y, z) = (side(0), side(1), side(2));
     2.0 * (x * y + y * z + z * x)
@@ -236,7 +236,7 @@ fn box_runs_split_resumed_and_merged_are_the_single_run() {
     let single = run(&["--lines", "7e5"]);
     assert_eq!(single["lines_through"], "box");
     // --lines counts lines through the sphere: the fewest through the box worth as many are drawn.
-    let h = 1.0 / 3f64.sqrt() + 1e-3;
+    let h = 1.0 / 3f64.sqrt() + 1e-6;
     let share = 6.0 * h * h / std::f64::consts::PI;
     let drawn = single["lines"].as_f64().unwrap();
     assert!(
@@ -370,7 +370,7 @@ fn the_lines_advice_of_a_box_run_counts_the_spheres_lines() {
 
 /// Lines through the bounding polytope: the octahedron's is itself grown by the margin (its surface
 /// between the octahedron's, 8 equilateral triangles of side sqrt 2, and that of the octahedron whose
-/// face planes are moved out by 1e-3, 4 sqrt 3 (1 + sqrt 3 10^-3)^2, which the planes of the axes and
+/// face planes are moved out by 1e-6, 4 sqrt 3 (1 + sqrt 3 10^-6)^2, which the planes of the axes and
 /// the diagonals trim at its corners and edges), each of its faces is met by a share 2 A / S of the
 /// lines (Crofton) through every tracer with both samplers, and its exact I_s^c (the calibration's) is
 /// met within 4.5 standard errors; on 1 and 2 threads the same.
@@ -383,7 +383,7 @@ fn polytope_lines_meet_crofton_and_the_octahedrons_exact_measure() {
     let surface = share * 4.0 * std::f64::consts::PI;
     let octahedron = 4.0 * 3f64.sqrt();
     assert!(
-        surface > octahedron && surface < octahedron * (1.0 + 3f64.sqrt() * 1e-3).powi(2),
+        surface > octahedron && surface < octahedron * (1.0 + 3f64.sqrt() * 1e-6).powi(2),
         "{surface}"
     );
     let exact = truth::truth(&CalibrationScene::parse("@octahedron").unwrap())
