@@ -9,6 +9,7 @@ use rayon::prelude::*;
 use super::plan::BatchPlan;
 use crate::sample::bounds::{batch_lines_through, sobol_lines_through, LineBound, LineRegion};
 use crate::sample::lines::{sobol_lines, LineSource, Sampler};
+use crate::sample::tally::LastCosine;
 use crate::scene::Scene;
 use crate::trace::{Line, LineHits, RawHit, TraceError, Tracer};
 
@@ -43,6 +44,17 @@ impl LineStream {
             bound: LineBound::Sphere,
             groups: crate::run::DEFAULT_GROUPS as u64,
             seed,
+        }
+    }
+
+    /// How eq. (27)'s sum takes the far cosine of each line's last pair for these lines: the first
+    /// pair's near cosine for Sobol' lines drawn from a container's faces (the box's or the
+    /// polytope's), whose entry the sequence's coordinates give; each pair's own otherwise
+    /// ([`LastCosine`], docs/sampling.md).
+    pub fn last_cosine(&self) -> LastCosine {
+        match (self.sampler, self.bound) {
+            (Sampler::Sobol, LineBound::Box | LineBound::Polytope) => LastCosine::FirstEntry,
+            _ => LastCosine::Own,
         }
     }
 

@@ -36,7 +36,7 @@ impl TracedBatches {
         wanted: Wanted,
         stop: &(dyn Fn(u64) -> bool + Sync),
     ) -> Result<(TracedBatches, bool), TraceError> {
-        let tally = LineTally::new(scene, wanted);
+        let tally = LineTally::new(scene, wanted).with_last_cosine(stream.last_cosine());
         let (batches, complete) = map_traced_batches(
             stream,
             tracer,
