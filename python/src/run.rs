@@ -13,6 +13,7 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
+use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyTuple;
 
@@ -513,6 +514,9 @@ pub fn resume(
         .allow_threads(|| scene_complexity::read_state(&file))
         .map_err(persist_error)?;
     let mut identity = stored.identity().clone();
+    identity
+        .continuable_here()
+        .map_err(|problem| PyValueError::new_err(format!("{shown}: {problem}")))?;
     let scene = scene_of_state(py, scene, &identity, &policy)?;
     identity.tracing = TRACING;
     let lib_scene = Arc::clone(&scene.get().inner);

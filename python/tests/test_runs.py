@@ -37,6 +37,27 @@ def test_save_then_resume_to_more_lines_is_the_longer_run(cube4, full, tmp_path)
     assert numbers(again) == numbers(full)
 
 
+def test_a_state_of_another_scx_version_is_merged_but_not_resumed(cube4, full, tmp_path):
+    import struct
+    import zlib
+
+    state = tmp_path / "run.scx"
+    scx.analyze(cube4, lines=SHORT, seed=11).save(state)
+    data = state.read_bytes()
+    payload = data[24:]
+    here = scx.__version__.encode()
+    # The version is a CBOR text string in the identity; stamp it as another of the same length.
+    tag = bytes([0x60 + len(here)])
+    stamped = payload.replace(tag + here, tag + b"0" * len(here), 1)
+    assert stamped != payload
+    other = tmp_path / "other.scx"
+    other.write_bytes(data[:12] + struct.pack("<QI", len(stamped), zlib.crc32(stamped)) + stamped)
+    with pytest.raises(ValueError, match="started by scx 0+, and this is scx"):
+        scx.resume(other, lines=LONG)
+    assert other.read_bytes()[24:] == stamped
+    assert scx.merge([other]).lines == scx.merge([state]).lines
+
+
 def test_shards_merged_are_the_whole_run(cube4, full, tmp_path):
     parts = [tmp_path / f"shard{k}.scx" for k in (1, 2, 3)]
     for k, path in enumerate(parts, start=1):

@@ -297,6 +297,9 @@ fn new_run(args: &AnalyzeArgs, name: &str) -> Result<Prepared, Failure> {
 fn resumed_run(args: &AnalyzeArgs, file: &Path) -> Result<Prepared, Failure> {
     let stored = scene_complexity::read_state(file).map_err(persist_failure)?;
     let mut identity = stored.identity().clone();
+    identity
+        .continuable_here()
+        .map_err(|problem| Failure::bad_input(format!("{}: {problem}", file.display())))?;
     let name = args
         .scene
         .clone()

@@ -110,6 +110,28 @@ impl RunIdentity {
         }
     }
 
+    /// Whether this scx may continue the run: only the version that started it may, since another
+    /// version's lines or estimates may differ, and a run continued by it would mix the two without a
+    /// word (its results then those of neither). The problem in words otherwise.
+    pub fn continuable_here(&self) -> Result<(), String> {
+        let here = env!("CARGO_PKG_VERSION");
+        if self.scx_version == here {
+            return Ok(());
+        }
+        // A forged state's version may be any text: a bounded, printable excerpt.
+        let theirs: String = self
+            .scx_version
+            .chars()
+            .take(40)
+            .map(|c| if c.is_control() { '?' } else { c })
+            .collect();
+        Err(format!(
+            "the run was started by scx {theirs}, and this is scx {here}, whose lines or estimates \
+             may differ: continue it with scx {theirs}, or start it again (`scx merge` still reports \
+             it)"
+        ))
+    }
+
     /// The first setting in which two runs differ that must agree for them to be parts of one run:
     /// the scx version, the scene, the spec ([`RunSpec::difference`]; the line counts only unless
     /// `lines_may_differ`) and the shard count.

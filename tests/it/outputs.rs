@@ -659,6 +659,66 @@ fn forged_states_are_refused() {
     }
 }
 
+/// A run is continued only by the scx version that started it: another version's lines or estimates may
+/// differ, and `--resume` would mix them without a word. A state stamped with another version is refused
+/// by `--resume` (exit 2, both versions named, the state file unchanged) and still reported by `merge`;
+/// a forged version's control characters are not printed.
+#[test]
+fn another_versions_state_is_reported_but_not_continued() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let out = scx_in(
+        d,
+        &["analyze", "@cube:2", "--lines", "3e5", "--save", "s.scx"],
+    );
+    assert_eq!(code(&out), Some(0), "{}", stderr(&out));
+    let bytes = read(&d.join("s.scx"));
+    let (header, payload) = bytes.split_at(24);
+    let doc: ciborium::Value = ciborium::from_reader(payload).unwrap();
+    let stamp = |name: &str, version: &str| {
+        let mut doc = doc.clone();
+        *field(field(&mut doc, "identity"), "scx_version") = ciborium::Value::Text(version.into());
+        let mut payload = Vec::new();
+        ciborium::into_writer(&doc, &mut payload).unwrap();
+        let mut out = header[..12].to_vec();
+        out.extend_from_slice(&(payload.len() as u64).to_le_bytes());
+        out.extend_from_slice(&crc32fast::hash(&payload).to_le_bytes());
+        out.extend_from_slice(&payload);
+        std::fs::write(d.join(name), &out).unwrap();
+        out
+    };
+    let old = stamp("old.scx", "0.0.9");
+    let out = scx_in(d, &["analyze", "--resume", "old.scx", "--lines", "6e5"]);
+    let err = stderr(&out);
+    assert_eq!(code(&out), Some(2), "{err}");
+    let here = env!("CARGO_PKG_VERSION");
+    assert!(
+        err.contains("old.scx")
+            && err.contains("started by scx 0.0.9")
+            && err.contains(&format!("this is scx {here}")),
+        "{err}"
+    );
+    assert_eq!(
+        read(&d.join("old.scx")),
+        old,
+        "the refused state was rewritten"
+    );
+    let out = scx_in(d, &["merge", "old.scx"]);
+    assert_eq!(code(&out), Some(0), "{}", stderr(&out));
+    assert!(String::from_utf8_lossy(&out.stdout).contains("@cube:2"));
+    // This version's own state goes on.
+    let out = scx_in(d, &["analyze", "--resume", "s.scx", "--lines", "6e5"]);
+    assert_eq!(code(&out), Some(0), "{}", stderr(&out));
+    stamp("odd.scx", "9\u{1b}[31m\nred");
+    let out = scx_in(d, &["analyze", "--resume", "odd.scx"]);
+    let err = stderr(&out);
+    assert_eq!(code(&out), Some(2), "{err}");
+    assert!(
+        !err.contains('\u{1b}') && err.contains("scx 9?[31m?red"),
+        "{err}"
+    );
+}
+
 /// A FIFO or a directory named as a state to resume or merge is refused, not read without end.
 #[test]
 fn states_are_read_from_regular_files_only() {
