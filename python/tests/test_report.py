@@ -167,8 +167,8 @@ def test_to_dict_of_a_run_through_the_box_is_the_json_of_scx_analyze():
     d = a.to_dict()
     assert d["lines_through"] == "box"
     # lines counts lines through the sphere; a cube's box (half side 1/sqrt(3) in tracing space, grown
-    # by 1e-3) meets a share 6 h^2 / pi of them, and the fewest worth 2e5 are drawn.
-    h = 1 / np.sqrt(3) + 1e-3
+    # by 1e-6) meets a share 6 h^2 / pi of them, and the fewest worth 2e5 are drawn.
+    h = 1 / np.sqrt(3) + 1e-6
     assert abs(d["lines"] - 2e5 * 6 * h * h / np.pi) < 1.001
     assert 2e5 <= d["sphere_lines"] <= 2e5 + 2
     cli = run_cli(
