@@ -577,13 +577,7 @@ fn forged_states_are_refused() {
     let forge = |name: &str, change: &dyn Fn(&mut ciborium::Value)| {
         let mut doc = doc.clone();
         change(&mut doc);
-        let mut payload = Vec::new();
-        ciborium::into_writer(&doc, &mut payload).unwrap();
-        let mut out = header[..12].to_vec();
-        out.extend_from_slice(&(payload.len() as u64).to_le_bytes());
-        out.extend_from_slice(&crc32fast::hash(&payload).to_le_bytes());
-        out.extend_from_slice(&payload);
-        std::fs::write(d.join(name), out).unwrap();
+        write_state(&d.join(name), header, &doc);
     };
     let int = |n: u64| ciborium::Value::Integer(n.into());
     let counter = |doc: &mut ciborium::Value, name: &str, n: u64| {
@@ -678,14 +672,7 @@ fn another_versions_state_is_reported_but_not_continued() {
     let stamp = |name: &str, version: &str| {
         let mut doc = doc.clone();
         *field(field(&mut doc, "identity"), "scx_version") = ciborium::Value::Text(version.into());
-        let mut payload = Vec::new();
-        ciborium::into_writer(&doc, &mut payload).unwrap();
-        let mut out = header[..12].to_vec();
-        out.extend_from_slice(&(payload.len() as u64).to_le_bytes());
-        out.extend_from_slice(&crc32fast::hash(&payload).to_le_bytes());
-        out.extend_from_slice(&payload);
-        std::fs::write(d.join(name), &out).unwrap();
-        out
+        write_state(&d.join(name), header, &doc)
     };
     let old = stamp("old.scx", "0.0.9");
     let out = scx_in(d, &["analyze", "--resume", "old.scx", "--lines", "6e5"]);
@@ -743,6 +730,19 @@ fn states_are_read_from_regular_files_only() {
             assert!(err.contains(words), "{args:?}: {err}");
         }
     }
+}
+
+/// Writes a state of the CBOR document `doc` to `path` behind the magic and format version of `header`
+/// (a state's first 24 bytes), with its length and checksum recomputed; returns the bytes written.
+fn write_state(path: &std::path::Path, header: &[u8], doc: &ciborium::Value) -> Vec<u8> {
+    let mut payload = Vec::new();
+    ciborium::into_writer(doc, &mut payload).unwrap();
+    let mut out = header[..12].to_vec();
+    out.extend_from_slice(&(payload.len() as u64).to_le_bytes());
+    out.extend_from_slice(&crc32fast::hash(&payload).to_le_bytes());
+    out.extend_from_slice(&payload);
+    std::fs::write(path, &out).unwrap();
+    out
 }
 
 /// An edit of a state's CBOR document.
