@@ -566,14 +566,8 @@ fn outputs_are_renamed_into_place() {
 fn forged_states_are_refused() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    let out = scx_in(
-        d,
-        &["analyze", "@cube:2", "--lines", "1e4", "--save", "s.scx"],
-    );
-    assert_eq!(code(&out), Some(0), "{}", stderr(&out));
-    let bytes = read(&d.join("s.scx"));
-    let (header, payload) = bytes.split_at(24);
-    let doc: ciborium::Value = ciborium::from_reader(payload).unwrap();
+    let (header, doc) = saved_state(d, "1e4");
+    let header = header.as_slice();
     let forge = |name: &str, change: &dyn Fn(&mut ciborium::Value)| {
         let mut doc = doc.clone();
         change(&mut doc);
@@ -661,14 +655,8 @@ fn forged_states_are_refused() {
 fn another_versions_state_is_reported_but_not_continued() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    let out = scx_in(
-        d,
-        &["analyze", "@cube:2", "--lines", "3e5", "--save", "s.scx"],
-    );
-    assert_eq!(code(&out), Some(0), "{}", stderr(&out));
-    let bytes = read(&d.join("s.scx"));
-    let (header, payload) = bytes.split_at(24);
-    let doc: ciborium::Value = ciborium::from_reader(payload).unwrap();
+    let (header, doc) = saved_state(d, "3e5");
+    let header = header.as_slice();
     let stamp = |name: &str, version: &str| {
         let mut doc = doc.clone();
         *field(field(&mut doc, "identity"), "scx_version") = ciborium::Value::Text(version.into());
@@ -730,6 +718,19 @@ fn states_are_read_from_regular_files_only() {
             assert!(err.contains(words), "{args:?}: {err}");
         }
     }
+}
+
+/// Runs `@cube:2` for `lines` lines in `d`, saved to `s.scx`: its state's first 24 bytes (magic, format
+/// version, length, checksum) and its CBOR document.
+fn saved_state(d: &std::path::Path, lines: &str) -> (Vec<u8>, ciborium::Value) {
+    let out = scx_in(
+        d,
+        &["analyze", "@cube:2", "--lines", lines, "--save", "s.scx"],
+    );
+    assert_eq!(code(&out), Some(0), "{}", stderr(&out));
+    let bytes = read(&d.join("s.scx"));
+    let (header, payload) = bytes.split_at(24);
+    (header.to_vec(), ciborium::from_reader(payload).unwrap())
 }
 
 /// Writes a state of the CBOR document `doc` to `path` behind the magic and format version of `header`
