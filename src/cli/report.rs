@@ -478,7 +478,7 @@ fn reliability_summary(s: &mut String, a: &Analysis) {
         let jackknife = e_mse_by_jackknife(a);
         let _ = writeln!(
             s,
-            "reliability: an `undersampled` reading is biased beyond its standard error, an `unusable` one \
+            "reliability: an `undersampled` reading is biased beyond what its interval allows, an `unusable` one \
              cannot be trusted{why}{needed}{jackknife} (docs/results.md, \"Reading the reliability verdict\")."
         );
     }

@@ -106,7 +106,8 @@ pub enum VerdictRule {
     Mean,
     /// A plug-in reading: the rows' coverage, and its estimated bias, `sign` times the distance from the
     /// plug-in to the corrected entropy of its family ([`Family::entropies`]: the plug-in H_s reads low
-    /// by about its correction, so I_s = H_p - H_s reads high by as much), within its standard error.
+    /// by about its correction, so I_s = H_p - H_s reads high by as much), within half its standard
+    /// error (`reliability::PLUG_IN_BIAS_SHARE`).
     PlugIn {
         /// +1 when the reading moves with the entropy, -1 when against it.
         sign: f64,
@@ -114,8 +115,8 @@ pub enum VerdictRule {
     /// A bias-corrected reading: the rows' coverage.
     Corrected,
     /// A ratio to I_s^c of the reading `of`: that reading's verdict (not its flags) or I_s^c's, whichever
-    /// is worse, its bias divided by I_s^c times `sign`, and `unusable` when I_s^c is not
-    /// distinguishable from 0.
+    /// is worse, its bias divided by I_s^c times `sign` judged against the ratio's own standard error as
+    /// `of`'s is against its own, and `unusable` when I_s^c is not distinguishable from 0.
     RatioOf {
         /// The reading in the numerator.
         of: Measure,
@@ -123,7 +124,8 @@ pub enum VerdictRule {
         sign: f64,
     },
     /// A plug-in reading with an unbiased estimate whatever the coverage (eq. 22's); `ok` when its
-    /// estimated bias (from the rows' sampling) is within its standard error.
+    /// estimated bias (from the rows' sampling) is within half its standard error, as a plug-in
+    /// entropy's.
     Unbiased,
     /// That unbiased estimate (each row's `sum_j x_j (x_j - 1) / (N_i (N_i - 1))` for `sum_j F_ij^2`):
     /// it needs no coverage of the rows, only rows of at least two segments, which any coverage above
