@@ -73,11 +73,30 @@ pub enum StartError {
 /// materials when radiosity is asked for).
 pub fn start(scene: &Scene, cfg: &RunSpec) -> Result<RunState, StartError> {
     cfg.check()?;
-    Ok(RunState::new(
-        cfg.plan(),
-        cfg.group_count(),
-        gathered(scene, cfg)?,
-    ))
+    let wanted = gathered(scene, cfg)?;
+    check_target_is_gathered(cfg, wanted)?;
+    Ok(RunState::new(cfg.plan(), cfg.group_count(), wanted))
+}
+
+/// A precision target on a measure the run does not gather is refused: its reading never comes, so the
+/// run would go on to its line cap (or, without one, forever) and end with the target not met.
+fn check_target_is_gathered(cfg: &RunSpec, wanted: Wanted) -> Result<(), SpecError> {
+    let Some(target) = cfg.budget.target else {
+        return Ok(());
+    };
+    let info = target.measure.info();
+    if info.needs.met_by(wanted.discrete, wanted.continuous) {
+        return Ok(());
+    }
+    let gathered = match (wanted.discrete, wanted.continuous) {
+        (true, false) => "the pair counts alone",
+        (false, true) => "eq. (27)'s sums alone",
+        _ => "neither the pair counts nor eq. (27)'s sums",
+    };
+    Err(SpecError::TargetNotGathered {
+        measure: info.key,
+        gathered,
+    })
 }
 
 /// Shard `index` (from 1) of `count`: a contiguous block of about 1/count of a run's batches.

@@ -316,6 +316,7 @@ impl RunSpec {
         if new.batch_size != old.batch_size || longer.group_count() != self.group_count() {
             return Err(ExtendError::CutDifferently {
                 lines: self.lines,
+                most: BatchPlan::most_lines_with_batch(old.batch_size).max(self.lines),
                 batch_size: old.batch_size,
                 asked: lines,
                 asked_batch_size: new.batch_size,
@@ -443,6 +444,18 @@ pub enum SpecError {
         /// Where the lines were to be drawn.
         bound: LineBound,
     },
+    /// A precision target on a measure the run's measures do not include.
+    #[error(
+        "the precision target watches {measure}, which this run does not compute: its measures gather \
+         {gathered} (--measures); watch a measure the run computes (--target-measure), or add the \
+         measures it needs"
+    )]
+    TargetNotGathered {
+        /// The watched measure's key.
+        measure: &'static str,
+        /// What the run gathers, in words.
+        gathered: &'static str,
+    },
 }
 
 /// Why a run cannot be continued to more lines.
@@ -459,15 +472,17 @@ pub enum ExtendError {
     /// The longer run would have other batches or groups.
     #[error(
         "a run of {lines} lines is cut into batches of {batch_size}, and a run can be continued only to \
-         line counts cut the same way: {asked} lines would be batches of {asked_batch_size} in \
-         {asked_groups} groups. Runs of {} lines or more all have batches of {} and can be continued to \
-         any count: start a run with at least that many lines to continue it freely",
+         line counts cut the same way, here at most {most}: {asked} lines would be batches of \
+         {asked_batch_size} in {asked_groups} groups. Runs of {} lines or more all have batches of {} and \
+         can be continued to any count: start a run with at least that many lines to continue it freely",
         BatchPlan::FULL_FROM,
         BatchPlan::MAX_BATCH
     )]
     CutDifferently {
         /// The run's lines.
         lines: u64,
+        /// The most lines it can be continued to.
+        most: u64,
         /// Its batch size.
         batch_size: u64,
         /// The lines asked for.
@@ -533,5 +548,9 @@ mod tests {
         let short = RunSpec::new(200_000, 1);
         let e = short.extended_to(300_000).unwrap_err().to_string();
         assert!(e.contains("batches of 3125") && e.contains("262144"), "{e}");
+        // 200,000 / 64 = 3125 lines a batch, as long as lines / 64 rounds down to 3125: up to 200,063.
+        assert!(e.contains("at most 200063"), "{e}");
+        assert_eq!(short.extended_to(200_063).unwrap().lines, 200_063);
+        assert!(short.extended_to(200_064).is_err());
     }
 }

@@ -94,6 +94,58 @@ fn a_precision_target_needs_a_reliable_reading() {
     assert!((mi["value"].as_f64().unwrap() - 1.12257).abs() < 4.0 * 0.005);
 }
 
+/// A precision target on a measure the run does not compute is refused before any line is cast (exit
+/// 2, naming the measure): its reading never comes, and the run went on to its cap, or without one for
+/// ever. A target on a measure the run does compute still runs.
+#[test]
+fn a_precision_target_on_a_measure_not_computed_is_refused() {
+    let refused = |args: &[&str], measure: &str| {
+        let mut all = vec![
+            "analyze",
+            "@cube:4",
+            "--target-stderr",
+            "0.01",
+            "--tracer",
+            "rust",
+        ];
+        all.extend_from_slice(args);
+        let out = scx(&all);
+        assert_eq!(out.status.code(), Some(2), "{all:?}: {}", stderr_of(&out));
+        let err = stderr_of(&out);
+        assert!(
+            err.contains(measure) && err.contains("does not compute"),
+            "{err}"
+        );
+        assert!(
+            out.stdout.is_empty(),
+            "no report: {}",
+            String::from_utf8_lossy(&out.stdout)
+        );
+    };
+    // Without a cap: the run used to go on until interrupted.
+    refused(
+        &["--measures", "continuous"],
+        "mutual_information_corrected",
+    );
+    refused(
+        &["--measures", "discrete", "--target-measure", "accuracy"],
+        "accuracy",
+    );
+    let doc = json_run(&[
+        "@cube:4",
+        "--measures",
+        "continuous",
+        "--target-stderr",
+        "0.01",
+        "--target-measure",
+        "continuous_mutual_information",
+        "--lines",
+        "1e7",
+    ]);
+    assert_eq!(doc["target"]["met"], true);
+    assert_eq!(doc["stop_reason"], "target_stderr");
+}
+
 /// Readings that break a bound of the theory are flagged, in JSON and in the table.
 #[test]
 fn impossible_readings_are_flagged_not_printed_bare() {
