@@ -116,7 +116,9 @@ pub struct AnalyzeArgs {
           allow_negative_numbers = true)]
     checkpoint_every: f64,
     /// Continue the run saved in FILE (by --save or --checkpoint) with its own settings, up to --lines
-    /// (more lines than first asked are fine), and save it back to FILE as it goes. --tracer, --query
+    /// (more lines than first asked are fine for a run of 262144 lines or more; a shorter one is cut
+    /// into smaller batches and continues only to a few lines more, as the message says), and save it
+    /// back to FILE as it goes. --tracer, --query
     /// and --threads may differ from the first run's: they change no number.
     #[arg(long, value_name = "FILE", conflicts_with_all = [
         "seed", "groups", "estimator", "errors", "measures", "seconds", "target_stderr",

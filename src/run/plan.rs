@@ -84,6 +84,16 @@ impl BatchPlan {
         }
     }
 
+    /// The most lines whose plan ([`BatchPlan::new`]) still has batches of `batch_size`: a run of that
+    /// batch size continues to at most this many ([`u64::MAX`] for full batches).
+    pub fn most_lines_with_batch(batch_size: u64) -> u64 {
+        if batch_size >= Self::MAX_BATCH {
+            u64::MAX
+        } else {
+            Self::MIN_BATCHES * (batch_size + 1) - 1
+        }
+    }
+
     /// Number of batches.
     pub fn batches(&self) -> u64 {
         self.lines.div_ceil(self.batch_size)
