@@ -173,7 +173,8 @@ impl RunOptions {
 /// Where a report goes.
 #[derive(clap::Args, Debug, Clone)]
 pub struct ReportOutput {
-    /// Write the report to FILE instead of standard output (checked writable before any line is cast).
+    /// Write the report to FILE instead of standard output (`-`: standard output; checked writable
+    /// before any line is cast).
     #[arg(short, long, value_name = "FILE")]
     pub output: Option<PathBuf>,
 }

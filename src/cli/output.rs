@@ -71,6 +71,9 @@ fn destination_of(path: &Path) -> Result<Destination, Failure> {
 /// a rename (every file is written to a temporary beside it, then renamed over it), an existing file is
 /// writable; a device is opened for writing; a directory is refused. Nothing is left behind.
 pub fn check_writable(path: &Path) -> Result<(), Failure> {
+    if is_standard_output(path) {
+        return Ok(());
+    }
     let destination = destination_of(path)?;
     if let Destination::File(real) = &destination {
         let dir = files::folder_of(real);
@@ -284,6 +287,11 @@ pub fn write_file(path: &Path, contents: &[u8]) -> Result<(), Failure> {
     write_with(path, |w| w.write_all(contents))
 }
 
+/// Whether a report's output path is `-`, standard output (as a scene path `-` is standard input).
+pub fn is_standard_output(path: &Path) -> bool {
+    path.as_os_str() == "-"
+}
+
 /// Says that a file written elsewhere (a mesh, a plot) was written.
 pub fn wrote(path: &Path) {
     note(&format!("wrote {}", path.display()));
@@ -292,7 +300,7 @@ pub fn wrote(path: &Path) {
 /// Sends a report to `output` (a file) or to standard output; a reader that went away
 /// (`scx ... | head`) is not an error.
 pub fn emit(output: Option<&Path>, text: &str) -> Result<(), Failure> {
-    if let Some(path) = output {
+    if let Some(path) = output.filter(|p| !is_standard_output(p)) {
         return write_file(path, text.as_bytes());
     }
     let mut out = std::io::stdout().lock();
