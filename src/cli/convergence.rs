@@ -9,6 +9,7 @@ use scene_complexity::report::reliability_json;
 use scene_complexity::Analysis;
 use scene_complexity::RunWarningKind;
 use scene_complexity::StopReason;
+use scene_complexity::Verdict;
 use scene_complexity::{Estimate, Measure};
 use serde_json::json;
 
@@ -97,6 +98,22 @@ impl Level {
         let stderr = mean(estimates.iter().filter_map(|e| e.stderr));
         Some((mean(estimates.iter().map(|e| e.value)), stderr))
     }
+
+    /// Whether a repeat's reading of `m` breaks a bound of the theory: their mean is then marked, as
+    /// `analyze` marks the reading.
+    fn flagged(&self, m: Measure) -> bool {
+        self.runs
+            .iter()
+            .any(|a| report::flagged(a.reliability.get(m)))
+    }
+
+    /// The worst verdict of the repeats' readings of `m` (`None`: no verdict, as for the exact H_p).
+    fn worst_verdict(&self, m: Measure) -> Option<Verdict> {
+        self.runs
+            .iter()
+            .filter_map(|a| a.reliability.get(m).map(|r| r.verdict))
+            .max()
+    }
 }
 
 fn mean(xs: impl Iterator<Item = f64>) -> f64 {
@@ -159,6 +176,7 @@ pub fn run(args: &ConvergenceArgs) -> Result<Exit, Failure> {
     if let Some(path) = &args.csv {
         output::write_file(path, csv(&info, &levels).as_bytes())?;
     }
+    let mut plot_written = false;
     if let Some(path) = &args.plot {
         let title = format!(
             "{}: error against run time ({} tracer, {} thread(s))",
@@ -175,10 +193,11 @@ pub fn run(args: &ConvergenceArgs) -> Result<Exit, Failure> {
                 message,
             })?;
             output::wrote(path);
+            plot_written = true;
         }
     }
     let text = match args.format {
-        ConvergenceFormat::Table => table(&info, &levels, args.repeats),
+        ConvergenceFormat::Table => table(&info, &levels, args.repeats, plot_written),
         ConvergenceFormat::Json => json_report(&info, &levels, args.repeats),
     };
     output::emit(args.out.output.as_deref(), &text)?;
@@ -358,7 +377,48 @@ fn curves(levels: &[Level]) -> Vec<Curve> {
     out
 }
 
-fn table(info: &report::RunInfo, levels: &[Level], repeats: u32) -> String {
+/// The notes under the table: for every repeat's reading that breaks a bound of the theory, the bound,
+/// in `analyze`'s words, after the run's lines and seed (each repeat's reading has its own numbers).
+fn flag_notes(levels: &[Level]) -> Vec<String> {
+    let mut notes = Vec::new();
+    for l in levels {
+        for a in &l.runs {
+            let whose = format!("{} lines, seed {}: ", a.lines, a.spec.seed);
+            for m in followed() {
+                for f in a.reliability.get(m).iter().flat_map(|r| r.flags.iter()) {
+                    let note = report::flag_note(&whose, f);
+                    if !notes.contains(&note) {
+                        notes.push(note);
+                    }
+                }
+            }
+        }
+    }
+    notes
+}
+
+/// One line per line count whose readings are not all `ok`: each such reading with the worst verdict of
+/// its repeats, so that the means in the table are not taken for more than they are worth.
+fn verdict_lines(levels: &[Level]) -> Vec<String> {
+    levels
+        .iter()
+        .filter_map(|l| {
+            let poor: Vec<String> = followed()
+                .into_iter()
+                .filter_map(|m| {
+                    let v = l.worst_verdict(m).filter(|&v| v != Verdict::Ok)?;
+                    Some(format!("{} {}", m.info().symbol, v.name()))
+                })
+                .collect();
+            (!poor.is_empty()).then(|| format!("  {} lines: {}", l.lines, poor.join(", ")))
+        })
+        .collect()
+}
+
+/// The table: the means of every line count's repeats, each marked `!` when a repeat's reading breaks
+/// a bound of the theory, then the notes that say which, and the readings that are not `ok`.
+/// `plot_written`: a plot was drawn, whose points carry no mark.
+fn table(info: &report::RunInfo, levels: &[Level], repeats: u32, plot_written: bool) -> String {
     let mut s = String::new();
     let _ = writeln!(
         s,
@@ -376,12 +436,50 @@ fn table(info: &report::RunInfo, levels: &[Level], repeats: u32) -> String {
         let mut row = vec![l.lines.to_string(), format!("{:.3}", l.seconds())];
         for m in followed() {
             row.push(match l.measure(m) {
-                Some((v, e)) => format!("{} +- {}", fixed(v), fixed(e)),
+                Some((v, e)) => format!(
+                    "{} +- {}{}",
+                    fixed(v),
+                    fixed(e),
+                    if l.flagged(m) { " !" } else { "  " }
+                ),
                 None => "-".into(),
             });
         }
         t.row(row);
     }
     s += &t.render();
+    let notes = flag_notes(levels);
+    for n in &notes {
+        let _ = writeln!(s, "{n}");
+    }
+    let poor = verdict_lines(levels);
+    if !notes.is_empty() || !poor.is_empty() {
+        let _ = writeln!(
+            s,
+            "\nmarked !: a repeat's reading breaks a bound of the theory (the notes above say which); \
+             every reading's verdict is in --format json and --csv."
+        );
+    }
+    if !poor.is_empty() {
+        let _ = writeln!(
+            s,
+            "readings not ok (the worst verdict of the repeats; docs/results.md, \"Reading the \
+             reliability verdict\"):"
+        );
+        for p in &poor {
+            let _ = writeln!(s, "{p}");
+        }
+    }
+    if plot_written
+        && levels
+            .iter()
+            .any(|l| followed().into_iter().any(|m| plotted(m) && l.flagged(m)))
+    {
+        let _ = writeln!(
+            s,
+            "the plot draws the errors of the readings marked ! like any other: their standard errors \
+             do not cover their bias."
+        );
+    }
     s
 }

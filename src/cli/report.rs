@@ -150,11 +150,31 @@ pub fn csv(run: &RunInfo, a: &Analysis) -> String {
     String::from_utf8(w.into_inner().expect("writing to memory")).expect("CSV of UTF-8 text")
 }
 
+/// Whether a reading breaks a bound of the theory (its verdict names the bounds).
+pub fn flagged(r: Option<&Reliability>) -> bool {
+    r.is_some_and(|r| !r.flags.is_empty())
+}
+
+/// The mark after a reading that breaks a bound of the theory, ` !`, or as many blanks, so that marked
+/// and unmarked values keep their digits aligned.
+pub fn flag_mark(r: Option<&Reliability>) -> &'static str {
+    if flagged(r) {
+        " !"
+    } else {
+        "  "
+    }
+}
+
+/// The note under a table that says which bound a marked reading breaks: `! ` and the verdict's
+/// sentence, after `whose` (`1e4 lines, seed 1: `) when one table holds the readings of several runs.
+pub fn flag_note(whose: &str, sentence: &str) -> String {
+    format!("! {whose}{sentence}")
+}
+
 /// The text of a value with a mark when it breaks a bound of the theory (unmarked values keep the same
 /// width, so that the digits stay aligned).
 fn marked(e: Estimate, r: Option<&Reliability>) -> String {
-    let flagged = r.is_some_and(|r| !r.flags.is_empty());
-    format!("{}{}", fixed(e.value), if flagged { " !" } else { "  " })
+    format!("{}{}", fixed(e.value), flag_mark(r))
 }
 
 fn stderr_text(e: Estimate) -> String {
@@ -197,7 +217,7 @@ fn add_rows(t: &mut Table, rows: &[Row], notes: &mut Vec<String>) {
             .flatten()
         {
             for f in &rel.flags {
-                let note = format!("! {f}");
+                let note = flag_note("", f);
                 if !notes.contains(&note) {
                     notes.push(note);
                 }

@@ -66,7 +66,9 @@ pub fn run(args: &ReproduceArgs) -> Result<Exit, Failure> {
     print(&format!(
         "`scx reproduce`: lines {}, seed {}, tracer {}, {threads} \
          threads. Each value is `estimate ± standard error`; `corr.` is the bias-corrected estimate \
-         (chao-wang-jost row entropies); `paper` is the published value.\n\n",
+         (chao-wang-jost row entropies); `paper` is the published value. `!` marks a reading that \
+         breaks a bound of the theory, as `scx analyze` does (the note under the table says which); a \
+         finding judged on such readings says `on flagged readings` and names them.\n\n",
         cfg.lines,
         cfg.seed,
         match cfg.backend {

@@ -17,8 +17,9 @@ use std::collections::HashMap;
 use std::fmt::Write as _;
 use std::time::Instant;
 
+use crate::analysis::Reliability;
 use crate::analysis::{analyze, AnalysisError, RadiosityOutcome};
-use crate::measure::{ByMeasure, Estimate};
+use crate::measure::{ByMeasure, Estimate, Measure};
 use crate::refine::RefineError;
 use crate::run::{Measures, RunControl, RunSpec};
 use crate::scene::{Scene, SceneError};
@@ -132,6 +133,22 @@ pub struct Finding {
     pub holds: bool,
     /// The numbers behind the verdict.
     pub detail: String,
+    /// The readings it was judged on that break a bound of the theory (`@fig2:a 1e5 I_s`), marked `!` in
+    /// the table: a verdict resting on them is no evidence either way, and the report says so.
+    pub flagged: Vec<String>,
+}
+
+impl Finding {
+    /// The verdict as the report prints it: `holds` or `does NOT hold`, and `on flagged readings` when it
+    /// rests on readings that break a bound of the theory.
+    pub fn verdict(&self) -> String {
+        let verdict = if self.holds { "holds" } else { "does NOT hold" };
+        if self.flagged.is_empty() {
+            verdict.into()
+        } else {
+            format!("{verdict} on flagged readings")
+        }
+    }
 }
 
 /// A regenerated table.
@@ -173,8 +190,19 @@ impl TableReport {
             let _ = writeln!(s, "{n}  ");
         }
         for f in &self.findings {
-            let verdict = if f.holds { "holds" } else { "does NOT hold" };
-            let _ = writeln!(s, "- *{}*: **{verdict}** ({})", f.claim, f.detail);
+            let flagged = if f.flagged.is_empty() {
+                String::new()
+            } else {
+                // One entry per run, its readings comma separated: the runs apart by `;`.
+                format!("flagged: {}. ", f.flagged.join("; "))
+            };
+            let _ = writeln!(
+                s,
+                "- *{}*: **{}** ({flagged}{})",
+                f.claim,
+                f.verdict(),
+                f.detail
+            );
         }
         let mut shared = Vec::new();
         if self.reused > 0 {
@@ -279,6 +307,8 @@ enum Want {
 /// What one run found, kept for the tables.
 #[derive(Clone, Debug)]
 struct Run {
+    /// The scene's name (`@fig2:a`), which names the run in the notes and findings.
+    name: String,
     patches: usize,
     lines: u64,
     seconds: f64,
@@ -286,6 +316,8 @@ struct Run {
     v: ByMeasure<Estimate>,
     /// The radiosity readings, when computed.
     radiosity: Option<ByMeasure<Estimate>>,
+    /// The verdicts on the readings of both families, with the bounds of the theory each breaks.
+    reliability: ByMeasure<Reliability>,
     /// Segments leaving a front side out of the scene (0 in a closed scene but for grazing hits).
     escapes: u64,
     /// Segments joining two patches.
@@ -360,15 +392,30 @@ impl Session<'_> {
             lines_text(a.lines)
         ));
         Ok(Run {
+            name: scene.name.clone(),
             patches: scene.patch_count(),
             lines: a.lines,
             seconds,
             v: a.estimates,
             radiosity,
+            reliability: a.reliability,
             escapes: a.escapes,
             pairs: a.pairs,
             area_weight: 2.0 * std::f64::consts::PI / scene.total_area(),
         })
+    }
+}
+
+impl Run {
+    /// The bounds of the theory the reading of `m` breaks, in `analyze`'s words (none when it breaks
+    /// none or was not made).
+    fn flags(&self, m: Measure) -> &[String] {
+        self.reliability.get(m).map_or(&[], |r| r.flags.as_slice())
+    }
+
+    /// The run as the notes and findings name it: `@fig2:a 1e5`.
+    fn label(&self) -> String {
+        format!("{} {}", self.name, lines_text(self.lines))
     }
 }
 

@@ -42,11 +42,74 @@ fn report(number: u8, title: &str, header: &[&str]) -> TableReport {
     }
 }
 
+/// A claim checked on readings none of which is flagged (those that may be use [`finding_on`]).
 fn finding(claim: &str, holds: bool, detail: String) -> Finding {
     Finding {
         claim: claim.into(),
         holds,
         detail,
+        flagged: Vec::new(),
+    }
+}
+
+/// A claim checked on the readings `measures` of `runs`: the finding names those that break a bound of
+/// the theory, so that its verdict does not pass for more than they are worth.
+fn finding_on(
+    claim: &str,
+    holds: bool,
+    detail: String,
+    runs: &[&Run],
+    measures: &[Measure],
+) -> Finding {
+    Finding {
+        flagged: flagged_among(runs, measures),
+        ..finding(claim, holds, detail)
+    }
+}
+
+/// The readings `measures` of `runs` that break a bound of the theory, one entry per run
+/// (`@fig2:a 1e5: I_s, I_s corrected`).
+fn flagged_among(runs: &[&Run], measures: &[Measure]) -> Vec<String> {
+    let mut out = Vec::new();
+    for r in runs {
+        let symbols: Vec<&str> = measures
+            .iter()
+            .filter(|&&m| !r.flags(m).is_empty())
+            .map(|m| m.info().symbol)
+            .collect();
+        let entry = format!("{}: {}", r.label(), symbols.join(", "));
+        if !symbols.is_empty() && !out.contains(&entry) {
+            out.push(entry);
+        }
+    }
+    out
+}
+
+/// A table's reading cells, each marked `!` when the reading breaks a bound of the theory, and the
+/// notes under the table that say which bound, in `scx analyze`'s words after the run's name.
+#[derive(Default)]
+struct Marks {
+    notes: Vec<String>,
+}
+
+impl Marks {
+    /// The cell of reading `m` of run `r`, with `digits` decimals ([`est`]), marked.
+    fn cell(&mut self, r: &Run, m: Measure, digits: usize) -> String {
+        self.cell_of(r, m, r.v.of(m), digits)
+    }
+
+    /// The cell of `e`, a number derived from reading `m` of run `r` (E(MSE) area-weighted), marked as
+    /// that reading is: it breaks what the reading breaks.
+    fn cell_of(&mut self, r: &Run, m: Measure, e: Option<Estimate>, digits: usize) -> String {
+        let flags = r.flags(m);
+        for f in flags {
+            let note = format!("! {}: {f}", r.label());
+            if !self.notes.contains(&note) {
+                self.notes.push(note);
+            }
+        }
+        let mark = if flags.is_empty() { "" } else { " !" };
+        format!("{}{mark}", est(e, digits))
     }
 }
 
@@ -154,6 +217,7 @@ fn table1(s: &mut Session) -> Result<TableReport, ReproduceError> {
             "E(MSE) paper",
         ],
     );
+    let mut marks = Marks::default();
     let mut runs = Vec::new();
     for &(p, lines, hs, is, mse) in &published::TABLE1 {
         let r = s.run(&format!("@fig2:{p}"), lines, Want::Visibility)?;
@@ -162,18 +226,24 @@ fn table1(s: &mut Session) -> Result<TableReport, ReproduceError> {
             format!("Fig.2{p}"),
             lines_text(r.lines),
             secs(&r),
-            est(v.of(Measure::Entropy), 3),
-            est(v.of(Measure::EntropyCorrected), 3),
+            marks.cell(&r, Measure::Entropy, 3),
+            marks.cell(&r, Measure::EntropyCorrected, 3),
             hs.into(),
-            est(v.of(Measure::MutualInformation), 3),
-            est(v.of(Measure::MutualInformationCorrected), 3),
+            marks.cell(&r, Measure::MutualInformation, 3),
+            marks.cell(&r, Measure::MutualInformationCorrected, 3),
             is.into(),
-            est(v.of(Measure::MsePerLine), 1),
-            est(scaled(v.of(Measure::MsePerLine), r.area_weight), 1),
+            marks.cell(&r, Measure::MsePerLine, 1),
+            marks.cell_of(
+                &r,
+                Measure::MsePerLine,
+                scaled(v.of(Measure::MsePerLine), r.area_weight),
+                1,
+            ),
             mse.into(),
         ]);
         runs.push((p, lines, mse.parse::<f64>().unwrap_or(f64::NAN), r));
     }
+    t.notes.append(&mut marks.notes);
     let hp = runs[0].3.v.of(Measure::PositionalEntropy);
     t.notes.push(format!(
         "H_p (eq. 19, exact from the areas) = {} for all three (paper: {}).",
@@ -231,8 +301,9 @@ fn table1_findings(s: &Session, runs: &[Fig2Run]) -> Vec<Finding> {
             mse.map(|m| format!("{m:.0}")).join("/")
         ));
     }
+    let all: Vec<&Run> = runs.iter().map(|x| &x.3).collect();
     let mut findings = vec![
-        finding(
+        finding_on(
             "clustered configurations (b, c) have lower H_s and higher I_s than the random one (a)",
             plug && corr,
             format!(
@@ -241,11 +312,20 @@ fn table1_findings(s: &Session, runs: &[Fig2Run]) -> Vec<Finding> {
                 yes(corr),
                 detail.join("; ")
             ),
+            &all,
+            &[
+                Measure::Entropy,
+                Measure::EntropyCorrected,
+                Measure::MutualInformation,
+                Measure::MutualInformationCorrected,
+            ],
         ),
-        finding(
+        finding_on(
             "the larger the entropy, the larger the E(MSE)",
             mse_order,
             "see the E(MSE) above".into(),
+            &all,
+            &[Measure::Entropy, Measure::MsePerLine],
         ),
     ];
     // Only meaningful when the two line counts still differ after `--lines`.
@@ -255,10 +335,12 @@ fn table1_findings(s: &Session, runs: &[Fig2Run]) -> Vec<Finding> {
             val(hi.of(Measure::Entropy)) > val(lo.of(Measure::Entropy))
                 && val(hi.of(Measure::MutualInformation)) < val(lo.of(Measure::MutualInformation))
         });
-        findings.push(finding(
+        findings.push(finding_on(
             "more lines increase the (plug-in) H_s and decrease I_s",
             more,
             "each scene, 10x the lines".into(),
+            &all,
+            &[Measure::Entropy, Measure::MutualInformation],
         ));
     }
     findings
@@ -282,26 +364,27 @@ fn table2(s: &mut Session) -> Result<TableReport, ReproduceError> {
             "I_s^c paper",
         ],
     );
+    let mut marks = Marks::default();
     let mut runs = Vec::new();
     for &(n, lines, hs, is, isc) in &published::TABLE2 {
         let r = s.run(&format!("@cube:{n}"), lines, Want::Visibility)?;
-        let v = &r.v;
         let fig = ["3a", "3b", "3c"][n / 10 - 1];
         t.rows.push(vec![
             format!("Fig.{fig} ({n}x{n})"),
             lines_text(r.lines),
             secs(&r),
-            est(v.of(Measure::Entropy), 3),
-            est(v.of(Measure::EntropyCorrected), 3),
+            marks.cell(&r, Measure::Entropy, 3),
+            marks.cell(&r, Measure::EntropyCorrected, 3),
             hs.into(),
-            est(v.of(Measure::MutualInformation), 3),
-            est(v.of(Measure::MutualInformationCorrected), 3),
+            marks.cell(&r, Measure::MutualInformation, 3),
+            marks.cell(&r, Measure::MutualInformationCorrected, 3),
             is.into(),
-            est(v.of(Measure::ContinuousMutualInformation), 3),
+            marks.cell(&r, Measure::ContinuousMutualInformation, 3),
             isc.into(),
         ]);
         runs.push((n, lines, r));
     }
+    t.notes.append(&mut marks.notes);
     t.notes
         .extend(capped_note(s, &published::TABLE2.map(|r| r.1)));
     t.findings = table2_findings(s, &runs);
@@ -311,16 +394,19 @@ fn table2(s: &mut Session) -> Result<TableReport, ReproduceError> {
 /// Table 2's claims: I_s^c ignores the mesh and bounds I_s; more lines raise H_s and lower I_s.
 fn table2_findings(s: &Session, runs: &[(usize, u64, Run)]) -> Vec<Finding> {
     let mut findings = Vec::new();
+    let all: Vec<&Run> = runs.iter().map(|x| &x.2).collect();
     let counts = distinct(runs.iter().map(|x| x.1));
     let at = |n: usize, l: u64| &runs.iter().find(|x| x.0 == n && x.1 == l).expect("ran").2.v;
     let same_isc = counts.iter().all(|&l| {
         let c = [10, 20, 30].map(|n| at(n, l).of(Measure::ContinuousMutualInformation));
         agree(c[0], c[1]) && agree(c[1], c[2]) && agree(c[0], c[2])
     });
-    findings.push(finding(
+    findings.push(finding_on(
         "I_s^c does not depend on the discretisation (the three meshes agree at every line count)",
         same_isc,
         "within 3 combined standard errors".into(),
+        &all,
+        &[Measure::ContinuousMutualInformation],
     ));
     let last = *counts.last().expect("three counts");
     let bound: Vec<String> = [10, 20, 30]
@@ -344,7 +430,8 @@ fn table2_findings(s: &Session, runs: &[(usize, u64, Run)]) -> Vec<Finding> {
         below(|v| v.of(Measure::MutualInformation)),
         below(|v| v.of(Measure::MutualInformationCorrected)),
     );
-    findings.push(finding(
+    let at_last: Vec<&Run> = runs.iter().filter(|x| x.1 == last).map(|x| &x.2).collect();
+    findings.push(finding_on(
         "I_s^c is an upper bound of I_s (Proposition 2), checked at the most lines",
         corr,
         format!(
@@ -353,6 +440,11 @@ fn table2_findings(s: &Session, runs: &[(usize, u64, Run)]) -> Vec<Finding> {
             yes(plug),
             bound.join(", ")
         ),
+        &at_last,
+        &[
+            Measure::MutualInformationCorrected,
+            Measure::ContinuousMutualInformation,
+        ],
     ));
     // Only meaningful when the line counts still differ after `--lines`.
     if distinct(counts.iter().map(|&l| s.lines(l))).len() == counts.len() {
@@ -367,10 +459,12 @@ fn table2_findings(s: &Session, runs: &[(usize, u64, Run)]) -> Vec<Finding> {
                 .collect();
             decreasing(&i) && h.windows(2).all(|w| w[0] < w[1])
         });
-        findings.push(finding(
+        findings.push(finding_on(
             "more lines increase the (plug-in) H_s and decrease I_s",
             more,
             "each mesh, over its three line counts".into(),
+            &all,
+            &[Measure::Entropy, Measure::MutualInformation],
         ));
     }
     findings
@@ -390,21 +484,22 @@ fn table3(s: &mut Session) -> Result<TableReport, ReproduceError> {
             "I_s^c paper",
         ],
     );
+    let mut marks = Marks::default();
     let mut runs = Vec::new();
     for &(lines, is, isc) in &published::TABLE3 {
         let r = s.run("@fig2:a", lines, Want::Visibility)?;
-        let v = &r.v;
         t.rows.push(vec![
             lines_text(r.lines),
             secs(&r),
-            est(v.of(Measure::MutualInformation), 3),
-            est(v.of(Measure::MutualInformationCorrected), 3),
+            marks.cell(&r, Measure::MutualInformation, 3),
+            marks.cell(&r, Measure::MutualInformationCorrected, 3),
             is.into(),
-            est(v.of(Measure::ContinuousMutualInformation), 3),
+            marks.cell(&r, Measure::ContinuousMutualInformation, 3),
             isc.into(),
         ]);
         runs.push(r);
     }
+    t.notes.append(&mut marks.notes);
     t.notes
         .extend(capped_note(s, &published::TABLE3.map(|r| r.0)));
     let last = runs
@@ -415,7 +510,8 @@ fn table3(s: &mut Session) -> Result<TableReport, ReproduceError> {
     let cheap = runs
         .iter()
         .all(|r| agree(r.v.of(Measure::ContinuousMutualInformation), last));
-    t.findings.push(finding(
+    let all: Vec<&Run> = runs.iter().collect();
+    t.findings.push(finding_on(
         "I_s^c is cheap: every line count gives it within 3 standard errors of the largest run",
         cheap,
         format!(
@@ -427,16 +523,20 @@ fn table3(s: &mut Session) -> Result<TableReport, ReproduceError> {
                     .collect::<Vec<_>>()
             )
         ),
+        &all,
+        &[Measure::ContinuousMutualInformation],
     ));
     let is: Vec<f64> = runs
         .iter()
         .map(|r| val(r.v.of(Measure::MutualInformation)))
         .collect();
     if distinct(runs.iter().map(|r| r.lines)).len() == runs.len() {
-        t.findings.push(finding(
+        t.findings.push(finding_on(
             "I_s is expensive: the plug-in I_s keeps falling as lines are added",
             decreasing(&is),
             format!("I_s {}", slash(&is)),
+            &all,
+            &[Measure::MutualInformation],
         ));
     }
     Ok(t)
@@ -459,6 +559,8 @@ fn table4(s: &mut Session) -> Result<TableReport, ReproduceError> {
         "continuous mutual information of the regular solids, a sphere and the Cornell box",
         &["scene", "scx scene", "lines", "s", "I_s^c", "I_s^c paper"],
     );
+    let mut marks = Marks::default();
+    let mut runs = Vec::new();
     let mut isc = Vec::new();
     for (&(name, value), spec) in published::TABLE4.iter().zip(TABLE4_SCENES) {
         let r = s.run(spec, published::TABLE45_LINES, Want::Continuous)?;
@@ -468,11 +570,13 @@ fn table4(s: &mut Session) -> Result<TableReport, ReproduceError> {
             format!("`{spec}`"),
             lines_text(r.lines),
             secs(&r),
-            est(c, 4),
+            marks.cell(&r, Measure::ContinuousMutualInformation, 4),
             value.into(),
         ]);
         isc.push(c);
+        runs.push(r);
     }
+    t.notes.append(&mut marks.notes);
     t.notes.push(
         "The sphere is the icosphere `@sphere:5` (20480 triangles), whose I_s^c tends to the sphere's 0 as it \
          is subdivided; `@cornell` is the closed box (see `scx scenes`)."
@@ -481,15 +585,21 @@ fn table4(s: &mut Session) -> Result<TableReport, ReproduceError> {
     t.notes.extend(capped_note(s, &[published::TABLE45_LINES]));
     let solids: Vec<f64> = isc[..6].iter().map(|&e| val(e)).collect();
     let ranked = solids.windows(2).all(|w| w[0] < w[1]);
-    t.findings.push(finding(
+    let isc_only = [Measure::ContinuousMutualInformation];
+    let solid_runs: Vec<&Run> = runs[..6].iter().collect();
+    t.findings.push(finding_on(
         "I_s^c ranks sphere < icosahedron < dodecahedron < octahedron < cube < tetrahedron",
         ranked,
         format!("I_s^c {}", slash(&solids)),
+        &solid_runs,
+        &isc_only,
     ));
-    t.findings.push(finding(
+    t.findings.push(finding_on(
         "the Cornell box is clearly more complex than the empty cube",
         val(isc[6]) > val(isc[4]),
         format!("{:.3} vs {:.3}", val(isc[6]), val(isc[4])),
+        &[&runs[6], &runs[4]],
+        &isc_only,
     ));
     Ok(t)
 }
@@ -500,6 +610,8 @@ fn table5(s: &mut Session) -> Result<TableReport, ReproduceError> {
         "fig. 4, tables with four chairs in a room (`@fig4:a..f`)",
         &["scene", "lines", "s", "I_s^c", "I_s^c paper"],
     );
+    let mut marks = Marks::default();
+    let mut runs = Vec::new();
     let mut isc = Vec::new();
     for &(p, value) in &published::TABLE5 {
         let r = s.run(
@@ -512,11 +624,13 @@ fn table5(s: &mut Session) -> Result<TableReport, ReproduceError> {
             format!("4{p}"),
             lines_text(r.lines),
             secs(&r),
-            est(c, 3),
+            marks.cell(&r, Measure::ContinuousMutualInformation, 3),
             value.into(),
         ]);
         isc.push(c);
+        runs.push(r);
     }
+    t.notes.append(&mut marks.notes);
     t.notes.push(
         "a: one group in the middle; b: 2 x 2 in the middle; c: 4 x 4 in the middle; d: 4 x 4 spread \
          evenly; e: four 2 x 2 blocks in the corners; f: 16 along the walls (our layouts, `scx scenes`)."
@@ -524,10 +638,13 @@ fn table5(s: &mut Session) -> Result<TableReport, ReproduceError> {
     );
     t.notes.extend(capped_note(s, &[published::TABLE45_LINES]));
     let v: Vec<f64> = isc.iter().map(|&e| val(e)).collect();
-    t.findings.push(finding(
+    let isc_only = [Measure::ContinuousMutualInformation];
+    t.findings.push(finding_on(
         "introducing objects increases the complexity (a < b < c)",
         v[0] < v[1] && v[1] < v[2],
         format!("I_s^c a/b/c {}", slash(&v[..3])),
+        &runs[..3].iter().collect::<Vec<_>>(),
+        &isc_only,
     ));
     let spread = |x: &[f64]| {
         x.iter().cloned().fold(f64::MIN, f64::max) - x.iter().cloned().fold(f64::MAX, f64::min)
@@ -536,7 +653,7 @@ fn table5(s: &mut Session) -> Result<TableReport, ReproduceError> {
         .iter()
         .map(|r| r.1.parse().unwrap_or(f64::NAN))
         .collect();
-    t.findings.push(finding(
+    t.findings.push(finding_on(
         "objects near the walls increase the complexity (e and f, near the walls, above c, in the middle)",
         v[4] > v[2] && v[5] > v[2],
         format!(
@@ -547,6 +664,8 @@ fn table5(s: &mut Session) -> Result<TableReport, ReproduceError> {
             spread(&v[2..]),
             spread(&paper_v[2..])
         ),
+        &[&runs[2], &runs[4], &runs[5]],
+        &isc_only,
     ));
     Ok(t)
 }
@@ -584,6 +703,7 @@ fn table67(s: &mut Session, number: u8) -> Result<TableReport, ReproduceError> {
             "paper",
         ],
     );
+    let mut marks = Marks::default();
     let mut runs = Vec::new();
     for (k, &(is, isc, acc)) in data.iter().enumerate() {
         let stage = "abcdef".as_bytes()[k] as char;
@@ -592,32 +712,35 @@ fn table67(s: &mut Session, number: u8) -> Result<TableReport, ReproduceError> {
             published::TABLE67_LINES,
             Want::Visibility,
         )?;
-        let v = &r.v;
         t.rows.push(vec![
             format!("Fig.{fig}{stage}"),
             lines_text(r.lines),
             secs(&r),
-            est(v.of(Measure::MutualInformation), 3),
-            est(v.of(Measure::MutualInformationCorrected), 3),
+            marks.cell(&r, Measure::MutualInformation, 3),
+            marks.cell(&r, Measure::MutualInformationCorrected, 3),
             is.into(),
-            est(v.of(Measure::ContinuousMutualInformation), 3),
+            marks.cell(&r, Measure::ContinuousMutualInformation, 3),
             isc.into(),
-            est(v.of(Measure::Accuracy), 3),
-            est(v.of(Measure::AccuracyCorrected), 3),
+            marks.cell(&r, Measure::Accuracy, 3),
+            marks.cell(&r, Measure::AccuracyCorrected, 3),
             acc.into(),
         ]);
         runs.push(r);
     }
+    t.notes.append(&mut marks.notes);
     t.notes.extend(capped_note(s, &[published::TABLE67_LINES]));
     let isc: Vec<f64> = runs
         .iter()
         .map(|r| val(r.v.of(Measure::ContinuousMutualInformation)))
         .collect();
     let extremes_complex = isc[1..5].iter().all(|&m| m < isc[0] && m < isc[5]);
-    t.findings.push(finding(
+    let all: Vec<&Run> = runs.iter().collect();
+    t.findings.push(finding_on(
         "the extreme stages (a, f) are the most complex (highest I_s^c)",
         extremes_complex,
         format!("I_s^c a..f {}", slash(&isc)),
+        &all,
+        &[Measure::ContinuousMutualInformation],
     ));
     let middle_best = |acc: &[f64]| {
         let worst_middle = acc[1..5].iter().cloned().fold(f64::INFINITY, f64::min);
@@ -632,7 +755,7 @@ fn table67(s: &mut Session, number: u8) -> Result<TableReport, ReproduceError> {
         .map(|r| val(r.v.of(Measure::AccuracyCorrected)))
         .collect();
     let (plug, corr) = (middle_best(&acc), middle_best(&acc_c));
-    t.findings.push(finding(
+    t.findings.push(finding_on(
         "the middle stages (b-e) have the highest accuracy I_s/I_s^c and the extreme ones (a, f) the lowest",
         plug && corr,
         format!(
@@ -642,6 +765,8 @@ fn table67(s: &mut Session, number: u8) -> Result<TableReport, ReproduceError> {
             yes(corr),
             slash(&acc_c)
         ),
+        &all,
+        &[Measure::Accuracy, Measure::AccuracyCorrected],
     ));
     if number == 7 {
         t.findings.push(compare_meshes(s, &runs)?);
@@ -659,7 +784,7 @@ fn compare_meshes(s: &mut Session, fig6: &[Run]) -> Result<Finding, ReproduceErr
         wins(|v| v.of(Measure::Accuracy)),
         wins(|v| v.of(Measure::AccuracyCorrected)),
     );
-    Ok(finding(
+    Ok(finding_on(
         "5a (cubes finer) is more accurate than 6a, and 6f (walls finer) more accurate than 5f",
         plug && corr,
         format!(
@@ -671,6 +796,8 @@ fn compare_meshes(s: &mut Session, fig6: &[Run]) -> Result<Finding, ReproduceErr
             val(f5.v.of(Measure::Accuracy)),
             val(fig6[5].v.of(Measure::Accuracy))
         ),
+        &[&a5, &fig6[0], &f5, &fig6[5]],
+        &[Measure::Accuracy, Measure::AccuracyCorrected],
     ))
 }
 
@@ -692,6 +819,7 @@ fn table8(s: &mut Session) -> Result<TableReport, ReproduceError> {
             "I_s paper",
         ],
     );
+    let mut marks = Marks::default();
     let r = s.run("@labyrinth", super::UNSTATED_LINES, Want::Radiosity)?;
     let v = &r.v;
     let (ph, ps, pi) = published::TABLE8_VISIBILITY;
@@ -699,16 +827,17 @@ fn table8(s: &mut Session) -> Result<TableReport, ReproduceError> {
         "Visibility".into(),
         lines_text(r.lines),
         secs(&r),
-        est(v.of(Measure::PositionalEntropy), 4),
+        marks.cell(&r, Measure::PositionalEntropy, 4),
         ph.into(),
-        est(v.of(Measure::Entropy), 5),
-        est(v.of(Measure::EntropyCorrected), 5),
+        marks.cell(&r, Measure::Entropy, 5),
+        marks.cell(&r, Measure::EntropyCorrected, 5),
         ps.into(),
-        est(v.of(Measure::MutualInformation), 5),
-        est(v.of(Measure::MutualInformationCorrected), 5),
+        marks.cell(&r, Measure::MutualInformation, 5),
+        marks.cell(&r, Measure::MutualInformationCorrected, 5),
         pi.into(),
     ]);
     let Some(rad) = &r.radiosity else {
+        t.notes.append(&mut marks.notes);
         t.notes
             .push("The radiosity measures could not be computed.".into());
         return Ok(t);
@@ -718,15 +847,16 @@ fn table8(s: &mut Session) -> Result<TableReport, ReproduceError> {
         "Radiosity".into(),
         lines_text(r.lines),
         "(same run)".into(),
-        est(rad.of(Measure::RadiosityPositionalEntropy), 4),
+        marks.cell(&r, Measure::RadiosityPositionalEntropy, 4),
         qh.into(),
-        est(rad.of(Measure::RadiosityEntropy), 5),
-        est(rad.of(Measure::RadiosityEntropyCorrected), 5),
+        marks.cell(&r, Measure::RadiosityEntropy, 5),
+        marks.cell(&r, Measure::RadiosityEntropyCorrected, 5),
         qs.into(),
-        est(rad.of(Measure::RadiosityMutualInformation), 5),
-        est(rad.of(Measure::RadiosityMutualInformationCorrected), 5),
+        marks.cell(&r, Measure::RadiosityMutualInformation, 5),
+        marks.cell(&r, Measure::RadiosityMutualInformationCorrected, 5),
         qi.into(),
     ]);
+    t.notes.append(&mut marks.notes);
     t.notes.push(format!(
         "The paper does not give its line count; ours is {}. Our labyrinth has {} equal patches (H_p = \
          log2 {}); the paper's 10.6883 is log2 1650.",
@@ -760,7 +890,7 @@ fn table8(s: &mut Session) -> Result<TableReport, ReproduceError> {
     // The identity is exact when every form-factor row sums to 1; a segment escaping through a grazing
     // hit (a line exactly through an edge) leaves its row short and B a hair below 1. The paper's own
     // two rows differ by up to 0.004.
-    t.findings.push(finding(
+    t.findings.push(finding_on(
         "with constant radiosity (R_i + E_i = 1) the radiosity measures equal the visibility measures",
         gap <= 1e-4,
         format!(
@@ -768,6 +898,19 @@ fn table8(s: &mut Session) -> Result<TableReport, ReproduceError> {
             r.escapes,
             r.escapes + r.pairs
         ),
+        &[&r],
+        &[
+            Measure::PositionalEntropy,
+            Measure::Entropy,
+            Measure::EntropyCorrected,
+            Measure::MutualInformation,
+            Measure::MutualInformationCorrected,
+            Measure::RadiosityPositionalEntropy,
+            Measure::RadiosityEntropy,
+            Measure::RadiosityEntropyCorrected,
+            Measure::RadiosityMutualInformation,
+            Measure::RadiosityMutualInformationCorrected,
+        ],
     ));
     Ok(t)
 }
@@ -796,6 +939,8 @@ fn table9(s: &mut Session) -> Result<TableReport, ReproduceError> {
         ],
     );
     let base = scenes::load("@cornell")?;
+    let mut marks = Marks::default();
+    let mut runs = Vec::new();
     let mut mi = Vec::new();
     for &(fig, mesh, patches, lines, hp, hs, is) in &published::TABLE9 {
         let strategy = match mesh {
@@ -817,13 +962,13 @@ fn table9(s: &mut Session) -> Result<TableReport, ReproduceError> {
             format!("{refine_s:.2}"),
             lines_text(r.lines),
             secs(&r),
-            est(rad.of(Measure::RadiosityPositionalEntropy), 2),
+            marks.cell(&r, Measure::RadiosityPositionalEntropy, 2),
             hp.into(),
-            est(rad.of(Measure::RadiosityEntropy), 2),
-            est(rad.of(Measure::RadiosityEntropyCorrected), 2),
+            marks.cell(&r, Measure::RadiosityEntropy, 2),
+            marks.cell(&r, Measure::RadiosityEntropyCorrected, 2),
             hs.into(),
-            est(rad.of(Measure::RadiosityMutualInformation), 3),
-            est(rad.of(Measure::RadiosityMutualInformationCorrected), 3),
+            marks.cell(&r, Measure::RadiosityMutualInformation, 3),
+            marks.cell(&r, Measure::RadiosityMutualInformationCorrected, 3),
             is.into(),
         ]);
         mi.push((
@@ -831,7 +976,9 @@ fn table9(s: &mut Session) -> Result<TableReport, ReproduceError> {
             val(rad.of(Measure::RadiosityMutualInformation)),
             val(rad.of(Measure::RadiosityMutualInformationCorrected)),
         ));
+        runs.push(r);
     }
+    t.notes.append(&mut marks.notes);
     t.notes.push(format!(
         "Meshes: `scx refine @cornell --strategy uniform|power|smoothness --patches N` (rounds of {} lines, \
          growth 1.5) to the paper's patch counts; measures: `scx analyze` with the lines in the table.",
@@ -839,7 +986,19 @@ fn table9(s: &mut Session) -> Result<TableReport, ReproduceError> {
     ));
     t.notes.extend(capped_note(s, &[16_500_000, 41_200_000]));
     if mi.len() == 6 {
-        t.findings.extend(table9_findings(&mi));
+        let all: Vec<&Run> = runs.iter().collect();
+        let flagged = flagged_among(
+            &all,
+            &[
+                Measure::RadiosityMutualInformation,
+                Measure::RadiosityMutualInformationCorrected,
+            ],
+        );
+        t.findings
+            .extend(table9_findings(&mi).into_iter().map(|f| Finding {
+                flagged: flagged.clone(),
+                ..f
+            }));
     }
     Ok(t)
 }

@@ -361,6 +361,112 @@ fn convergence_json_carries_the_verdicts_of_its_csv() {
     assert_eq!(checked, 4);
 }
 
+/// `convergence` marks `!` each reading that breaks a bound of the theory, as `analyze` does, with a note
+/// in `analyze`'s words, and marks nothing else: on `@cube:10` at 10^4 lines the rows are so undersampled
+/// that I_s and the corrected I_s are far above I_s^c (Proposition 2 says I_s <= I_s^c), at 10^6 lines
+/// the corrected I_s is below it. Checked against `analyze --format json` of the same runs (same lines
+/// and seed): their values, which the numbers themselves show above or below I_s^c, and their flags.
+#[test]
+fn convergence_marks_the_readings_analyze_flags_and_no_other() {
+    let out = scx(&[
+        "convergence",
+        "@cube:10",
+        "--lines",
+        "1e4,1e6",
+        "--threads",
+        "1",
+        "--quiet",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let table = String::from_utf8(out.stdout).unwrap();
+    // The table's columns, as `analyze --format json` keys the same readings.
+    let columns = [
+        ("mutual_information", false),
+        ("mutual_information", true),
+        ("entropy", false),
+        ("entropy", true),
+        ("continuous_mutual_information", false),
+    ];
+    let (mut marked, mut unmarked, mut notes) = (0, 0, 0);
+    for lines in ["10000", "1000000"] {
+        let doc = json_of(&scx(&[
+            "analyze",
+            "@cube:10",
+            "--lines",
+            lines,
+            "--threads",
+            "1",
+            "--format",
+            "json",
+            "--quiet",
+        ]));
+        let v = &doc["visibility"];
+        let row = table
+            .lines()
+            .find(|l| l.trim_start().starts_with(&format!("{lines} ")))
+            .unwrap_or_else(|| panic!("no row for {lines}:\n{table}"));
+        let isc = &v["continuous_mutual_information"];
+        for (key, corrected) in columns {
+            let reading = if corrected {
+                &v[key]["corrected"]
+            } else {
+                &v[key]
+            };
+            let (value, se) = (
+                reading["value"].as_f64().unwrap(),
+                reading["stderr"].as_f64().unwrap(),
+            );
+            let cell = format!("{value:.6} +- {se:.6}");
+            let at = row
+                .find(&cell)
+                .unwrap_or_else(|| panic!("{key} {cell} not in the {lines} row: {row}"));
+            let is_marked = row[at + cell.len()..].starts_with(" !");
+            let flags = reading["reliability"]["flags"].as_array().unwrap();
+            assert_eq!(is_marked, !flags.is_empty(), "{key} at {lines}: {row}");
+            // Proposition 2 read off the numbers alone: I_s above I_s^c by more than twice their
+            // combined standard error is flagged, below it is not.
+            if key == "mutual_information" {
+                let (c, cse) = (
+                    isc["value"].as_f64().unwrap(),
+                    isc["stderr"].as_f64().unwrap(),
+                );
+                let above = value - c > 2.0 * (se * se + cse * cse).sqrt();
+                let below = value < c;
+                assert!(
+                    above || below,
+                    "{key} at {lines}: too close to I_s^c to test"
+                );
+                assert_eq!(
+                    is_marked, above,
+                    "{key} {value} against I_s^c {c} at {lines}"
+                );
+            }
+            for f in flags {
+                let note = format!("! {lines} lines, seed 1: {}", f.as_str().unwrap());
+                assert!(table.lines().any(|l| l == note), "{note} missing:\n{table}");
+                notes += 1;
+            }
+            if is_marked {
+                marked += 1;
+            } else {
+                unmarked += 1;
+            }
+        }
+    }
+    // The case breaks bounds (both I_s at 10^4 lines) and keeps others; every note is one of the flags.
+    assert!(marked >= 2 && unmarked >= 5, "{table}");
+    assert_eq!(
+        table.lines().filter(|l| l.starts_with("! ")).count(),
+        notes,
+        "{table}"
+    );
+    assert!(table.contains("\nmarked !: "), "the legend: {table}");
+}
+
 /// One flat quad sees nothing of itself: `convergence` names the undefined measures and says why (the
 /// `no-pairs` warning, which knows the scene is flat), writes no plot and says so, and exits 0.
 #[test]

@@ -128,3 +128,108 @@ fn runs_cast_once_are_told_apart_by_where_they_came_from() {
         "{second}"
     );
 }
+
+/// `reproduce` marks `!` the readings `scx analyze` flags, with a note in its words, and no other; a
+/// finding judged on flagged readings says so and names them. Fig. 2a at 10^5 lines: the plug-in I_s is
+/// far above I_s^c (Proposition 2 says I_s <= I_s^c), the corrected I_s below it. Checked against
+/// `analyze --format json` of the same run (scene, lines, seed 1): its numbers and its flags.
+#[test]
+fn flagged_readings_are_marked_and_findings_resting_on_them_say_so() {
+    let out = scx(&[
+        "reproduce",
+        "--table",
+        "1,3",
+        "--lines",
+        "1e5",
+        "--tracer",
+        "rust",
+        "--threads",
+        "1",
+        "--quiet",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let md = String::from_utf8(out.stdout).unwrap();
+    let doc = support::json_of(&scx(&[
+        "analyze",
+        "@fig2:a",
+        "--lines",
+        "1e5",
+        "--tracer",
+        "rust",
+        "--threads",
+        "1",
+        "--format",
+        "json",
+        "--quiet",
+    ]));
+    let v = &doc["visibility"];
+    let isc = &v["continuous_mutual_information"];
+    let (c, cse) = (
+        isc["value"].as_f64().unwrap(),
+        isc["stderr"].as_f64().unwrap(),
+    );
+    // Table 3's row: lines, seconds, I_s, I_s corr., paper, I_s^c, paper.
+    let row: Vec<&str> = md
+        .lines()
+        .find(|l| l.starts_with("| 1e5 |"))
+        .unwrap_or_else(|| panic!("no Table 3 row:\n{md}"))
+        .split(" | ")
+        .collect();
+    let mut marks = 0;
+    for (reading, cell) in [
+        (&v["mutual_information"], row[2]),
+        (&v["mutual_information"]["corrected"], row[3]),
+        (isc, row[5]),
+    ] {
+        let (value, se) = (
+            reading["value"].as_f64().unwrap(),
+            reading["stderr"].as_f64().unwrap(),
+        );
+        let text = format!("{value:.3} ± {se:.4}");
+        assert!(cell.starts_with(&text), "{cell} is not {text}");
+        let flags = reading["reliability"]["flags"].as_array().unwrap();
+        assert_eq!(cell.ends_with(" !"), !flags.is_empty(), "{cell}: {flags:?}");
+        for f in flags {
+            let note = format!("! @fig2:a 1e5: {}  ", f.as_str().unwrap());
+            assert!(md.lines().any(|l| l == note), "{note} missing:\n{md}");
+            marks += 1;
+        }
+    }
+    // The numbers alone: the plug-in I_s breaks Proposition 2, the corrected one does not.
+    let is = v["mutual_information"]["value"].as_f64().unwrap();
+    let is_se = v["mutual_information"]["stderr"].as_f64().unwrap();
+    assert!(
+        is - c > 2.0 * (is_se * is_se + cse * cse).sqrt(),
+        "{is} vs {c}"
+    );
+    assert!(
+        v["mutual_information"]["corrected"]["value"]
+            .as_f64()
+            .unwrap()
+            < c
+    );
+    assert!(row[2].ends_with(" !") && !row[3].ends_with(" !") && !row[5].ends_with(" !"));
+    assert_eq!(marks, 1, "one broken bound: {md}");
+    // Table 1's first finding rests on fig. 2a's plug-in I_s; Table 3's first on I_s^c alone.
+    let finding = |claim: &str| {
+        md.lines()
+            .find(|l| l.starts_with(&format!("- *{claim}")))
+            .unwrap_or_else(|| panic!("{claim}: no finding\n{md}"))
+            .to_string()
+    };
+    let clustered = finding("clustered configurations");
+    assert!(
+        clustered.contains("on flagged readings**")
+            && clustered.contains("(flagged: @fig2:a 1e5: I_s. "),
+        "{clustered}"
+    );
+    let cheap = finding("I_s^c is cheap");
+    assert!(
+        cheap.contains("**holds**") && !cheap.contains("flagged"),
+        "{cheap}"
+    );
+}
