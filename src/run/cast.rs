@@ -74,6 +74,10 @@ pub enum StartError {
 pub fn start(scene: &Scene, cfg: &RunSpec) -> Result<RunState, StartError> {
     cfg.check()?;
     let wanted = gathered(scene, cfg)?;
+    if !wanted.discrete && !wanted.continuous {
+        // Only the radiosity measures were asked for, and nothing emits.
+        return Err(SpecError::NothingToCompute.into());
+    }
     check_target_is_gathered(cfg, wanted)?;
     Ok(RunState::new(cfg.plan(), cfg.group_count(), wanted))
 }

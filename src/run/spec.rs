@@ -444,6 +444,12 @@ pub enum SpecError {
         /// Where the lines were to be drawn.
         bound: LineBound,
     },
+    /// Only the radiosity measures asked for, of a scene where nothing emits: nothing to compute.
+    #[error(
+        "the radiosity measures need light, and nothing in this scene emits (no material has an \
+         emission above 0): nothing to compute; ask for the visibility measures too (--measures)"
+    )]
+    NothingToCompute,
     /// A precision target on a measure the run's measures do not include.
     #[error(
         "the precision target watches {measure}, which this run does not compute: its measures gather \

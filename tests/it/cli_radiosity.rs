@@ -56,6 +56,31 @@ fn scenes_without_light_say_why_radiosity_is_left_out() {
     let table = scx(&["analyze", "@cube", "--lines", "1e4", "--tracer", "rust"]);
     assert!(String::from_utf8_lossy(&table.stdout)
         .contains("radiosity measures left out: nothing emits"));
+    // Asked for alone, the radiosity measures of a scene without light leave nothing to compute: refused
+    // before any line is cast (it printed an empty report and exited 0), as `render --color radiosity`.
+    let alone = scx(&[
+        "analyze",
+        "@cube:2",
+        "--lines",
+        "1e4",
+        "--measures",
+        "radiosity",
+    ]);
+    assert_eq!(alone.status.code(), Some(2));
+    assert!(alone.stdout.is_empty());
+    assert!(String::from_utf8_lossy(&alone.stderr).contains("nothing in this scene emits"));
+    // With light they are computed.
+    let lit = json_of(&scx(&[
+        "analyze",
+        "@cornell",
+        "--lines",
+        "1e4",
+        "--measures",
+        "radiosity",
+        "--format",
+        "json",
+    ]));
+    assert!(lit["radiosity"].is_object());
 }
 
 #[test]
