@@ -204,7 +204,7 @@ fn stderr(e: Estimate) -> f64 {
 /// the spread of 16 groups' errors, sd z ~1.1): 95% at 0, 92-93% at 0.5, 85% at 1. With 1, the old
 /// share, the ok readings covered 76% (the plug-in accuracy of `@tetrahedron:4` at 1e6 lines, 200
 /// seeds) to 90% (the plug-in E(MSE) of `@octahedron:3`). A bias-corrected reading is held to its whole
-/// standard error ([`corrected`]): the jackknife overestimates its remaining bias about twice.
+/// standard error: the jackknife overestimates its remaining bias about twice.
 pub const PLUG_IN_BIAS_SHARE: f64 = 0.5;
 
 /// Whether a plug-in reading's estimated bias `bias` is beyond what an ok reading of standard error `se`
