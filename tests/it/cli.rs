@@ -368,7 +368,7 @@ fn convergence_json_carries_the_verdicts_of_its_csv() {
 /// and seed): their values, which the numbers themselves show above or below I_s^c, and their flags.
 #[test]
 fn convergence_marks_the_readings_analyze_flags_and_no_other() {
-    let out = scx(&[
+    let table = support::text_of(scx(&[
         "convergence",
         "@cube:10",
         "--lines",
@@ -376,13 +376,7 @@ fn convergence_marks_the_readings_analyze_flags_and_no_other() {
         "--threads",
         "1",
         "--quiet",
-    ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let table = String::from_utf8(out.stdout).unwrap();
+    ]));
     // The table's columns, as `analyze --format json` keys the same readings.
     let columns = [
         ("mutual_information", false),

@@ -250,6 +250,16 @@ pub fn scx(args: &[&str]) -> std::process::Output {
         .expect("scx runs")
 }
 
+/// The standard output of a successful `scx` run, as text.
+pub fn text_of(out: std::process::Output) -> String {
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8(out.stdout).expect("UTF-8 output")
+}
+
 /// The JSON document a successful `scx ... --format json` printed.
 pub fn json_of(out: &std::process::Output) -> serde_json::Value {
     assert!(
