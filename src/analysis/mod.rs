@@ -371,6 +371,12 @@ pub fn finish(
             )
         },
     ));
+    let closed = total.counters.escapes == 0 && total.counters.pairs > 0;
+    warnings.extend(
+        patches
+            .as_deref()
+            .and_then(|p| warnings::negative_lost_information(&scene.name, p, closed)),
+    );
     let mut visibility = visibility;
     if total.counters.pairs == 0 && !enclose {
         // No pair: only H_p (exact, from the areas) is defined; zeros would read as measurements.

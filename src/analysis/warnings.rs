@@ -1,7 +1,8 @@
 //! What a user must know about a run's numbers, as data: each warning has a kind a program can test and
 //! a sentence a person can read.
 
-use crate::measure::Estimate;
+use super::patch_results::PatchResult;
+use crate::measure::{Estimate, PatchMeasure};
 use crate::sample::tally::Counters;
 use crate::scene::Warning;
 
@@ -30,6 +31,9 @@ pub enum RunWarningKind {
     SeenInsideSolid,
     /// The run had fewer standard-error groups than asked (`--groups`): too few batches to deal.
     FewerGroups,
+    /// Per-patch information lost, I_i^c - I_i, below 0 beyond its error on some patches of a closed
+    /// scene: the plug-in I_i's bias on undersampled rows (the corrected column has none).
+    NegativeLostInformation,
 }
 
 impl RunWarningKind {
@@ -46,6 +50,7 @@ impl RunWarningKind {
             RunWarningKind::LightSeenFromBehind => "light-seen-from-behind",
             RunWarningKind::SeenInsideSolid => "seen-inside-solid",
             RunWarningKind::FewerGroups => "fewer-groups",
+            RunWarningKind::NegativeLostInformation => "negative-lost-information",
         }
     }
 }
@@ -164,4 +169,40 @@ pub(crate) fn fewer_groups(
             ("lines_needed", needed as f64),
         ]),
     )
+}
+
+/// The patches of a closed scene whose plug-in information lost, I_i^c - I_i, reads below 0 by more than
+/// twice its standard error. The log-sum inequality makes every row's I_i^c at least its I_i (coarse
+/// graining loses information), so such a reading is no measurement of the patch: it is the plug-in
+/// I_i's bias, high on a row sampled too thinly, which the corrected column (`lost_information_corrected`)
+/// removes. Open scenes are not judged (their rows do not sum to 1).
+pub(crate) fn negative_lost_information(
+    scene: &str,
+    patches: &[PatchResult],
+    closed: bool,
+) -> Option<RunWarning> {
+    if !closed {
+        return None;
+    }
+    let below = |e: Estimate| e.value < -2.0 * e.stderr.unwrap_or(f64::INFINITY);
+    let (mut n, mut fraction) = (0usize, 0.0);
+    for p in patches {
+        if p.get(PatchMeasure::LostInformation).is_some_and(below) {
+            n += 1;
+            fraction += p.area_fraction;
+        }
+    }
+    (n > 0).then(|| {
+        RunWarning::new(
+            RunWarningKind::NegativeLostInformation,
+            format!(
+                "{scene}: {n} patch(es) ({:.2}% of the area) read a negative information lost \
+                 (lost_information below 0 by more than twice its standard error), which no row of a \
+                 closed scene allows: the plug-in I_i reads high on rows sampled too thinly; read \
+                 lost_information_corrected (--color lost-information-corrected), or cast more lines",
+                100.0 * fraction
+            ),
+        )
+        .with_numbers(&[("patches", n as f64), ("area_fraction", fraction)])
+    })
 }

@@ -595,3 +595,71 @@ fn enclose_leaves_the_files_of_a_closed_scene_alone() {
         assert!(!x.is_empty() && x == y, "{name} differs");
     }
 }
+
+/// The information lost per patch, I_i^c - I_i, is at least 0 on every row of a closed scene (the
+/// log-sum inequality); a plug-in I_i on rows sampled too thinly reads it below 0, and the run warns,
+/// counting exactly the rows of the `--patches` file more than two standard errors below 0, with their
+/// area. A well-sampled scene has none and no warning.
+#[test]
+fn negative_information_lost_is_warned_of_with_the_rows_that_show_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let csv = dir.path().join("p.csv");
+    let run = |scene: &str, lines: &str| {
+        let out = scx(&[
+            "analyze",
+            scene,
+            "--lines",
+            lines,
+            "--tracer",
+            "rust",
+            "--patches",
+            csv.to_str().unwrap(),
+            "--format",
+            "json",
+            "--quiet",
+        ]);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        let warning = doc["warnings"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|w| w["code"] == "negative-lost-information")
+            .cloned();
+        (warning, read_csv(&csv))
+    };
+    let (warning, (header, rows)) = run("@fig2:a", "1e5");
+    let col = |name: &str| header.iter().position(|h| h == name).unwrap();
+    let (value, se, share) = (
+        col("lost_information"),
+        col("lost_information_stderr"),
+        col("area_fraction"),
+    );
+    let (mut n, mut area) = (0usize, 0.0);
+    for r in &rows {
+        let (v, s): (f64, f64) = (r[value].parse().unwrap(), r[se].parse().unwrap());
+        if v < -2.0 * s {
+            n += 1;
+            area += r[share].parse::<f64>().unwrap();
+        }
+    }
+    assert!(n > 100, "{n} rows below 0");
+    let warning = warning.expect("a warning");
+    let numbers = &warning["numbers"];
+    assert_eq!(numbers["patches"].as_f64().unwrap() as usize, n);
+    assert!((numbers["area_fraction"].as_f64().unwrap() - area).abs() < 1e-6);
+    assert!(warning["message"]
+        .as_str()
+        .unwrap()
+        .contains("lost_information_corrected"));
+    let (warning, (header, rows)) = run("@cube:2", "1e6");
+    let value = header.iter().position(|h| h == "lost_information").unwrap();
+    assert!(rows
+        .iter()
+        .all(|r| r[value].parse::<f64>().unwrap() > -0.01));
+    assert!(warning.is_none(), "{warning:?}");
+}
