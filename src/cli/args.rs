@@ -15,7 +15,8 @@ use scene_complexity::{ObjectSet, Planarity, Reach, ReadPolicy, SceneOptions, DE
 pub struct SceneArgs {
     /// A polygon whose corners leave its plane by at most this fraction of its size is planar (one
     /// patch); a less planar one is split into planar triangles (one warning per file).
-    #[arg(long, default_value_t = DEFAULT_PLANARITY, value_parser = parse_tolerance)]
+    #[arg(long, default_value_t = DEFAULT_PLANARITY, value_parser = parse_tolerance,
+          allow_negative_numbers = true)]
     pub planarity: f64,
     /// Refuse non-planar polygons (exit 2, naming the first) instead of splitting them.
     #[arg(long)]

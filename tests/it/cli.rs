@@ -112,6 +112,16 @@ fn bad_input_is_one_clear_error_with_exit_code_2() {
             ],
             "non-finite",
         ),
+        // A negative tolerance gets the value's own message, not the parser's "unexpected argument".
+        (
+            vec![
+                "analyze".into(),
+                "@cube".into(),
+                "--planarity".into(),
+                "-1".into(),
+            ],
+            "need a number >= 0",
+        ),
     ];
     for (args, expect) in cases {
         let args: Vec<&str> = args.iter().map(String::as_str).collect();
