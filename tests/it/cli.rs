@@ -397,17 +397,7 @@ fn convergence_marks_the_readings_analyze_flags_and_no_other() {
     ];
     let (mut marked, mut unmarked, mut notes) = (0, 0, 0);
     for lines in ["10000", "1000000"] {
-        let doc = json_of(&scx(&[
-            "analyze",
-            "@cube:10",
-            "--lines",
-            lines,
-            "--threads",
-            "1",
-            "--format",
-            "json",
-            "--quiet",
-        ]));
+        let doc = support::analyze_json(&["@cube:10", "--lines", lines, "--threads", "1"]);
         let v = &doc["visibility"];
         let row = table
             .lines()

@@ -147,19 +147,7 @@ fn flagged_readings_are_marked_and_findings_resting_on_them_say_so() {
         "1",
         "--quiet",
     ]));
-    let doc = support::json_of(&scx(&[
-        "analyze",
-        "@fig2:a",
-        "--lines",
-        "1e5",
-        "--tracer",
-        "rust",
-        "--threads",
-        "1",
-        "--format",
-        "json",
-        "--quiet",
-    ]));
+    let doc = support::analyze_json(&["@fig2:a", "--lines", "1e5", "--threads", "1"]);
     let v = &doc["visibility"];
     let isc = &v["continuous_mutual_information"];
     let (c, cse) = (

@@ -260,6 +260,15 @@ pub fn text_of(out: std::process::Output) -> String {
     String::from_utf8(out.stdout).expect("UTF-8 output")
 }
 
+/// The JSON report of a successful `scx analyze ARGS --format json --tracer rust --quiet`.
+#[cfg(feature = "cli")]
+pub fn analyze_json(args: &[&str]) -> serde_json::Value {
+    let mut all = vec!["analyze"];
+    all.extend_from_slice(args);
+    all.extend_from_slice(&["--format", "json", "--tracer", "rust", "--quiet"]);
+    json_of(&scx(&all))
+}
+
 /// The JSON document a successful `scx ... --format json` printed.
 pub fn json_of(out: &std::process::Output) -> serde_json::Value {
     assert!(
