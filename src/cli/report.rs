@@ -12,7 +12,8 @@ use scene_complexity::report::{
 use scene_complexity::VerdictRule;
 use scene_complexity::{quantity_text, Scene};
 use scene_complexity::{
-    sphere_lines, EntropyEstimator, ErrorMethod, LineBound, Sampler, Shard, StopReason, Tracing,
+    sphere_lines, sphere_lines_of_drawn, EntropyEstimator, ErrorMethod, LineBound, Sampler, Shard,
+    StopReason, Tracing,
 };
 use scene_complexity::{
     Analysis, LinesAdvice, RadiosityOutcome, Reliability, SamplingReport, TargetOutcome, Verdict,
@@ -643,9 +644,9 @@ fn through_the_box(scene: &Scene, a: &Analysis) -> String {
     match a.spec.bound {
         LineBound::Sphere => String::new(),
         bound => format!(
-            " through the bounding {} (as many as {:.0} through the sphere)",
+            " through the bounding {} (as many as {} through the sphere)",
             bound.name(),
-            sphere_lines(scene, bound, a.lines)
+            sphere_lines_of_drawn(scene, bound, a.lines)
         ),
     }
 }

@@ -10,7 +10,7 @@ use crate::analysis::{
 use crate::measure::catalogue::{Family, PatchMeasure, Unit};
 use crate::measure::Estimate;
 use crate::run::{Shard, StopReason, Tracing};
-use crate::sample::bounds::sphere_lines;
+use crate::sample::bounds::sphere_lines_of_drawn;
 use crate::sample::lines::LineSource;
 use crate::scene::Scene;
 
@@ -175,7 +175,7 @@ pub fn json(run: &Context, a: &Analysis) -> Value {
         "sampler": a.spec.sampler.name(),
         "lines_through": a.spec.bound.name(),
         "lines": a.lines,
-        "sphere_lines": sphere_lines(run.scene, a.spec.bound, a.lines).round() as u64,
+        "sphere_lines": sphere_lines_of_drawn(run.scene, a.spec.bound, a.lines),
         "seed": a.spec.seed,
         "threads": run.process.as_ref().map(|p| p.threads),
         "groups": a.groups,

@@ -316,6 +316,37 @@ pub fn share_of_sphere(scene: &Scene, bound: LineBound) -> f64 {
     }
 }
 
+/// The count of lines through `scene`'s bounding sphere that a report gives for `drawn` lines drawn as
+/// `bound` says: of the counts whose lines to draw ([`lines_to_draw`]) are exactly `drawn`, the
+/// roundest (most trailing decimal zeros; the smallest of equals). Each is worth no more than the lines
+/// drawn are, so the report's "as many as" holds for any of them. `--lines 1e6` through a cube's box
+/// draws 636,620 lines, worth 1,000,000.4 sphere lines ([`sphere_lines`]): the report says 1000000,
+/// the count asked, rather than 1000000 or 1000001 by rounding's luck. The count asked always draws
+/// `drawn`, so the one given differs from it by at most the few counts that draw as many (one or two
+/// for a box smaller than the sphere). A count no sphere count draws (a run stopped early through a
+/// container larger than the sphere) gives its worth, rounded.
+pub fn sphere_lines_of_drawn(scene: &Scene, bound: LineBound, drawn: u64) -> u64 {
+    if bound == LineBound::Sphere {
+        return drawn;
+    }
+    let worth = sphere_lines(scene, bound, drawn);
+    let around = worth.floor() as u64;
+    (around.saturating_sub(4)..=around.saturating_add(4))
+        .filter(|&n| lines_to_draw(scene, bound, n) == drawn)
+        .max_by_key(|&n| (trailing_decimal_zeros(n), std::cmp::Reverse(n)))
+        .unwrap_or(worth.round() as u64)
+}
+
+/// How many decimal zeros end `n` (none for 0).
+fn trailing_decimal_zeros(mut n: u64) -> u32 {
+    let mut zeros = 0;
+    while n > 0 && n % 10 == 0 {
+        n /= 10;
+        zeros += 1;
+    }
+    zeros
+}
+
 /// How many lines to draw as `bound` says for a run worth `sphere_lines` lines through `scene`'s
 /// bounding sphere: as many through the sphere; through the box the fewest whose worth
 /// ([`sphere_lines`]) is at least that many, `ceil(p * sphere_lines)` ([`BoundingBox::share_of_sphere`]),
@@ -390,6 +421,37 @@ mod tests {
 
     const LO: [f64; 3] = [-0.5, -1.0, 0.25];
     const HI: [f64; 3] = [0.5, 1.0, 3.25];
+
+    /// A report's sphere lines for the lines a count draws through a cube's box or an octahedron's
+    /// polytope are that count when it is round, and otherwise a count that draws the same lines,
+    /// within two of it and worth no more than they are.
+    #[test]
+    fn reports_give_the_round_count_that_draws_the_lines() {
+        for (spec, bound) in [
+            ("@cube:4", LineBound::Box),
+            ("@octahedron", LineBound::Polytope),
+        ] {
+            let scene = crate::scenes::load(spec).unwrap();
+            for asked in [100_000u64, 1_000_000, 30_000_000, 2_000, 123_457, 1_001, 7] {
+                let drawn = lines_to_draw(&scene, bound, asked);
+                let given = sphere_lines_of_drawn(&scene, bound, drawn);
+                assert_eq!(lines_to_draw(&scene, bound, given), drawn, "{spec} {asked}");
+                assert!(given.abs_diff(asked) <= 2, "{spec}: {asked} gave {given}");
+                assert!(
+                    given as f64 <= sphere_lines(&scene, bound, drawn),
+                    "{spec} {asked}"
+                );
+                if asked % 1000 == 0 {
+                    assert_eq!(given, asked, "{spec}");
+                }
+            }
+        }
+        let cube = crate::scenes::load("@cube:4").unwrap();
+        assert_eq!(
+            sphere_lines_of_drawn(&cube, LineBound::Sphere, 12_345),
+            12_345
+        );
+    }
 
     /// 2^16 lines through the box `LO..HI` from both samplers (independent: 16 batches; Sobol': the first
     /// points of group 0).
