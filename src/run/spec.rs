@@ -238,9 +238,10 @@ impl RunSpec {
     /// The bound `--lines-through auto` chooses for `scene`: for the Sobol' sampler, the tightest
     /// container of the scene ([`tightest_container`]: the box for rooms, the polytope for solids and
     /// objects, the sphere when neither is smaller), whose lines cover the space of lines far more evenly
-    /// (docs/sampling.md, "Lines through the bounding box"); the sphere otherwise. For independent lines
-    /// a container would save only the lines that miss it, which cost little, and the sphere keeps the
-    /// paper's lines; bundles and the environment of `enclose` need the sphere.
+    /// (docs/sampling.md, "Lines through the bounding box"); the sphere otherwise. Independent lines keep
+    /// the paper's sphere, as every other command draws them (a smaller container would leave their
+    /// estimates' distribution alone and save time: measured in the docs); bundles and the environment
+    /// of `enclose` need the sphere.
     pub fn auto_bound(&self, scene: &Scene) -> LineBound {
         let sobol = self.sampler == Sampler::Sobol && self.source == LineSource::Independent;
         if sobol && !self.enclose {
