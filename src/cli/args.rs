@@ -399,6 +399,19 @@ pub fn target_measure_parser() -> impl clap::builder::TypedValueParser<Value = M
     })
 }
 
+/// Refuses `--target-measure` without `--target-stderr`: it names the measure a precision target
+/// watches, and with no target it would be accepted and do nothing.
+pub fn check_target_measure(measure: Option<Measure>, stderr: Option<f64>) -> Result<(), String> {
+    match (measure, stderr) {
+        (Some(m), None) => Err(format!(
+            "--target-measure {} needs --target-stderr E: it names the measure a precision target \
+             watches, and there is no target without --target-stderr",
+            m.key()
+        )),
+        _ => Ok(()),
+    }
+}
+
 fn parse_query(s: &str) -> Result<Query, String> {
     Query::parse(s).map_err(|e| e.to_string())
 }

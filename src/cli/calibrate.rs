@@ -11,8 +11,8 @@ use scene_complexity::calibrate::{
 use scene_complexity::{LinesThrough, Measure, Sampler};
 
 use super::args::{
-    parse_count, parse_positive, parse_seed, parse_whole_in, target_measure_parser, ReportOutput,
-    Threads, Tracer, TracerArg, MAX_WHOLE,
+    check_target_measure, parse_count, parse_positive, parse_seed, parse_whole_in,
+    target_measure_parser, ReportOutput, Threads, Tracer, TracerArg, MAX_WHOLE,
 };
 use super::exit::{Exit, Failure};
 use super::output::{self, check_all};
@@ -49,9 +49,10 @@ pub struct CalibrateArgs {
     /// `--target-measure` reaches this on an ok reading, or at `--lines`.
     #[arg(long, requires = "scene", value_parser = parse_positive)]
     target_stderr: Option<f64>,
-    /// The measure the target watches (with `--scene`).
-    #[arg(long, requires = "scene", default_value = Measure::DEFAULT_TARGET.key(), value_parser = target_measure_parser())]
-    target_measure: Measure,
+    /// The measure the target watches (with `--scene` and `--target-stderr`) [default:
+    /// mutual_information_corrected].
+    #[arg(long, requires = "scene", value_parser = target_measure_parser())]
+    target_measure: Option<Measure>,
     /// How the runs draw their lines, for every cell (the suite's or `--scene`'s): `independent` or
     /// `sobol` (`scx analyze --sampler`).
     #[arg(long, default_value = "independent", value_parser = parse_sampler)]
@@ -118,7 +119,7 @@ fn cells(args: &CalibrateArgs) -> Vec<Cell> {
             .collect();
     }
     let target = args.target_stderr.map(|stderr| CellTarget {
-        measure: args.target_measure,
+        measure: args.target_measure.unwrap_or(Measure::DEFAULT_TARGET),
         stderr,
     });
     args.scene
@@ -140,6 +141,7 @@ fn cells(args: &CalibrateArgs) -> Vec<Cell> {
 
 /// Runs `scx calibrate`.
 pub fn run(args: &CalibrateArgs) -> Result<Exit, Failure> {
+    check_target_measure(args.target_measure, args.target_stderr).map_err(Failure::bad_input)?;
     let named = [
         ("-o", &args.out.output),
         ("--csv", &args.csv),

@@ -146,6 +146,70 @@ fn a_precision_target_on_a_measure_not_computed_is_refused() {
     assert_eq!(doc["stop_reason"], "target_stderr");
 }
 
+/// An option that only tunes another one is refused without it (exit 2, saying what it needs, nothing
+/// on stdout): accepted, it did nothing, and the user believed it had. With the option it tunes, it is
+/// taken.
+#[test]
+fn an_option_without_the_one_it_tunes_is_refused() {
+    let cases: [(&[&str], &str); 3] = [
+        (
+            &["analyze", "@cube:2", "--checkpoint-every", "30s"],
+            "--checkpoint-every needs --checkpoint FILE (or --resume FILE)",
+        ),
+        (
+            &["analyze", "@cube:2", "--target-measure", "accuracy"],
+            "--target-measure accuracy needs --target-stderr E",
+        ),
+        (
+            &[
+                "calibrate",
+                "--scene",
+                "@cube:1",
+                "--target-measure",
+                "accuracy",
+            ],
+            "--target-measure accuracy needs --target-stderr E",
+        ),
+    ];
+    for (args, expect) in cases {
+        let mut all = args.to_vec();
+        all.extend_from_slice(&["--lines", "1e4", "--threads", "1"]);
+        let out = scx(&all);
+        let err = stderr_of(&out);
+        assert_eq!(out.status.code(), Some(2), "{all:?}: {err}");
+        assert!(err.contains(expect), "{all:?}: {err}");
+        assert!(out.stdout.is_empty(), "{all:?}: no report");
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let state = dir.path().join("c.scx");
+    let state = state.to_str().unwrap();
+    let out = scx(&[
+        "analyze",
+        "@cube:2",
+        "--lines",
+        "1e4",
+        "--threads",
+        "1",
+        "--checkpoint",
+        state,
+        "--checkpoint-every",
+        "30s",
+        "--target-stderr",
+        "0.5",
+        "--target-measure",
+        "continuous_mutual_information",
+        "--format",
+        "json",
+        "-q",
+    ]);
+    let doc = json_of(&out);
+    assert_eq!(doc["target"]["measure"], "continuous_mutual_information");
+    assert!(
+        std::path::Path::new(state).is_file(),
+        "the checkpoint was saved"
+    );
+}
+
 /// Readings that break a bound of the theory are flagged, in JSON and in the table.
 #[test]
 fn impossible_readings_are_flagged_not_printed_bare() {
