@@ -20,6 +20,7 @@ use super::args::{
     target_measure_parser, ReportOutput, RunOptions,
 };
 use super::exit::{Exit, Failure};
+use super::file_kind::report_format;
 use super::output::{self, warn};
 use super::patch_files::PatchFiles;
 use super::report::{self, Format};
@@ -88,14 +89,15 @@ pub struct AnalyzeArgs {
     /// after the scene's patches.
     #[arg(long)]
     enclose: bool,
-    /// Output format: `table` (for people), `json` (one document with every field, units and verdicts),
-    /// `csv` (one row per measure: scene, lines, seed, tracer, patches, escape_fraction, seconds, family,
-    /// measure, unit, value, stderr, reliability, corrected, corrected_stderr, corrected_reliability,
-    /// then the bounds each reading breaks and the bias and lines behind an `undersampled` verdict:
-    /// flags, corrected_flags, estimated_bias, lines_needed, corrected_estimated_bias,
-    /// corrected_lines_needed).
-    #[arg(long, value_enum, default_value_t = Format::Table)]
-    format: Format,
+    /// Output format (default: the one the extension of -o names, `.json` or `.csv`, else `table`; one
+    /// that contradicts the extension is refused): `table` (for people), `json` (one document with every
+    /// field, units and verdicts), `csv` (one row per measure: scene, lines, seed, tracer, patches,
+    /// escape_fraction, seconds, family, measure, unit, value, stderr, reliability, corrected,
+    /// corrected_stderr, corrected_reliability, then the bounds each reading breaks and the bias and
+    /// lines behind an `undersampled` verdict: flags, corrected_flags, estimated_bias, lines_needed,
+    /// corrected_estimated_bias, corrected_lines_needed).
+    #[arg(long, value_enum)]
+    format: Option<Format>,
     #[command(flatten)]
     out: ReportOutput,
     /// Save the run's state to FILE at the end (also when interrupted): `scx merge` reports it,
@@ -158,9 +160,6 @@ fn parse_shard(s: &str) -> Result<Shard, String> {
 /// run will have what they need (a resumed one is checked once its state is read).
 fn check_patch_files(args: &AnalyzeArgs) -> Result<(), Failure> {
     let f = &args.files;
-    if f.is_empty() {
-        return Ok(());
-    }
     f.check()?;
     if !f.form_factors.is_empty()
         && args.measures.as_ref().is_some_and(|m| {
@@ -414,6 +413,7 @@ fn check_tuning_options(args: &AnalyzeArgs) -> Result<(), Failure> {
 /// Runs `scx analyze`.
 pub fn run(args: &AnalyzeArgs) -> Result<Exit, Failure> {
     check_tuning_options(args)?;
+    let format = report_format("analyze", args.format, args.out.output.as_deref(), "")?;
     if args.shard.is_some() && args.save.is_none() && args.checkpoint.is_none() {
         return Err(Failure::bad_input(
             "--shard needs --save FILE (or --checkpoint FILE): a shard's work is only of use saved",
@@ -531,7 +531,7 @@ pub fn run(args: &AnalyzeArgs) -> Result<Exit, Failure> {
         shard: identity.shard,
         ..runner.info()
     };
-    let text = report::render(args.format, &run, &analysis);
+    let text = report::render(format, &run, &analysis);
     let mut failures = Vec::new();
     failures.extend(output::emit(args.out.output.as_deref(), &text).err());
     failures.extend(

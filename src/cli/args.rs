@@ -175,7 +175,8 @@ impl RunOptions {
 #[derive(clap::Args, Debug, Clone)]
 pub struct ReportOutput {
     /// Write the report to FILE instead of standard output (`-`: standard output; checked writable
-    /// before any line is cast).
+    /// before any line is cast). A `.json` or `.csv` name picks that format when --format is not given;
+    /// one that names a format the command does not write, or that --format contradicts, is refused.
     #[arg(short, long, value_name = "FILE")]
     pub output: Option<PathBuf>,
 }

@@ -15,6 +15,7 @@ use super::args::{
     target_measure_parser, ReportOutput, Threads, Tracer, TracerArg, MAX_WHOLE,
 };
 use super::exit::{Exit, Failure};
+use super::file_kind::{check_csv, text_report};
 use super::output::{self, check_all};
 use super::runner::thread_pool;
 
@@ -70,10 +71,10 @@ pub struct CalibrateArgs {
     threads: Threads,
     #[command(flatten)]
     tracer: Tracer,
-    /// Also write the table as CSV (one row per cell, measure and basis).
+    /// Also write the table as CSV to FILE (.csv; one row per cell, measure and basis).
     #[arg(long, value_name = "FILE")]
     csv: Option<PathBuf>,
-    /// Also write every run's readings as CSV (one row per run and measure).
+    /// Also write every run's readings as CSV to FILE (.csv; one row per run and measure).
     #[arg(long, value_name = "FILE")]
     readings: Option<PathBuf>,
     #[command(flatten)]
@@ -142,6 +143,14 @@ fn cells(args: &CalibrateArgs) -> Vec<Cell> {
 /// Runs `scx calibrate`.
 pub fn run(args: &CalibrateArgs) -> Result<Exit, Failure> {
     check_target_measure(args.target_measure, args.target_stderr).map_err(Failure::bad_input)?;
+    text_report(
+        "calibrate",
+        "Markdown",
+        args.out.output.as_deref(),
+        " (the table as CSV: --csv FILE; every run's readings: --readings FILE)",
+    )?;
+    check_csv("--csv", args.csv.as_deref())?;
+    check_csv("--readings", args.readings.as_deref())?;
     let named = [
         ("-o", &args.out.output),
         ("--csv", &args.csv),

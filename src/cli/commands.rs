@@ -4,6 +4,7 @@
 use clap::{Parser, Subcommand};
 
 use super::exit::{Exit, Failure};
+use super::file_kind::text_report;
 use super::{
     analyze, calibrate, convergence, crosscheck, docs, export, merge, refine, render, reproduce,
 };
@@ -128,6 +129,7 @@ pub fn scenes(args: &ScenesArgs) -> Result<Exit, Failure> {
         .iter()
         .map(|b| format!("{:<18} {}\n", b.usage, b.description))
         .collect();
+    text_report("scenes", "a listing", args.out.output.as_deref(), "")?;
     output::check_all(args.out.output.as_deref())?;
     output::emit(args.out.output.as_deref(), &list)?;
     Ok(Exit::Ok)

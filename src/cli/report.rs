@@ -20,6 +20,7 @@ use scene_complexity::{
 };
 use scene_complexity::{Estimate, Family, Measure, RunWarningKind};
 
+use super::file_kind::{Kind, ReportFormat};
 use super::table::{fixed, Align, Table};
 
 /// Output formats of a report.
@@ -31,6 +32,16 @@ pub enum Format {
     Json,
     /// CSV rows with a header.
     Csv,
+}
+
+impl ReportFormat for Format {
+    fn kind(self) -> Kind {
+        match self {
+            Format::Table => Kind::Text,
+            Format::Json => Kind::Json,
+            Format::Csv => Kind::Csv,
+        }
+    }
 }
 
 /// The report of an analysis in `format`.
