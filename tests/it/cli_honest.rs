@@ -210,6 +210,77 @@ fn an_option_without_the_one_it_tunes_is_refused() {
     );
 }
 
+/// The exit codes a help lists: each code with its meaning, its continuation lines joined.
+fn exit_codes_of(help: &str) -> Vec<(String, String)> {
+    let block = help
+        .split("Exit codes:\n")
+        .nth(1)
+        .unwrap_or_else(|| panic!("no exit codes in: {help}"));
+    let mut codes: Vec<(String, String)> = Vec::new();
+    for line in block.lines().take_while(|l| !l.trim().is_empty()) {
+        match codes.last_mut() {
+            Some((_, meaning)) if line.starts_with("       ") => {
+                meaning.push(' ');
+                meaning.push_str(line.trim());
+            }
+            _ => {
+                let (code, meaning) = line.trim().split_once(' ').unwrap();
+                codes.push((code.to_string(), meaning.trim().to_string()));
+            }
+        }
+    }
+    codes
+}
+
+/// Every help that lists the exit codes lists the same ones, with the words of docs/cli.md and the
+/// README; and the codes are what the commands return (exit 3 for a run state that cannot be read,
+/// 2 for a scene that cannot be, and for a state that is not one).
+#[test]
+fn exit_codes_mean_one_thing_everywhere() {
+    let help = |args: &[&str]| String::from_utf8_lossy(&scx(args).stdout).into_owned();
+    let codes = exit_codes_of(&help(&["--help"]));
+    let listed: Vec<&str> = codes.iter().map(|(c, _)| c.as_str()).collect();
+    assert_eq!(listed, ["0", "1", "2", "3", "130"]);
+    for command in ["analyze", "render"] {
+        assert_eq!(
+            exit_codes_of(&help(&[command, "--help"])),
+            codes,
+            "{command}"
+        );
+    }
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    for doc in ["docs/cli.md", "README.md"] {
+        let text = std::fs::read_to_string(root.join(doc)).unwrap();
+        for (code, meaning) in &codes {
+            let row = format!("| {code} | {meaning} |");
+            assert!(text.contains(&row), "{doc} lacks `{row}`");
+        }
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let missing = dir.path().join("missing.scx");
+    let missing = missing.to_str().unwrap();
+    let junk = dir.path().join("junk.scx");
+    std::fs::write(&junk, "not a state").unwrap();
+    let cases: [(&[&str], i32, &str); 4] = [
+        (&["analyze", "--resume", missing], 3, "cannot read"),
+        (&["merge", missing], 3, "cannot read"),
+        (
+            &["merge", junk.to_str().unwrap()],
+            2,
+            "not an scx run state",
+        ),
+        (&["analyze", "/no/such/scene.obj"], 2, "no such file"),
+    ];
+    for (args, code, words) in cases {
+        let mut all = args.to_vec();
+        all.extend_from_slice(&["--threads", "1"]);
+        let out = scx(&all);
+        let err = stderr_of(&out);
+        assert_eq!(out.status.code(), Some(code), "{all:?}: {err}");
+        assert!(err.contains(words), "{all:?}: {err}");
+    }
+}
+
 /// Readings that break a bound of the theory are flagged, in JSON and in the table.
 #[test]
 fn impossible_readings_are_flagged_not_printed_bare() {
