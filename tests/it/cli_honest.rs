@@ -94,6 +94,65 @@ fn a_precision_target_needs_a_reliable_reading() {
     assert!((mi["value"].as_f64().unwrap() - 1.12257).abs() < 4.0 * 0.005);
 }
 
+/// The table says what became of a precision target in words that are true: a met target's run is
+/// not called partial (it was: "covers lines 0..393216 of the run's 1000000000000 (a partial run ...)");
+/// an unmet one says so, and that the run reached its cap, as the JSON's `stop_reason` and `met` do. A
+/// shard is still a partial run.
+#[test]
+fn the_table_says_whether_a_target_was_met_and_what_ended_the_run() {
+    let table = |args: &[&str]| {
+        let mut all = vec![
+            "analyze",
+            "@cube:4",
+            "--threads",
+            "1",
+            "--tracer",
+            "rust",
+            "-q",
+        ];
+        all.extend_from_slice(args);
+        support::text_of(scx(&all))
+    };
+    for capped in [&["--lines", "1e7"][..], &[]] {
+        let text = table(&[&["--target-stderr", "0.01"], capped].concat());
+        assert!(
+            text.contains("precision target met: mutual_information_corrected standard error")
+                && text.contains("and the reading is ok")
+                && text.contains("stopped by: the precision target (--target-stderr) was met"),
+            "{text}"
+        );
+        assert!(
+            !text.contains("partial") && !text.contains("covers") && !text.contains("NOT met"),
+            "{text}"
+        );
+    }
+    let text = table(&["--target-stderr", "0.001", "--lines", "1e4"]);
+    let last = text.lines().last().unwrap();
+    assert!(
+        last.starts_with("precision target NOT met: mutual_information_corrected standard error")
+            && last.contains("(goal 1.000e-3)")
+            && last.contains("when the run reached its cap (--lines) at 10000 lines"),
+        "{text}"
+    );
+    let doc = json_run(&["@cube:4", "--target-stderr", "0.001", "--lines", "1e4"]);
+    assert_eq!(doc["stop_reason"], "lines");
+    assert_eq!(doc["target"]["met"], false);
+    let dir = tempfile::tempdir().unwrap();
+    let state = dir.path().join("s.scx");
+    let text = table(&[
+        "--lines",
+        "1e6",
+        "--shard",
+        "1/2",
+        "--save",
+        state.to_str().unwrap(),
+    ]);
+    assert!(
+        text.contains("of the run's 1000000, shard 1 of 2 (a partial run"),
+        "{text}"
+    );
+}
+
 /// A precision target on a measure the run does not compute is refused before any line is cast (exit
 /// 2, naming the measure): its reading never comes, and the run went on to its cap, or without one for
 /// ever. A target on a measure the run does compute still runs.
