@@ -16,10 +16,11 @@ use scene_complexity::{
 };
 
 use super::args::{
-    parse_count, parse_positive, parse_seconds, parse_whole_in, target_measure_parser,
-    ReportOutput, RunOptions,
+    check_target_measure, parse_count, parse_positive, parse_seconds, parse_whole_in,
+    target_measure_parser, ReportOutput, RunOptions,
 };
 use super::exit::{Exit, Failure};
+use super::file_kind::report_format;
 use super::output::{self, warn};
 use super::patch_files::PatchFiles;
 use super::report::{self, Format};
@@ -51,9 +52,10 @@ pub struct AnalyzeArgs {
     /// (verdict `ok`); then --lines (and --seconds) only cap the run.
     #[arg(long, value_parser = parse_positive, allow_negative_numbers = true)]
     target_stderr: Option<f64>,
-    /// The measure --target-stderr watches.
-    #[arg(long, default_value = Measure::DEFAULT_TARGET.key(), value_parser = target_measure_parser())]
-    target_measure: Measure,
+    /// The measure --target-stderr watches (only with --target-stderr) [default:
+    /// mutual_information_corrected].
+    #[arg(long, value_parser = target_measure_parser())]
+    target_measure: Option<Measure>,
     /// Cast the lines in bundles of G x G parallel lines (jittered grid over the disc, traced as adjacent
     /// packets); 0 casts independent lines. The standard errors include the correlation within a bundle.
     #[arg(long, default_value_t = 0, value_parser = parse_bundle)]
@@ -87,14 +89,15 @@ pub struct AnalyzeArgs {
     /// after the scene's patches.
     #[arg(long)]
     enclose: bool,
-    /// Output format: `table` (for people), `json` (one document with every field, units and verdicts),
-    /// `csv` (one row per measure: scene, lines, seed, tracer, patches, escape_fraction, seconds, family,
-    /// measure, unit, value, stderr, reliability, corrected, corrected_stderr, corrected_reliability,
-    /// then the bounds each reading breaks and the bias and lines behind an `undersampled` verdict:
-    /// flags, corrected_flags, estimated_bias, lines_needed, corrected_estimated_bias,
-    /// corrected_lines_needed).
-    #[arg(long, value_enum, default_value_t = Format::Table)]
-    format: Format,
+    /// Output format (default: the one the extension of -o names, `.json` or `.csv`, else `table`; one
+    /// that contradicts the extension is refused): `table` (for people), `json` (one document with every
+    /// field, units and verdicts), `csv` (one row per measure: scene, lines, seed, tracer, patches,
+    /// escape_fraction, seconds, family, measure, unit, value, stderr, reliability, corrected,
+    /// corrected_stderr, corrected_reliability, then the bounds each reading breaks and the bias and
+    /// lines behind an `undersampled` verdict: flags, corrected_flags, estimated_bias, lines_needed,
+    /// corrected_estimated_bias, corrected_lines_needed).
+    #[arg(long, value_enum)]
+    format: Option<Format>,
     #[command(flatten)]
     out: ReportOutput,
     /// Save the run's state to FILE at the end (also when interrupted): `scx merge` reports it,
@@ -111,10 +114,10 @@ pub struct AnalyzeArgs {
     /// run killed loses only the work since the last checkpoint).
     #[arg(long, value_name = "FILE")]
     checkpoint: Option<PathBuf>,
-    /// Time between checkpoints: seconds (`300`), or with units (`30s`, `5m`, `1h30m`).
-    #[arg(long, value_name = "DURATION", default_value = "300", value_parser = parse_seconds,
-          allow_negative_numbers = true)]
-    checkpoint_every: f64,
+    /// Time between checkpoints, with --checkpoint (or --resume, which saves back as it goes):
+    /// seconds (`300`, the default), or with units (`30s`, `5m`, `1h30m`).
+    #[arg(long, value_name = "DURATION", value_parser = parse_seconds, allow_negative_numbers = true)]
+    checkpoint_every: Option<f64>,
     /// Continue the run saved in FILE (by --save or --checkpoint) with its own settings, up to --lines
     /// (more lines than first asked are fine for a run of 262144 lines or more; a shorter one is cut
     /// into smaller batches and continues only to a few lines more, as the message says), and save it
@@ -157,9 +160,6 @@ fn parse_shard(s: &str) -> Result<Shard, String> {
 /// run will have what they need (a resumed one is checked once its state is read).
 fn check_patch_files(args: &AnalyzeArgs) -> Result<(), Failure> {
     let f = &args.files;
-    if f.is_empty() {
-        return Ok(());
-    }
     f.check()?;
     if !f.form_factors.is_empty()
         && args.measures.as_ref().is_some_and(|m| {
@@ -208,7 +208,7 @@ fn spec_of(args: &AnalyzeArgs) -> Result<RunSpec, Failure> {
     let budget = Budget {
         seconds: args.seconds,
         target: args.target_stderr.map(|stderr| Target {
-            measure: args.target_measure,
+            measure: args.target_measure.unwrap_or(Measure::DEFAULT_TARGET),
             stderr,
         }),
     };
@@ -395,8 +395,25 @@ impl Checkpoints<'_> {
     }
 }
 
+/// Seconds between checkpoints when --checkpoint-every is not given.
+const DEFAULT_CHECKPOINT_EVERY: f64 = 300.0;
+
+/// Refuses an option given without the one it tunes: accepted, it would do nothing, and the user would
+/// believe it did.
+fn check_tuning_options(args: &AnalyzeArgs) -> Result<(), Failure> {
+    if args.checkpoint_every.is_some() && args.checkpoint.is_none() && args.resume.is_none() {
+        return Err(Failure::bad_input(
+            "--checkpoint-every needs --checkpoint FILE (or --resume FILE): it sets how often the \
+             run's state is saved to that file, and without one nothing is saved",
+        ));
+    }
+    check_target_measure(args.target_measure, args.target_stderr).map_err(Failure::bad_input)
+}
+
 /// Runs `scx analyze`.
 pub fn run(args: &AnalyzeArgs) -> Result<Exit, Failure> {
+    check_tuning_options(args)?;
+    let format = report_format("analyze", args.format, args.out.output.as_deref(), "")?;
     if args.shard.is_some() && args.save.is_none() && args.checkpoint.is_none() {
         return Err(Failure::bad_input(
             "--shard needs --save FILE (or --checkpoint FILE): a shard's work is only of use saved",
@@ -458,10 +475,11 @@ pub fn run(args: &AnalyzeArgs) -> Result<Exit, Failure> {
         ..identity.spec.clone()
     };
     let scope = Scope::of(identity.shard);
+    let every = args.checkpoint_every.unwrap_or(DEFAULT_CHECKPOINT_EVERY);
     let mut checkpoints = Checkpoints {
         path: checkpoint,
         // Longer than the clock can count (`--checkpoint-every 1e30`): a checkpoint at the end only.
-        every: Duration::try_from_secs_f64(args.checkpoint_every).unwrap_or(Duration::MAX),
+        every: Duration::try_from_secs_f64(every).unwrap_or(Duration::MAX),
         last: Instant::now(),
         failed: None,
         before,
@@ -484,7 +502,7 @@ pub fn run(args: &AnalyzeArgs) -> Result<Exit, Failure> {
                 &mut state,
                 CastOptions {
                     scope,
-                    round_seconds: checkpoint.map(|_| args.checkpoint_every.min(30.0) / 2.0),
+                    round_seconds: checkpoint.map(|_| every.min(30.0) / 2.0),
                 },
                 control,
                 &mut |s| checkpoints.after_round(&identity, s, control),
@@ -513,7 +531,7 @@ pub fn run(args: &AnalyzeArgs) -> Result<Exit, Failure> {
         shard: identity.shard,
         ..runner.info()
     };
-    let text = report::render(args.format, &run, &analysis);
+    let text = report::render(format, &run, &analysis);
     let mut failures = Vec::new();
     failures.extend(output::emit(args.out.output.as_deref(), &text).err());
     failures.extend(

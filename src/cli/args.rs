@@ -175,7 +175,8 @@ impl RunOptions {
 #[derive(clap::Args, Debug, Clone)]
 pub struct ReportOutput {
     /// Write the report to FILE instead of standard output (`-`: standard output; checked writable
-    /// before any line is cast).
+    /// before any line is cast). A `.json` or `.csv` name picks that format when --format is not given;
+    /// one that names a format the command does not write, or that --format contradicts, is refused.
     #[arg(short, long, value_name = "FILE")]
     pub output: Option<PathBuf>,
 }
@@ -397,6 +398,19 @@ pub fn target_measure_parser() -> impl clap::builder::TypedValueParser<Value = M
     clap::builder::TypedValueParser::map(clap::builder::PossibleValuesParser::new(values), |key| {
         Measure::target_named(&key).expect("a possible value names a target")
     })
+}
+
+/// Refuses `--target-measure` without `--target-stderr`: it names the measure a precision target
+/// watches, and with no target it would be accepted and do nothing.
+pub fn check_target_measure(measure: Option<Measure>, stderr: Option<f64>) -> Result<(), String> {
+    match (measure, stderr) {
+        (Some(m), None) => Err(format!(
+            "--target-measure {} needs --target-stderr E: it names the measure a precision target \
+             watches, and there is no target without --target-stderr",
+            m.key()
+        )),
+        _ => Ok(()),
+    }
 }
 
 fn parse_query(s: &str) -> Result<Query, String> {

@@ -11,10 +11,11 @@ use scene_complexity::calibrate::{
 use scene_complexity::{LinesThrough, Measure, Sampler};
 
 use super::args::{
-    parse_count, parse_positive, parse_seed, parse_whole_in, target_measure_parser, ReportOutput,
-    Threads, Tracer, TracerArg, MAX_WHOLE,
+    check_target_measure, parse_count, parse_positive, parse_seed, parse_whole_in,
+    target_measure_parser, ReportOutput, Threads, Tracer, TracerArg, MAX_WHOLE,
 };
 use super::exit::{Exit, Failure};
+use super::file_kind::{check_csv, text_report};
 use super::output::{self, check_all};
 use super::runner::thread_pool;
 
@@ -49,9 +50,10 @@ pub struct CalibrateArgs {
     /// `--target-measure` reaches this on an ok reading, or at `--lines`.
     #[arg(long, requires = "scene", value_parser = parse_positive)]
     target_stderr: Option<f64>,
-    /// The measure the target watches (with `--scene`).
-    #[arg(long, requires = "scene", default_value = Measure::DEFAULT_TARGET.key(), value_parser = target_measure_parser())]
-    target_measure: Measure,
+    /// The measure the target watches (with `--scene` and `--target-stderr`) [default:
+    /// mutual_information_corrected].
+    #[arg(long, requires = "scene", value_parser = target_measure_parser())]
+    target_measure: Option<Measure>,
     /// How the runs draw their lines, for every cell (the suite's or `--scene`'s): `independent` or
     /// `sobol` (`scx analyze --sampler`).
     #[arg(long, default_value = "independent", value_parser = parse_sampler)]
@@ -69,10 +71,10 @@ pub struct CalibrateArgs {
     threads: Threads,
     #[command(flatten)]
     tracer: Tracer,
-    /// Also write the table as CSV (one row per cell, measure and basis).
+    /// Also write the table as CSV to FILE (.csv; one row per cell, measure and basis).
     #[arg(long, value_name = "FILE")]
     csv: Option<PathBuf>,
-    /// Also write every run's readings as CSV (one row per run and measure).
+    /// Also write every run's readings as CSV to FILE (.csv; one row per run and measure).
     #[arg(long, value_name = "FILE")]
     readings: Option<PathBuf>,
     #[command(flatten)]
@@ -118,7 +120,7 @@ fn cells(args: &CalibrateArgs) -> Vec<Cell> {
             .collect();
     }
     let target = args.target_stderr.map(|stderr| CellTarget {
-        measure: args.target_measure,
+        measure: args.target_measure.unwrap_or(Measure::DEFAULT_TARGET),
         stderr,
     });
     args.scene
@@ -140,6 +142,15 @@ fn cells(args: &CalibrateArgs) -> Vec<Cell> {
 
 /// Runs `scx calibrate`.
 pub fn run(args: &CalibrateArgs) -> Result<Exit, Failure> {
+    check_target_measure(args.target_measure, args.target_stderr).map_err(Failure::bad_input)?;
+    text_report(
+        "calibrate",
+        "Markdown",
+        args.out.output.as_deref(),
+        " (the table as CSV: --csv FILE; every run's readings: --readings FILE)",
+    )?;
+    check_csv("--csv", args.csv.as_deref())?;
+    check_csv("--readings", args.readings.as_deref())?;
     let named = [
         ("-o", &args.out.output),
         ("--csv", &args.csv),

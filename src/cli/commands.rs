@@ -4,24 +4,34 @@
 use clap::{Parser, Subcommand};
 
 use super::exit::{Exit, Failure};
+use super::file_kind::text_report;
 use super::{
     analyze, calibrate, convergence, crosscheck, docs, export, merge, refine, render, reproduce,
 };
 use super::{args, output};
 
-/// The exit codes as `--help` lists them.
-const EXIT_CODES: &str = "\
-Exit codes:
-  0    success
-  1    a check failed (crosscheck found lines that differ) or the tracer failed
-  2    bad input or usage (a scene that cannot be read, a value out of range)
-  3    a file could not be read or written (named in the message)
-  130  interrupted (Ctrl-C): the report printed covers the lines gathered so far";
+/// The exit codes as `--help` lists them (`scx --help` and the commands that cast lines), one text so
+/// that no help says otherwise; docs/cli.md, "Exit codes", has the same words, which a test compares.
+macro_rules! exit_codes {
+    () => {
+        "Exit codes:
+  0    success; also a run stopped by --seconds or --target-stderr, the target met or not (the
+       report says which)
+  1    a check failed (crosscheck found lines that differ), the tracer failed, or scx failed (a
+       bug: the message says so)
+  2    bad input or usage: an option or value refused, a scene that cannot be read (the message
+       names the file and line), bad materials, a run state that is damaged or of another run
+  3    a file could not be written (every output is checked before any line is cast), or a run
+       state could not be read (--resume, merge: the message gives the system's reason) or is
+       held by a live run
+  130  interrupted (Ctrl-C): the report printed covers the lines gathered so far"
+    };
+}
 
 /// scx: how hard is a 3D scene to light and to mesh? Information-theoretic scene complexity
 /// (Feixas, del Acebo, Bekaert, Sbert, Eurographics 1999) from global lines.
 #[derive(Parser, Debug)]
-#[command(name = "scx", version, about, long_about = None, after_help = EXIT_CODES)]
+#[command(name = "scx", version, about, long_about = None, after_help = exit_codes!())]
 pub struct Cli {
     #[command(subcommand)]
     pub command: Command,
@@ -41,8 +51,7 @@ pub enum Command {
         "  scx analyze @cube:30 --target-stderr 0.002 --lines 1e9\n",
         "  scx analyze @fig2:a --lines 1e7 --patches patches.csv --form-factors ff.mtx\n",
         "  cat room.obj | scx analyze - --lines 1e6\n\n",
-        "Exit codes: 0 success, 1 the tracer failed, 2 bad input, 3 a file could not be written, \
-         130 interrupted (the report covers the lines gathered)."
+        exit_codes!()
     ))]
     Analyze(analyze::AnalyzeArgs),
     /// List the built-in scenes and their parameters.
@@ -76,8 +85,7 @@ pub enum Command {
         "  scx render @fig2:a --color lost-information --per-area --lines 1e7 -o fig2a.png\n",
         "  scx render @cornell --color radiosity -o cornell.png --patches-mesh cornell.ply\n",
         "  scx render @cube:10 --color row-entropy --camera 0.5,0.5,0.02,0.5,0.5,1,0,1,0,70 -o cube.png\n\n",
-        "Exit codes: 0 success, 1 the tracer failed, 2 bad input, 3 a file could not be written, \
-         130 interrupted."
+        exit_codes!()
     ))]
     Render(render::RenderArgs),
     /// Trace the same lines with Embree and the pure-Rust tracer, compare them hit for hit and measure
@@ -128,6 +136,7 @@ pub fn scenes(args: &ScenesArgs) -> Result<Exit, Failure> {
         .iter()
         .map(|b| format!("{:<18} {}\n", b.usage, b.description))
         .collect();
+    text_report("scenes", "a listing", args.out.output.as_deref(), "")?;
     output::check_all(args.out.output.as_deref())?;
     output::emit(args.out.output.as_deref(), &list)?;
     Ok(Exit::Ok)

@@ -15,6 +15,7 @@ use serde_json::json;
 
 use super::args::{parse_count, parse_whole_in, ReportOutput, RunOptions};
 use super::exit::{Exit, Failure};
+use super::file_kind::{check_csv, report_format, Kind, ReportFormat};
 use super::output::{self, check_all, note, warn};
 use super::plot::{self, Curve, Series};
 use super::report;
@@ -36,17 +37,18 @@ pub struct ConvergenceArgs {
     repeats: u32,
     #[command(flatten)]
     run: RunOptions,
-    /// Output format of the report: `table` or `json` (every run's measures with units and verdicts).
-    #[arg(long, value_enum, default_value_t = ConvergenceFormat::Table)]
-    format: ConvergenceFormat,
+    /// Output format of the report: `table` or `json` (every run's measures with units and verdicts);
+    /// default: `json` when -o names a .json file, else `table`.
+    #[arg(long, value_enum)]
+    format: Option<ConvergenceFormat>,
     #[command(flatten)]
     out: ReportOutput,
-    /// Also write every run's measures as CSV (the rows of `analyze --format csv`, with the run's
-    /// repeat and seconds).
-    #[arg(long)]
+    /// Also write every run's measures as CSV to FILE (.csv; the rows of `analyze --format csv`, with
+    /// the run's repeat and seconds).
+    #[arg(long, value_name = "FILE")]
     csv: Option<PathBuf>,
-    /// Also draw error against run time, log-log (.svg or .png).
-    #[arg(long)]
+    /// Also draw error against run time, log-log, to FILE (.svg or .png).
+    #[arg(long, value_name = "FILE")]
     plot: Option<PathBuf>,
 }
 
@@ -54,6 +56,15 @@ pub struct ConvergenceArgs {
 enum ConvergenceFormat {
     Table,
     Json,
+}
+
+impl ReportFormat for ConvergenceFormat {
+    fn kind(self) -> Kind {
+        match self {
+            ConvergenceFormat::Table => Kind::Text,
+            ConvergenceFormat::Json => Kind::Json,
+        }
+    }
 }
 
 /// The measures followed (the catalogue's, in their column order).
@@ -127,6 +138,13 @@ fn mean(xs: impl Iterator<Item = f64>) -> f64 {
 
 /// Runs `scx convergence`.
 pub fn run(args: &ConvergenceArgs) -> Result<Exit, Failure> {
+    let format = report_format(
+        "convergence",
+        args.format,
+        args.out.output.as_deref(),
+        " (the runs as CSV: --csv FILE)",
+    )?;
+    check_csv("--csv", args.csv.as_deref())?;
     let mut outputs: Vec<(&str, &std::path::Path)> = Vec::new();
     outputs.extend(args.out.output.as_deref().map(|p| ("-o", p)));
     outputs.extend(args.csv.as_deref().map(|p| ("--csv", p)));
@@ -196,7 +214,7 @@ pub fn run(args: &ConvergenceArgs) -> Result<Exit, Failure> {
             plot_written = true;
         }
     }
-    let text = match args.format {
+    let text = match format {
         ConvergenceFormat::Table => table(&info, &levels, args.repeats, plot_written),
         ConvergenceFormat::Json => json_report(&info, &levels, args.repeats),
     };

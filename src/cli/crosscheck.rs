@@ -7,6 +7,7 @@ use scene_complexity::{make_tracer, AnalysisError, Backend, Query, Scene, Tracer
 use super::args::SceneArgs;
 use super::args::{parse_count, parse_whole_in, ReportOutput, Seed, Threads};
 use super::exit::{Exit, Failure};
+use super::file_kind::text_report;
 use super::input::load_scene;
 use super::output::{self, check_all};
 use super::runner::thread_pool;
@@ -129,6 +130,7 @@ pub fn run(args: &CrosscheckArgs) -> Result<Exit, Failure> {
             args.ulps
         )));
     }
+    text_report("crosscheck", "text", args.out.output.as_deref(), "")?;
     check_all(args.out.output.as_deref())?;
     let scene = load_scene(&args.scene, &args.input.options(), &args.input.policy())?;
     let embree = make_tracer(Backend::Embree, &scene, Query::Single).map_err(Failure::bad_input)?;

@@ -6,6 +6,7 @@ use std::path::PathBuf;
 use clap_complete::Shell;
 
 use super::exit::{Exit, Failure};
+use super::file_kind::text_report;
 use super::output::{self, check_all};
 
 /// Arguments of `scx completions`.
@@ -30,6 +31,7 @@ pub struct ManArgs {
 
 /// Prints the completion script of a shell for the program `scx` defines.
 pub fn completions(args: &CompletionsArgs, mut scx: clap::Command) -> Result<Exit, Failure> {
+    text_report("completions", "a shell script", args.output.as_deref(), "")?;
     check_all(args.output.as_deref())?;
     let mut script = Vec::new();
     clap_complete::generate(args.shell, &mut scx, "scx", &mut script);
@@ -40,6 +42,7 @@ pub fn completions(args: &CompletionsArgs, mut scx: clap::Command) -> Result<Exi
 /// Prints the manual page of scx, the program `scx` defines (its commands listed), or of one command
 /// (`scx-analyze`).
 pub fn man(args: &ManArgs, scx: clap::Command) -> Result<Exit, Failure> {
+    text_report("man", "roff", args.output.as_deref(), "")?;
     check_all(args.output.as_deref())?;
     let command = match &args.command {
         None => scx,

@@ -1,7 +1,8 @@
 //! How a command ends: the exit codes, one scheme for every command, and the failure that carries its
 //! code and the sentence that explains it.
 
-/// The exit codes, one scheme for every command (listed in `--help` and the README, "Exit codes").
+/// The exit codes, one scheme for every command (listed in `--help`, docs/cli.md and the README, "Exit
+/// codes").
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Exit {
     /// Success.
@@ -10,7 +11,8 @@ pub enum Exit {
     Failed = 1,
     /// Bad input or usage: a scene that cannot be read, a nonsense option.
     BadInput = 2,
-    /// A file could not be read or written.
+    /// A file could not be written, or a run state could not be read (the system refused) or is held
+    /// by a live run.
     Io = 3,
     /// Interrupted (Ctrl-C): the report printed covers the lines gathered so far.
     Interrupted = 130,

@@ -9,6 +9,7 @@ use scene_complexity::{RunSpec, RunState, SavedRun, Scene, StateFile, StopReason
 use super::analyze::persist_failure;
 use super::args::{ReadArgs, ReportOutput, Threads};
 use super::exit::{Exit, Failure};
+use super::file_kind::report_format;
 use super::output::{self, check_all, warn};
 use super::patch_files::PatchFiles;
 use super::report;
@@ -36,9 +37,10 @@ pub struct MergeArgs {
     threads: Threads,
     #[command(flatten)]
     reading: ReadArgs,
-    /// Output format, as for `scx analyze`.
-    #[arg(long, value_enum, default_value_t = Format::Table)]
-    format: Format,
+    /// Output format, as for `scx analyze` (default: the one the extension of -o names, `.json` or
+    /// `.csv`, else `table`).
+    #[arg(long, value_enum)]
+    format: Option<Format>,
     #[command(flatten)]
     out: ReportOutput,
     #[command(flatten)]
@@ -165,6 +167,7 @@ fn warn_live_states(states: &[PathBuf]) {
 
 /// Runs `scx merge`.
 pub fn run(args: &MergeArgs) -> Result<Exit, Failure> {
+    let format = report_format("merge", args.format, args.out.output.as_deref(), "")?;
     check_states_distinct(&args.states)?;
     warn_live_states(&args.states);
     let mut outputs: Vec<(&str, &Path)> = Vec::new();
@@ -231,7 +234,7 @@ pub fn run(args: &MergeArgs) -> Result<Exit, Failure> {
         warn(&w.message);
     }
     let info = runner.info();
-    let text = report::render(args.format, &info, &analysis);
+    let text = report::render(format, &info, &analysis);
     let mut failures = Vec::new();
     failures.extend(output::emit(args.out.output.as_deref(), &text).err());
     failures.extend(

@@ -9,6 +9,7 @@ mod crosscheck;
 mod docs;
 mod exit;
 mod export;
+mod file_kind;
 mod input;
 mod merge;
 mod output;

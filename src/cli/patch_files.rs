@@ -21,6 +21,7 @@ use scene_complexity::Scene;
 use scene_complexity::Wanted;
 
 use super::exit::Failure;
+use super::file_kind::{check_csv, check_extension, extension};
 use super::output::{self, warn};
 
 /// The per-patch files of `scx analyze` and `scx merge`.
@@ -34,7 +35,8 @@ pub struct PatchFiles {
     #[arg(long, value_name = "FILE")]
     pub patches: Vec<PathBuf>,
     /// Also write the sparse form-factor matrix to FILE: `.csv` (i, j, n_ij, n_i, f_ij, f_ij_stderr) or
-    /// `.mtx` (Matrix Market, for scipy.io.mmread). Repeat to write both.
+    /// `.mtx` (Matrix Market, for scipy.io.mmread); any other extension is refused. Repeat to write
+    /// both.
     #[arg(long, value_name = "FILE")]
     pub form_factors: Vec<PathBuf>,
     /// Also write one row per object (the groups, meshes or nodes the scene file names) to FILE (.csv):
@@ -70,9 +72,11 @@ impl PatchFiles {
 
     /// Checks, before any work, the files' kinds and that they can be written.
     pub fn check(&self) -> Result<(), Failure> {
-        check_csv_files(&self.patches, "--patches")?;
-        check_csv_files(&self.objects, "--objects")?;
-        check_matrix_files(&self.form_factors)?;
+        check_csv("--patches", self.patches.iter().map(PathBuf::as_path))?;
+        check_csv("--objects", self.objects.iter().map(PathBuf::as_path))?;
+        for p in &self.form_factors {
+            check_extension("--form-factors", p, MATRIX_EXTENSIONS)?;
+        }
         output::check_all(
             self.patches
                 .iter()
@@ -143,40 +147,16 @@ enum MatrixFormat {
     MatrixMarket,
 }
 
-fn extension(path: &Path) -> String {
-    path.extension()
-        .and_then(|e| e.to_str())
-        .unwrap_or("")
-        .to_ascii_lowercase()
-}
-
-/// Checks, before any work, that every file of `option` is a `.csv`.
-fn check_csv_files(paths: &[PathBuf], option: &str) -> Result<(), Failure> {
-    for p in paths {
-        if extension(p) != "csv" {
-            return Err(Failure::bad_input(format!(
-                "{}: {option} writes a .csv file",
-                p.display()
-            )));
-        }
-    }
-    Ok(())
-}
+/// The extensions of a form-factor file: CSV, or Matrix Market.
+const MATRIX_EXTENSIONS: &[&str] = &["csv", "mtx"];
 
 fn matrix_format(path: &Path) -> Result<MatrixFormat, Failure> {
-    match extension(path).as_str() {
-        "csv" => Ok(MatrixFormat::Csv),
-        "mtx" => Ok(MatrixFormat::MatrixMarket),
-        _ => Err(Failure::bad_input(format!(
-            "{}: --form-factors writes a .csv or a Matrix Market .mtx file",
-            path.display()
-        ))),
-    }
-}
-
-/// Checks, before any work, that every form-factor file has a known extension.
-fn check_matrix_files(paths: &[PathBuf]) -> Result<(), Failure> {
-    paths.iter().try_for_each(|p| matrix_format(p).map(drop))
+    check_extension("--form-factors", path, MATRIX_EXTENSIONS)?;
+    Ok(if extension(path) == "mtx" {
+        MatrixFormat::MatrixMarket
+    } else {
+        MatrixFormat::Csv
+    })
 }
 
 /// Writes the per-patch results to every file in `paths`.

@@ -9,6 +9,8 @@ use std::path::Path;
 use plotters::prelude::*;
 use plotters::style::FontStyle;
 
+use super::file_kind::{check_extension, extension};
+
 /// Which measure a curve belongs to: its colour and marker.
 #[derive(Clone, Copy, Debug)]
 pub struct Series(pub usize);
@@ -45,21 +47,8 @@ const FONT_PATHS: &[&str] = &[
 
 /// Checks, before any work, that a plot can be drawn to `path`: its extension and a font.
 pub fn check_target(path: &Path) -> Result<(), String> {
-    let ext = extension(path);
-    if ext != "svg" && ext != "png" {
-        return Err(format!(
-            "{}: the plot must be a .svg or .png file",
-            path.display()
-        ));
-    }
+    check_extension("--plot", path, &["svg", "png"]).map_err(|f| f.message)?;
     font_path().map(drop)
-}
-
-fn extension(path: &Path) -> String {
-    path.extension()
-        .and_then(|e| e.to_str())
-        .unwrap_or("")
-        .to_ascii_lowercase()
 }
 
 pub(super) fn font_path() -> Result<String, String> {

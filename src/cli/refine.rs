@@ -5,6 +5,7 @@ use std::path::PathBuf;
 use clap::ValueEnum;
 use scene_complexity::refine::{refine, RefineConfig, RefineRound, Strategy};
 use scene_complexity::RunControl;
+use scene_complexity::Scene;
 use scene_complexity::SolveOptions;
 use scene_complexity::{make_tracer, Query};
 use std::sync::Arc;
@@ -28,7 +29,8 @@ pub struct RefineArgs {
     /// received radiosity over the patch), information (loss of information transfer).
     #[arg(long, value_enum)]
     strategy: StrategyArg,
-    /// Stop at about this many patches (at most 2 over).
+    /// Stop at about this many patches (at most 2 over). Refine only splits patches, so N below the
+    /// scene's patch count is refused; at that count the mesh is written as it is.
     #[arg(long, value_parser = parse_patches, allow_negative_numbers = true)]
     patches: u64,
     /// The file to write the refined mesh to, its format chosen by the extension: `.obj` (OBJ, its MTL
@@ -70,10 +72,32 @@ fn parse_patches(s: &str) -> Result<u64, String> {
     )
 }
 
+/// Refuses a target below the scene's patch count: refine only splits patches, so it would write the
+/// scene unchanged and leave the user to find out. At the count itself, says that no round will run.
+fn check_target(patches: u64, scene: &Scene) -> Result<(), Failure> {
+    let has = scene.patch_count() as u64;
+    if patches < has {
+        return Err(Failure::bad_input(format!(
+            "--patches {patches}: {} already has {has} patches, and refine only splits patches (it \
+             never merges them); ask for more than {has}",
+            scene.name
+        )));
+    }
+    if patches == has {
+        note(&format!(
+            "{} already has {has} patches (--patches {patches}): no patch is split, the mesh is \
+             written as it is",
+            scene.name
+        ));
+    }
+    Ok(())
+}
+
 /// Runs `scx refine`.
 pub fn run(args: &RefineArgs) -> Result<Exit, Failure> {
     let format = super::export::planned_output(&args.output, &args.scene)?;
     let scene = load_scene(&args.scene, &args.input.options(), &args.input.policy())?;
+    check_target(args.patches, &scene)?;
     super::export::check_not_read(&args.output, format, &scene)?;
     let backend = TracerArg::backend(args.tracer.value);
     // Check the backend once up front, so that an unavailable one is a clear input error.

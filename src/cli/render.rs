@@ -16,6 +16,7 @@ use scene_complexity::{Point, Vector};
 
 use super::args::{parse_count, RunOptions};
 use super::exit::{Exit, Failure};
+use super::file_kind::check_extension;
 use super::output::{self, warn};
 use super::plot::{font_path, register_font};
 use super::runner::Runner;
@@ -166,9 +167,9 @@ const HEADER: u32 = 34;
 
 /// Runs `scx render`.
 pub fn run(args: &RenderArgs) -> Result<Exit, Failure> {
-    check_extension(&args.output, "png", "-o")?;
+    check_extension("-o", &args.output, &["png"])?;
     if let Some(ply) = &args.patches_mesh {
-        check_extension(ply, "ply", "--patches-mesh")?;
+        check_extension("--patches-mesh", ply, &["ply"])?;
     }
     font_path().map_err(Failure::bad_input)?;
     let mut outputs = vec![("-o", args.output.as_path())];
@@ -321,22 +322,6 @@ pub fn run(args: &RenderArgs) -> Result<Exit, Failure> {
     } else {
         Exit::Ok
     })
-}
-
-fn check_extension(path: &Path, ext: &str, flag: &str) -> Result<(), Failure> {
-    let actual = path
-        .extension()
-        .and_then(|e| e.to_str())
-        .unwrap_or("")
-        .to_ascii_lowercase();
-    if actual == ext {
-        Ok(())
-    } else {
-        Err(Failure::bad_input(format!(
-            "{}: {flag} writes a .{ext} file",
-            path.display()
-        )))
-    }
 }
 
 fn emits(scene: &Scene) -> Result<bool, Failure> {

@@ -21,6 +21,7 @@ use scene_complexity::{
 };
 use scene_complexity::{Estimate, Family, Measure, RunWarningKind};
 
+use super::file_kind::{Kind, ReportFormat};
 use super::table::{fixed, Align, Table};
 
 /// Output formats of a report.
@@ -32,6 +33,16 @@ pub enum Format {
     Json,
     /// CSV rows with a header.
     Csv,
+}
+
+impl ReportFormat for Format {
+    fn kind(self) -> Kind {
+        match self {
+            Format::Table => Kind::Text,
+            Format::Json => Kind::Json,
+            Format::Csv => Kind::Csv,
+        }
+    }
 }
 
 /// The report of an analysis in `format`.
@@ -292,25 +303,8 @@ pub fn table(run: &RunInfo, a: &Analysis) -> String {
             }
         );
     }
-    if !a.is_complete() {
-        let ranges: Vec<String> = a
-            .covered_lines()
-            .iter()
-            .map(|r| format!("{}..{}", r.start, r.end))
-            .collect();
-        let _ = writeln!(
-            s,
-            "covers   lines {} of the run's {}{} (a partial run: every figure is of these lines only)",
-            if ranges.is_empty() {
-                "none".to_string()
-            } else {
-                ranges.join(", ")
-            },
-            a.plan.lines,
-            run.shard
-                .map(|s| format!(", shard {} of {}", s.index, s.count))
-                .unwrap_or_default()
-        );
+    if let Some(line) = covers_line(run, a) {
+        let _ = writeln!(s, "{line}");
     }
     if let Some(env) = a.environment_area {
         let r = scene.normalization.scale;
@@ -456,7 +450,7 @@ pub fn table(run: &RunInfo, a: &Analysis) -> String {
         );
     }
     if let Some(t) = &a.target {
-        let _ = writeln!(s, "{}", target_text(t));
+        let _ = writeln!(s, "{}", target_text(t, a));
     }
     if a.stop_reason != StopReason::Lines {
         let _ = writeln!(s, "stopped by: {}", stop_text(a.stop_reason));
@@ -600,26 +594,85 @@ fn extrapolation_note(sampling: Option<&SamplingReport>, n: u64) -> String {
     }
 }
 
-/// What became of a precision target.
-fn target_text(t: &TargetOutcome) -> String {
+/// Whether a run ended at its budget (`--seconds`, a precision target, the floor of f32 tracing): its
+/// lines are then the whole run, not a part of it, whatever the cap (`--lines`) would have allowed.
+fn stopped_by_budget(reason: StopReason) -> bool {
+    matches!(
+        reason,
+        StopReason::Seconds | StopReason::Target | StopReason::Floor
+    )
+}
+
+/// The line that says which lines a report covers, when they are not simply the run's: a part of the
+/// run (a shard, a partial merge, an interruption), or the batches a budget's stop left, when they are
+/// not the first ones.
+fn covers_line(run: &RunInfo, a: &Analysis) -> Option<String> {
+    if a.is_complete() {
+        return None;
+    }
+    let covered = a.covered_lines();
+    let ranges: Vec<String> = covered
+        .iter()
+        .map(|r| format!("{}..{}", r.start, r.end))
+        .collect();
+    let ranges = if ranges.is_empty() {
+        "none".to_string()
+    } else {
+        ranges.join(", ")
+    };
+    if stopped_by_budget(a.stop_reason) {
+        // The first batches are simply the run's lines, which the `lines` line already counts.
+        return (covered.len() > 1 || covered.first().is_some_and(|r| r.start > 0)).then(|| {
+            format!(
+                "covers   lines {ranges}: the batches finished when the run stopped (every figure is \
+                 of these lines)"
+            )
+        });
+    }
+    Some(format!(
+        "covers   lines {ranges} of the run's {}{} (a partial run: every figure is of these lines only)",
+        a.plan.lines,
+        run.shard
+            .map(|s| format!(", shard {} of {}", s.index, s.count))
+            .unwrap_or_default()
+    ))
+}
+
+/// What became of a precision target, and when it was not met, when the run ended.
+fn target_text(t: &TargetOutcome, a: &Analysis) -> String {
     let se = t.stderr.map_or_else(
         || "no standard error".into(),
         |e| format!("standard error {e:.3e}"),
     );
     let verdict = t.verdict.map_or("no verdict", Verdict::name);
     if t.met() {
-        format!(
+        return format!(
             "precision target met: {} {se} <= {:.3e}, and the reading is {verdict}",
             t.measure.key(),
             t.stderr_goal
-        )
-    } else {
-        format!(
-            "precision target NOT met: {} {se} (goal {:.3e}), reading {verdict}: a target counts only when \
-             the standard error is small enough and the reading is ok",
-            t.measure.key(),
-            t.stderr_goal
-        )
+        );
+    }
+    format!(
+        "precision target NOT met: {} {se} (goal {:.3e}) and reading {verdict} {}; a target counts \
+         only when the standard error is small enough and the reading is ok",
+        t.measure.key(),
+        t.stderr_goal,
+        unmet_when(a)
+    )
+}
+
+/// When a run whose precision target was not met ended, and what that leaves to do.
+fn unmet_when(a: &Analysis) -> String {
+    match a.stop_reason {
+        StopReason::Lines if a.is_complete() => format!(
+            "when the run reached its cap (--lines) at {} lines (a larger --lines may meet it)",
+            a.lines
+        ),
+        StopReason::Lines => "on the lines this report covers".into(),
+        StopReason::Seconds => "when the time budget (--seconds) ran out".into(),
+        StopReason::Floor => "at the floor of f32 tracing (more lines would not make it ok)".into(),
+        StopReason::Interrupted => "when the run was interrupted".into(),
+        StopReason::Target => "when the run stopped".into(),
     }
 }
 

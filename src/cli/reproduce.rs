@@ -8,6 +8,7 @@ use scene_complexity::Backend;
 
 use super::args::{parse_whole_in, ReportOutput, Seed, Threads, Tracer, TracerArg};
 use super::exit::{Exit, Failure};
+use super::file_kind::text_report;
 use super::output::{self, check_all};
 use super::runner::thread_pool;
 
@@ -39,6 +40,7 @@ fn parse_table(s: &str) -> Result<u8, String> {
 /// Runs `scx reproduce`: the Markdown goes to standard output as each table finishes, or to `-o FILE`
 /// at the end.
 pub fn run(args: &ReproduceArgs) -> Result<Exit, Failure> {
+    text_report("reproduce", "Markdown", args.out.output.as_deref(), "")?;
     check_all(args.out.output.as_deref())?;
     let tables = if args.table.is_empty() {
         TABLES.collect()

@@ -113,10 +113,12 @@ pub(super) enum BufferProblem {
         scheme: String,
     },
     /// No file where the URI points (or it cannot be resolved).
-    #[error("buffer {buffer}: cannot read `{}`: {error}", .path.display())]
+    #[error("buffer {buffer}: {}", missing_text(.uri, .path, .error))]
     Missing {
         /// The buffer's index.
         buffer: usize,
+        /// The URI, as the glTF writes it.
+        uri: String,
         /// The file's path for messages (the folder joined with the URI's path).
         path: PathBuf,
         /// Why.
@@ -145,6 +147,20 @@ pub(super) enum BufferProblem {
     },
 }
 
+/// Why a buffer's file was not read: the file as the glTF names it and as scx looked for it, and that
+/// it is not there (or the system's reason, without Rust's `(os error N)`).
+fn missing_text(uri: &str, path: &Path, error: &std::io::Error) -> String {
+    let file = format!("the file `{uri}` (resolved as `{}`)", path.display());
+    if error.kind() == std::io::ErrorKind::NotFound {
+        return format!("{file} was not found");
+    }
+    let reason = error.to_string();
+    let reason = reason
+        .find(" (os error")
+        .map_or(reason.as_str(), |k| &reason[..k]);
+    format!("{file} cannot be reached: {reason}")
+}
+
 /// One buffer's bytes.
 fn buffer_data(
     buffer: &::gltf::Buffer,
@@ -168,6 +184,7 @@ fn buffer_data(
             let fetched = folder.fetch(Path::new(&path)).map_err(|e| match e {
                 RefError::Missing(error) => BufferProblem::Missing {
                     buffer: k,
+                    uri: uri.to_string(),
                     path: folder.shown(Path::new(&path)),
                     error,
                 },

@@ -94,6 +94,65 @@ fn a_precision_target_needs_a_reliable_reading() {
     assert!((mi["value"].as_f64().unwrap() - 1.12257).abs() < 4.0 * 0.005);
 }
 
+/// The table says what became of a precision target in words that are true: a met target's run is
+/// not called partial (it was: "covers lines 0..393216 of the run's 1000000000000 (a partial run ...)");
+/// an unmet one says so, and that the run reached its cap, as the JSON's `stop_reason` and `met` do. A
+/// shard is still a partial run.
+#[test]
+fn the_table_says_whether_a_target_was_met_and_what_ended_the_run() {
+    let table = |args: &[&str]| {
+        let mut all = vec![
+            "analyze",
+            "@cube:4",
+            "--threads",
+            "1",
+            "--tracer",
+            "rust",
+            "-q",
+        ];
+        all.extend_from_slice(args);
+        support::text_of(scx(&all))
+    };
+    for capped in [&["--lines", "1e7"][..], &[]] {
+        let text = table(&[&["--target-stderr", "0.01"], capped].concat());
+        assert!(
+            text.contains("precision target met: mutual_information_corrected standard error")
+                && text.contains("and the reading is ok")
+                && text.contains("stopped by: the precision target (--target-stderr) was met"),
+            "{text}"
+        );
+        assert!(
+            !text.contains("partial") && !text.contains("covers") && !text.contains("NOT met"),
+            "{text}"
+        );
+    }
+    let text = table(&["--target-stderr", "0.001", "--lines", "1e4"]);
+    let last = text.lines().last().unwrap();
+    assert!(
+        last.starts_with("precision target NOT met: mutual_information_corrected standard error")
+            && last.contains("(goal 1.000e-3)")
+            && last.contains("when the run reached its cap (--lines) at 10000 lines"),
+        "{text}"
+    );
+    let doc = json_run(&["@cube:4", "--target-stderr", "0.001", "--lines", "1e4"]);
+    assert_eq!(doc["stop_reason"], "lines");
+    assert_eq!(doc["target"]["met"], false);
+    let dir = tempfile::tempdir().unwrap();
+    let state = dir.path().join("s.scx");
+    let text = table(&[
+        "--lines",
+        "1e6",
+        "--shard",
+        "1/2",
+        "--save",
+        state.to_str().unwrap(),
+    ]);
+    assert!(
+        text.contains("of the run's 1000000, shard 1 of 2 (a partial run"),
+        "{text}"
+    );
+}
+
 /// A precision target on a measure the run does not compute is refused before any line is cast (exit
 /// 2, naming the measure): its reading never comes, and the run went on to its cap, or without one for
 /// ever. A target on a measure the run does compute still runs.
@@ -144,6 +203,141 @@ fn a_precision_target_on_a_measure_not_computed_is_refused() {
     ]);
     assert_eq!(doc["target"]["met"], true);
     assert_eq!(doc["stop_reason"], "target_stderr");
+}
+
+/// An option that only tunes another one is refused without it (exit 2, saying what it needs, nothing
+/// on stdout): accepted, it did nothing, and the user believed it had. With the option it tunes, it is
+/// taken.
+#[test]
+fn an_option_without_the_one_it_tunes_is_refused() {
+    let cases: [(&[&str], &str); 3] = [
+        (
+            &["analyze", "@cube:2", "--checkpoint-every", "30s"],
+            "--checkpoint-every needs --checkpoint FILE (or --resume FILE)",
+        ),
+        (
+            &["analyze", "@cube:2", "--target-measure", "accuracy"],
+            "--target-measure accuracy needs --target-stderr E",
+        ),
+        (
+            &[
+                "calibrate",
+                "--scene",
+                "@cube:1",
+                "--target-measure",
+                "accuracy",
+            ],
+            "--target-measure accuracy needs --target-stderr E",
+        ),
+    ];
+    for (args, expect) in cases {
+        let mut all = args.to_vec();
+        all.extend_from_slice(&["--lines", "1e4", "--threads", "1"]);
+        let out = scx(&all);
+        let err = stderr_of(&out);
+        assert_eq!(out.status.code(), Some(2), "{all:?}: {err}");
+        assert!(err.contains(expect), "{all:?}: {err}");
+        assert!(out.stdout.is_empty(), "{all:?}: no report");
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let state = dir.path().join("c.scx");
+    let state = state.to_str().unwrap();
+    let out = scx(&[
+        "analyze",
+        "@cube:2",
+        "--lines",
+        "1e4",
+        "--threads",
+        "1",
+        "--checkpoint",
+        state,
+        "--checkpoint-every",
+        "30s",
+        "--target-stderr",
+        "0.5",
+        "--target-measure",
+        "continuous_mutual_information",
+        "--format",
+        "json",
+        "-q",
+    ]);
+    let doc = json_of(&out);
+    assert_eq!(doc["target"]["measure"], "continuous_mutual_information");
+    assert!(
+        std::path::Path::new(state).is_file(),
+        "the checkpoint was saved"
+    );
+}
+
+/// The exit codes a help lists: each code with its meaning, its continuation lines joined.
+fn exit_codes_of(help: &str) -> Vec<(String, String)> {
+    let block = help
+        .split("Exit codes:\n")
+        .nth(1)
+        .unwrap_or_else(|| panic!("no exit codes in: {help}"));
+    let mut codes: Vec<(String, String)> = Vec::new();
+    for line in block.lines().take_while(|l| !l.trim().is_empty()) {
+        match codes.last_mut() {
+            Some((_, meaning)) if line.starts_with("       ") => {
+                meaning.push(' ');
+                meaning.push_str(line.trim());
+            }
+            _ => {
+                let (code, meaning) = line.trim().split_once(' ').unwrap();
+                codes.push((code.to_string(), meaning.trim().to_string()));
+            }
+        }
+    }
+    codes
+}
+
+/// Every help that lists the exit codes lists the same ones, with the words of docs/cli.md and the
+/// README; and the codes are what the commands return (exit 3 for a run state that cannot be read,
+/// 2 for a scene that cannot be, and for a state that is not one).
+#[test]
+fn exit_codes_mean_one_thing_everywhere() {
+    let help = |args: &[&str]| String::from_utf8_lossy(&scx(args).stdout).into_owned();
+    let codes = exit_codes_of(&help(&["--help"]));
+    let listed: Vec<&str> = codes.iter().map(|(c, _)| c.as_str()).collect();
+    assert_eq!(listed, ["0", "1", "2", "3", "130"]);
+    for command in ["analyze", "render"] {
+        assert_eq!(
+            exit_codes_of(&help(&[command, "--help"])),
+            codes,
+            "{command}"
+        );
+    }
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    for doc in ["docs/cli.md", "README.md"] {
+        let text = std::fs::read_to_string(root.join(doc)).unwrap();
+        for (code, meaning) in &codes {
+            let row = format!("| {code} | {meaning} |");
+            assert!(text.contains(&row), "{doc} lacks `{row}`");
+        }
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let missing = dir.path().join("missing.scx");
+    let missing = missing.to_str().unwrap();
+    let junk = dir.path().join("junk.scx");
+    std::fs::write(&junk, "not a state").unwrap();
+    let cases: [(&[&str], i32, &str); 4] = [
+        (&["analyze", "--resume", missing], 3, "cannot read"),
+        (&["merge", missing], 3, "cannot read"),
+        (
+            &["merge", junk.to_str().unwrap()],
+            2,
+            "not an scx run state",
+        ),
+        (&["analyze", "/no/such/scene.obj"], 2, "no such file"),
+    ];
+    for (args, code, words) in cases {
+        let mut all = args.to_vec();
+        all.extend_from_slice(&["--threads", "1"]);
+        let out = scx(&all);
+        let err = stderr_of(&out);
+        assert_eq!(out.status.code(), Some(code), "{all:?}: {err}");
+        assert!(err.contains(words), "{all:?}: {err}");
+    }
 }
 
 /// Readings that break a bound of the theory are flagged, in JSON and in the table.

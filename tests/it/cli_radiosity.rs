@@ -232,3 +232,54 @@ fn refine_errors_are_clear() {
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("growth"));
 }
+
+/// Refine only splits patches: a target below the scene's count is refused (exit 2, naming the count)
+/// and writes nothing; the count itself writes the scene as it is, and says so.
+#[test]
+fn refine_below_the_scenes_patch_count_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let mesh = dir.path().join("m.obj");
+    let mesh_s = mesh.display().to_string();
+    let refine = |patches: &str| {
+        scx(&[
+            "refine",
+            "@cornell",
+            "--strategy",
+            "uniform",
+            "--patches",
+            patches,
+            "-o",
+            &mesh_s,
+            "--threads",
+            "1",
+        ])
+    };
+    let out = refine("10");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("--patches 10: @cornell already has 29 patches")
+            && err.contains("only splits patches"),
+        "{err}"
+    );
+    assert!(!mesh.exists(), "nothing written");
+    let out = refine("29");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    assert!(
+        err.contains("@cornell already has 29 patches (--patches 29): no patch is split"),
+        "{err}"
+    );
+    let doc = json_of(&scx(&[
+        "analyze",
+        &mesh_s,
+        "--lines",
+        "1e3",
+        "--threads",
+        "1",
+        "--format",
+        "json",
+        "-q",
+    ]));
+    assert_eq!(doc["patches"], 29);
+}

@@ -378,6 +378,61 @@ fn inconsistent_gltf_is_bad_input_and_latin_1_obj_is_read() {
     );
 }
 
+/// A glTF whose buffer file is missing names the file as the glTF writes it and as scx looked for it,
+/// and says it was not found (exit 2; the message ended in "(os error 2)"); once the file is there, the
+/// same glTF is read. `analyze` and `export` say the same.
+#[test]
+fn a_missing_gltf_buffer_is_named_and_not_found() {
+    let dir = tempfile::tempdir().unwrap();
+    let gltf = dir.path().join("tri.gltf");
+    std::fs::write(
+        &gltf,
+        r#"{"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}],
+            "nodes": [{"mesh": 0}], "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
+            "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
+                           "min": [0, 0, 0], "max": [1, 1, 0]}],
+            "bufferViews": [{"buffer": 0, "byteLength": 36}],
+            "buffers": [{"uri": "data/tri%20mesh.bin", "byteLength": 36}]}"#,
+    )
+    .unwrap();
+    let resolved = dir.path().join("data/tri mesh.bin");
+    let gltf_s = gltf.to_str().unwrap();
+    let obj = dir.path().join("out.obj");
+    for args in [
+        vec!["analyze", gltf_s, "--lines", "1000", "--threads", "1"],
+        vec!["export", gltf_s, "-o", obj.to_str().unwrap()],
+    ] {
+        let out = scx(&args);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+        let expected = format!(
+            "{gltf_s}: buffer 0: the file `data/tri%20mesh.bin` (resolved as `{}`) was not found",
+            resolved.display()
+        );
+        assert!(err.contains(&expected), "{args:?}: {err}");
+        assert!(!err.contains("os error"), "{err}");
+        assert!(out.stdout.is_empty() && !obj.exists(), "{args:?}");
+    }
+    let triangle: Vec<u8> = [0f32, 0., 0., 1., 0., 0., 0., 1., 0.]
+        .iter()
+        .flat_map(|x| x.to_le_bytes())
+        .collect();
+    std::fs::create_dir(dir.path().join("data")).unwrap();
+    std::fs::write(&resolved, triangle).unwrap();
+    let doc = json_of(&scx(&[
+        "analyze",
+        gltf_s,
+        "--lines",
+        "1000",
+        "--threads",
+        "1",
+        "--format",
+        "json",
+        "-q",
+    ]));
+    assert_eq!(doc["triangles"], 1);
+}
+
 /// `scx export -o` writes the format its extension names (before: OBJ text whatever the extension, and
 /// an .mtl beside it): binary PLY (which reads back with the same patches and the same I_s^c bit for bit)
 /// and binary STL (84 + 50 bytes per triangle), with no .mtl; a warning says what each cannot keep. Any

@@ -1124,3 +1124,160 @@ fn merging_a_live_state_warns() {
         stderr(&out)
     );
 }
+
+/// A report's format is the one `--format` gives, else the one the extension of `-o` names (`.json`,
+/// `.csv`, in any case), else the table; `-o -` is standard output in the default format. A `--format`
+/// the extension contradicts, and an extension naming a format the command does not write, are refused
+/// before any work (exit 2, both named, nothing written), by every command that takes `-o`.
+#[test]
+fn the_extension_of_o_picks_the_format_and_contradictions_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let analyze = [
+        "analyze",
+        "@cube:2",
+        "--lines",
+        "1e4",
+        "--threads",
+        "1",
+        "-q",
+    ];
+    let written = |extra: &[&str], file: &str| {
+        let args: Vec<&str> = analyze.iter().chain(extra).copied().collect();
+        let out = scx_in(d, &args);
+        assert_eq!(code(&out), Some(0), "{args:?}: {}", stderr(&out));
+        std::fs::read_to_string(d.join(file)).unwrap()
+    };
+    let json: serde_json::Value =
+        serde_json::from_str(&written(&["-o", "r.json", "--save", "s.scx"], "r.json")).unwrap();
+    assert_eq!(json["patches"], 24);
+    assert!(written(&["-o", "r.CSV"], "r.CSV").starts_with("scene,lines,seed,"));
+    assert!(written(&["-o", "r.txt"], "r.txt").starts_with("scene    @cube:2"));
+    assert!(written(&["-o", "r", "--format", "json"], "r").starts_with('{'));
+    let out = scx_in(d, &[&analyze[..], &["-o", "-"]].concat());
+    assert!(String::from_utf8_lossy(&out.stdout).starts_with("scene    @cube:2"));
+    let out = scx_in(
+        d,
+        &["merge", "s.scx", "--threads", "1", "-q", "-o", "m.json"],
+    );
+    assert_eq!(code(&out), Some(0), "{}", stderr(&out));
+    let merged: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(d.join("m.json")).unwrap()).unwrap();
+    assert_eq!(merged["lines"], json["lines"]);
+    let refused: [(&[&str], &str, &[&str]); 8] = [
+        (
+            &["--format", "table", "-o", "x.json"],
+            "x.json",
+            &["--format table and -o x.json disagree", ".json names JSON"],
+        ),
+        (
+            &["--format", "json", "-o", "x.csv"],
+            "x.csv",
+            &["--format json and -o x.csv disagree", ".csv names CSV"],
+        ),
+        (
+            &[
+                "merge",
+                "s.scx",
+                "--threads",
+                "1",
+                "--format",
+                "csv",
+                "-o",
+                "x.json",
+            ],
+            "x.json",
+            &["--format csv and -o x.json disagree"],
+        ),
+        (
+            &["convergence", "@cube:2", "--threads", "1", "-o", "x.csv"],
+            "x.csv",
+            &[
+                "-o x.csv names a CSV file",
+                "scx convergence",
+                "table or json only",
+                "--csv FILE",
+            ],
+        ),
+        (
+            &[
+                "reproduce",
+                "--table",
+                "1",
+                "--threads",
+                "1",
+                "-o",
+                "x.json",
+            ],
+            "x.json",
+            &[
+                "-o x.json names a JSON file",
+                "scx reproduce",
+                "Markdown only",
+            ],
+        ),
+        (
+            &[
+                "calibrate",
+                "--scene",
+                "@cube:1",
+                "--threads",
+                "1",
+                "-o",
+                "x.csv",
+            ],
+            "x.csv",
+            &["-o x.csv names a CSV file", "scx calibrate", "--csv FILE"],
+        ),
+        (
+            &["crosscheck", "@cube:1", "--threads", "1", "-o", "x.json"],
+            "x.json",
+            &["-o x.json names a JSON file", "scx crosscheck"],
+        ),
+        (
+            &["scenes", "-o", "x.csv"],
+            "x.csv",
+            &["-o x.csv names a CSV file", "scx scenes"],
+        ),
+    ];
+    for (args, file, expected) in refused {
+        let args: Vec<&str> = if args[0].starts_with('-') {
+            analyze.iter().chain(args).copied().collect()
+        } else {
+            args.to_vec()
+        };
+        let out = scx_in(d, &args);
+        assert_usage(&out, expected);
+        assert!(!d.join(file).exists(), "{args:?}: nothing written");
+    }
+}
+
+/// Every option that writes files of one kind refuses another extension with one message, naming the
+/// option, the file and the extension it takes (`convergence --csv x.txt` used to be taken).
+#[test]
+fn file_options_take_their_extension_only() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let cases: [(&[&str], &str, &str); 7] = [
+        (&["analyze", "@cube:2"], "--patches", ".csv"),
+        (&["analyze", "@cube:2"], "--objects", ".csv"),
+        (&["analyze", "@cube:2"], "--form-factors", ".csv or .mtx"),
+        (&["convergence", "@cube:2"], "--csv", ".csv"),
+        (&["convergence", "@cube:2"], "--plot", ".svg or .png"),
+        (&["calibrate", "--scene", "@cube:1"], "--csv", ".csv"),
+        (&["calibrate", "--scene", "@cube:1"], "--readings", ".csv"),
+    ];
+    for (command, option, extensions) in cases {
+        let mut args = command.to_vec();
+        args.extend_from_slice(&["--lines", "1e3", "--threads", "1", option, "x.txt"]);
+        let out = scx_in(d, &args);
+        assert_usage(
+            &out,
+            &[&format!(
+                "{option} x.txt: {option} writes {extensions} files only; name one ending in \
+                 {extensions}"
+            )],
+        );
+        assert!(!d.join("x.txt").exists(), "{args:?}: nothing written");
+    }
+}
