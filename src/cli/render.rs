@@ -4,10 +4,9 @@
 use std::path::{Path, PathBuf};
 
 use plotters::prelude::*;
-use scene_complexity::render::colour::short_number;
 use scene_complexity::render::{
-    default_camera, noise_summary, trace_view, write_ply, Camera, ColourScale, PlyFormat, Quantity,
-    Sample, BACK_SIDE, NO_DATA,
+    bar_labels, default_camera, noise_summary, trace_view, write_ply, Camera, ColourScale,
+    PlyFormat, Quantity, Sample, BACK_SIDE, NO_DATA,
 };
 use scene_complexity::PatchMaterials;
 use scene_complexity::Scene;
@@ -163,6 +162,8 @@ const SUPERSAMPLING: usize = 2;
 const PANEL: u32 = 210;
 /// The height of the title strip above the picture, pixels.
 const HEADER: u32 = 34;
+/// The room a colour bar's label needs (its 14-pixel text and a little space), pixels.
+const LABEL_GAP: u32 = 16;
 
 /// Runs `scx render`.
 pub fn run(args: &RenderArgs) -> Result<Exit, Failure> {
@@ -424,28 +425,18 @@ fn draw<DB: DrawingBackend>(
         ))?;
     }
     root.draw(&Rectangle::new([(x0, top), (x0 + 26, top + height)], BLACK))?;
-    let y_of =
-        |value: f64| top + ((1.0 - scale.position(value)) * f64::from(height - 1)).round() as i32;
-    // Values beyond an end take its colour: the end is labelled `≥`/`≤` with its value to three
-    // significant digits, and round ticks too close to it give way.
-    let ends = [
-        (legend.clipped_high, scale.hi, "≥"),
-        (legend.clipped_low, scale.lo, "≤"),
-    ];
-    let mut labels: Vec<(i32, String)> = ends
-        .iter()
-        .filter(|(clipped, ..)| *clipped)
-        .map(|&(_, value, mark)| (y_of(value), format!("{mark} {}", three_digits(value))))
-        .collect();
-    for tick in scale.ticks() {
-        let y = y_of(tick.value);
-        if labels.iter().all(|(at, _)| (at - y).abs() >= 16) {
-            labels.push((y, tick.label));
-        }
-    }
-    for (y, label) in labels {
+    let y_of = |position: f64| top + ((1.0 - position) * f64::from(height - 1)).round() as i32;
+    let labels = bar_labels(
+        scale,
+        (legend.clipped_low, legend.clipped_high),
+        &[],
+        f64::from(height - 1),
+        f64::from(LABEL_GAP),
+    );
+    for label in labels {
+        let y = y_of(label.position);
         root.draw(&PathElement::new(vec![(x0 + 26, y), (x0 + 32, y)], BLACK))?;
-        root.draw(&Text::new(label, (x0 + 36, y - 7), text(14)))?;
+        root.draw(&Text::new(label.text, (x0 + 36, y - 7), text(14)))?;
     }
 
     // Swatches for what the bar does not cover.
@@ -473,12 +464,6 @@ fn draw<DB: DrawingBackend>(
         y += 44;
     }
     Ok(())
-}
-
-/// `v` to three significant digits, without trailing zeros (an end of the bar is not a round value).
-fn three_digits(v: f64) -> String {
-    let rounded: f64 = format!("{v:.2e}").parse().unwrap_or(v);
-    short_number(rounded)
 }
 
 /// A whole number with its digits in groups of three (`10 000 000`).
@@ -531,9 +516,6 @@ mod tests {
         assert!(parse_size("640").is_err() && parse_size("10x10").is_err());
         assert_eq!(parse_range("-1,2"), Ok((-1.0, 2.0)));
         assert!(parse_range("2,1").is_err());
-        assert_eq!(three_digits(0.48884), "0.489");
-        assert_eq!(three_digits(0.0118), "0.0118");
-        assert_eq!(three_digits(2.0), "2");
         assert_eq!(grouped(10_000_000), "10 000 000");
         assert_eq!(grouped(999), "999");
     }

@@ -284,3 +284,82 @@ fn the_default_view_of_a_flat_scene_shows_its_front() {
         assert_eq!(back, 0, "{plane}: the back of the triangle shows");
     }
 }
+
+/// The texts of a colour bar's labels, from the low end, on a bar of 400 pixels with labels 16 apart.
+fn bar_texts(lo: f64, hi: f64, log: bool, clipped: (bool, bool), marks: &[f64]) -> Vec<String> {
+    use scene_complexity::render::{bar_labels, ColourScale};
+    let scale = ColourScale { lo, hi, log };
+    bar_labels(&scale, clipped, marks, 400.0, 16.0)
+        .into_iter()
+        .map(|l| l.text)
+        .collect()
+}
+
+/// Both ends of a colour bar are labelled, rounded to what the scale can tell apart, with round ticks
+/// between them that keep clear of the ends; an end that is 0 up to rounding reads 0.
+#[test]
+fn a_colour_bar_labels_both_ends_and_round_ticks_between() {
+    // @cornell's radiosity, log scale: the bottom end is no round value and still labelled.
+    assert_eq!(
+        bar_texts(0.03468, 0.49437, true, (false, true), &[]),
+        ["0.0347", "0.05", "0.1", "0.2", "≥ 0.494"]
+    );
+    // Floating-point dust at an end reads 0; the round tick at 0 gives way to the end.
+    assert_eq!(
+        bar_texts(-6.41e-16, 0.49437, false, (true, true), &[]),
+        ["≤ 0", "0.1", "0.2", "0.3", "0.4", "≥ 0.494"]
+    );
+    // Neither end round, nothing clipped: both ends labelled bare, ticks every 0.005 between.
+    assert_eq!(
+        bar_texts(0.01368, 0.0389, false, (false, false), &[]),
+        ["0.0137", "0.015", "0.02", "0.025", "0.03", "0.035", "0.0389"]
+    );
+    // A value to mark (0, where the theory bounds the values) is labelled, the tick there gives way.
+    assert_eq!(
+        bar_texts(-7.62e-5, 0.0010934, false, (true, true), &[0.0]),
+        [
+            "≤ -7.6e-5",
+            "0",
+            "2e-4",
+            "4e-4",
+            "6e-4",
+            "8e-4",
+            "0.001",
+            "≥ 0.00109"
+        ]
+    );
+}
+
+/// On any scale and bar length, the first label is the low end and the last the high end, and no two
+/// labels are closer than the room a label needs.
+#[test]
+fn every_colour_bar_has_both_ends_labelled_and_labels_apart() {
+    use scene_complexity::render::{bar_labels, ColourScale};
+    let scales = [
+        (0.0, 1.0, false),
+        (-1.0, 1.0, false),
+        (4.674, 6.141, false),
+        (1e-5, 5.2e-5, false),
+        (-3.63, 0.409, false),
+        (0.0118, 0.4888, true),
+        (0.035, 0.05, true),
+        (1e-9, 1e9, true),
+        (3.0, 3.3, true),
+    ];
+    for (lo, hi, log) in scales {
+        for length in [20.0, 82.0, 200.0, 441.0, 900.0] {
+            let scale = ColourScale { lo, hi, log };
+            let labels = bar_labels(&scale, (true, false), &[0.0], length, 16.0);
+            let (first, last) = (&labels[0], &labels[labels.len() - 1]);
+            assert!(
+                first.position == 0.0 && first.text.starts_with('≤'),
+                "{labels:?}"
+            );
+            assert!(last.position == 1.0 && last.value == hi, "{labels:?}");
+            for pair in labels.windows(2) {
+                let apart = (pair[1].position - pair[0].position) * length;
+                assert!(apart >= 16.0 || labels.len() == 2, "{length}: {labels:?}");
+            }
+        }
+    }
+}
