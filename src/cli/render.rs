@@ -5,8 +5,8 @@ use std::path::{Path, PathBuf};
 
 use plotters::prelude::*;
 use scene_complexity::render::{
-    bar_labels, default_camera, noise_summary, trace_view, write_ply, Camera, ColourScale,
-    PlyFormat, Quantity, Sample, BACK_SIDE, NO_DATA,
+    bar_labels, default_camera, fit_title, noise_summary, trace_view, write_ply, Camera,
+    ColourScale, PlyFormat, Quantity, Sample, TitleLayout, TitleParts, BACK_SIDE, NO_DATA,
 };
 use scene_complexity::PatchMaterials;
 use scene_complexity::Scene;
@@ -56,7 +56,9 @@ pub struct RenderArgs {
     #[arg(long, value_parser = parse_camera, allow_hyphen_values = true)]
     camera: Option<Camera>,
     /// The size of the scene's picture in pixels, WIDTHxHEIGHT; the file is larger by the colour bar on
-    /// the right (210 pixels) and the title strip above (34): 800x600 makes a file of 1010x634.
+    /// the right (210 pixels) and the title strip above (34): 800x600 makes a file of 1010x634. A long
+    /// title takes two lines in a smaller font; a picture too narrow even for that wraps it on a taller
+    /// strip.
     #[arg(long, default_value = "800x600", value_parser = parse_size)]
     size: (usize, usize),
     /// Divide the shares of a sum over patches (mutual-information, continuous-mutual-information,
@@ -160,8 +162,8 @@ fn parse_range(s: &str) -> Result<(f64, f64), String> {
 const SUPERSAMPLING: usize = 2;
 /// The width of the colour-bar panel right of the picture, pixels.
 const PANEL: u32 = 210;
-/// The height of the title strip above the picture, pixels.
-const HEADER: u32 = 34;
+/// The space left and right of the title, pixels.
+const MARGIN: u32 = 10;
 /// The room a colour bar's label needs (its 14-pixel text and a little space), pixels.
 const LABEL_GAP: u32 = 16;
 
@@ -280,13 +282,17 @@ pub fn run(args: &RenderArgs) -> Result<Exit, Failure> {
         clipped_high: values.iter().flatten().any(|&v| v > scale.hi),
     };
     let (pw, ph, pixels) = image.to_rgb(&colours, SUPERSAMPLING);
-    let title = format!(
-        "{}   {} [{}]   {} lines",
-        scene.name,
+    let quantity = format!(
+        "{} [{}]",
         args.color.label(),
-        args.color.unit(args.per_area),
-        grouped(analysis.lines)
+        args.color.unit(args.per_area)
     );
+    let lines = format!("{} lines", grouped(analysis.lines));
+    let title = TitleParts {
+        scene: &scene.name,
+        quantity: &quantity,
+        lines: &lines,
+    };
     let mut picture = Some((pw, ph, pixels));
     output::write_via(&args.output, "png", |temporary| {
         let picture = picture.take().unwrap_or_default();
@@ -382,40 +388,80 @@ struct Legend {
 fn draw_png(
     path: &Path,
     (w, h, pixels): (usize, usize, Vec<u8>),
-    title: &str,
+    title: &TitleParts,
     scale: &ColourScale,
     legend: &Legend,
 ) -> Result<(), Failure> {
     register_font().map_err(Failure::bad_input)?;
-    let size = (w as u32 + PANEL, h as u32 + HEADER);
+    let title = fit_title(title, f64::from(w as u32 + PANEL - 2 * MARGIN), &text_width);
+    let header = title.height().ceil() as u32;
+    let panel = Panel::new(h as i32, &legend.entries());
+    let size = (
+        w as u32 + PANEL,
+        (h as u32).max(panel.height as u32) + header,
+    );
     let fail = |e: &dyn std::fmt::Display| Failure {
         code: Exit::Io,
         message: format!("cannot draw {}: {e}", path.display()),
     };
     let root = BitMapBackend::new(path, size).into_drawing_area();
-    draw(&root, (w, h, pixels), title, scale, legend).map_err(|e| fail(&e))?;
+    let (title_area, rest) = root.split_vertically(header);
+    draw_title(&title_area, &title).map_err(|e| fail(&e))?;
+    draw(&rest, (w, h, pixels), scale, legend).map_err(|e| fail(&e))?;
     root.present().map_err(|e| fail(&e))
+}
+
+/// The width of `text` in the labels' font at `size`, pixels (unmeasurable text counts as too wide).
+fn text_width(text: &str, size: f64) -> f64 {
+    ("sans-serif", size)
+        .into_font()
+        .box_size(text)
+        .map_or(f64::INFINITY, |(w, _)| f64::from(w))
+}
+
+fn draw_title<DB: DrawingBackend>(
+    area: &DrawingArea<DB, plotters::coord::Shift>,
+    title: &TitleLayout,
+) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
+    area.fill(&WHITE)?;
+    let font = ("sans-serif", title.size).into_font().color(&BLACK);
+    for (k, line) in title.lines.iter().enumerate() {
+        let at = (MARGIN as i32, title.top(k) as i32);
+        area.draw(&Text::new(line.clone(), at, font.clone()))?;
+    }
+    Ok(())
 }
 
 fn draw<DB: DrawingBackend>(
     root: &DrawingArea<DB, plotters::coord::Shift>,
     (w, h, pixels): (usize, usize, Vec<u8>),
-    title: &str,
     scale: &ColourScale,
     legend: &Legend,
 ) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
     root.fill(&WHITE)?;
-    let text = |size: u32| ("sans-serif", size).into_font().color(&BLACK);
-    root.draw(&Text::new(title.to_string(), (10, 8), text(17)))?;
-    let picture =
-        BitMapElement::with_owned_buffer((0, HEADER as i32), (w as u32, h as u32), pixels)
-            .expect("the buffer has 3 bytes per pixel");
+    let picture = BitMapElement::with_owned_buffer((0, 0), (w as u32, h as u32), pixels)
+        .expect("the buffer has 3 bytes per pixel");
     root.draw(&picture)?;
-
-    // The bar: viridis from the bottom (lo) to the top (hi), ticks on its right.
+    let entries = legend.entries();
+    let panel = Panel::new(h as i32, &entries);
     let x0 = w as i32 + 22;
-    let (top, bottom) = (HEADER as i32 + 28, HEADER as i32 + h as i32 - 130);
-    let height = (bottom - top).max(20);
+    draw_bar(root, x0, &panel, scale, legend)?;
+    draw_entries(root, x0, panel.legend_top, &entries)
+}
+
+fn label_font(size: u32) -> TextStyle<'static> {
+    ("sans-serif", size).into_font().color(&BLACK)
+}
+
+/// The bar: viridis from the bottom (lo) to the top (hi), labels on its right.
+fn draw_bar<DB: DrawingBackend>(
+    root: &DrawingArea<DB, plotters::coord::Shift>,
+    x0: i32,
+    panel: &Panel,
+    scale: &ColourScale,
+    legend: &Legend,
+) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
+    let (top, height) = (BAR_TOP, panel.length);
     for k in 0..height {
         let t = 1.0 - f64::from(k) / f64::from(height - 1);
         let [r, g, b] = scene_complexity::render::colour::viridis(t);
@@ -436,34 +482,106 @@ fn draw<DB: DrawingBackend>(
     for label in labels {
         let y = y_of(label.position);
         root.draw(&PathElement::new(vec![(x0 + 26, y), (x0 + 32, y)], BLACK))?;
-        root.draw(&Text::new(label.text, (x0 + 36, y - 7), text(14)))?;
-    }
-
-    // Swatches for what the bar does not cover.
-    let mut y = bottom + 22;
-    let swatches = [
-        (legend.back_sides, BACK_SIDE, "back side (seen from behind)"),
-        (legend.no_data, NO_DATA, "no value (no segment left it)"),
-    ];
-    for (shown, [r, g, b], label) in swatches {
-        if !shown {
-            continue;
-        }
-        root.draw(&Rectangle::new(
-            [(x0, y), (x0 + 18, y + 14)],
-            RGBColor(r, g, b).filled(),
-        ))?;
-        root.draw(&Rectangle::new([(x0, y), (x0 + 18, y + 14)], BLACK))?;
-        for (k, line) in wrap(label, 20).iter().enumerate() {
-            root.draw(&Text::new(
-                line.clone(),
-                (x0 + 24, y + 16 * k as i32),
-                text(13),
-            ))?;
-        }
-        y += 44;
+        root.draw(&Text::new(label.text, (x0 + 36, y - 7), label_font(14)))?;
     }
     Ok(())
+}
+
+/// The legend under the bar: a swatch and its wrapped text per entry, from `y` down.
+fn draw_entries<DB: DrawingBackend>(
+    root: &DrawingArea<DB, plotters::coord::Shift>,
+    x0: i32,
+    mut y: i32,
+    entries: &[Entry],
+) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
+    for entry in entries {
+        let [r, g, b] = entry.colour;
+        let swatch = [(x0, y), (x0 + 18, y + 14)];
+        root.draw(&Rectangle::new(swatch, RGBColor(r, g, b).filled()))?;
+        root.draw(&Rectangle::new(swatch, BLACK))?;
+        for (k, line) in entry.lines().iter().enumerate() {
+            root.draw(&Text::new(
+                line.clone(),
+                (x0 + 24, y + ENTRY_LINE * k as i32),
+                label_font(13),
+            ))?;
+        }
+        y += entry.height();
+    }
+    Ok(())
+}
+
+/// The top of the colour bar in the panel right of the picture, pixels (room for its top label).
+const BAR_TOP: i32 = 28;
+/// What a picture of ordinary height leaves under the bar for the legend, pixels.
+const UNDER_BAR: i32 = 130;
+/// The shortest bar: room for its two ends' labels and a tick between, pixels.
+const SHORTEST_BAR: i32 = 40;
+/// The space between the bar and the legend, pixels.
+const LEGEND_SPACE: i32 = 22;
+/// The distance between two lines of a legend entry, pixels.
+const ENTRY_LINE: i32 = 16;
+
+/// An entry of the legend under the bar.
+struct Entry {
+    colour: [u8; 3],
+    text: &'static str,
+}
+
+impl Entry {
+    fn lines(&self) -> Vec<String> {
+        wrap(self.text, 20)
+    }
+
+    /// Its lines and the space after it, pixels.
+    fn height(&self) -> i32 {
+        ENTRY_LINE * self.lines().len() as i32 + 12
+    }
+}
+
+/// Where the bar and the legend go in the panel, pixels from its top.
+struct Panel {
+    /// The bar's length.
+    length: i32,
+    /// The top of the legend.
+    legend_top: i32,
+    /// The height the bar and the legend need: a small picture's file grows to it.
+    height: i32,
+}
+
+impl Panel {
+    /// The bar as long as the picture allows with the legend under it, at least [`SHORTEST_BAR`].
+    fn new(picture_height: i32, entries: &[Entry]) -> Self {
+        let legend: i32 = entries.iter().map(Entry::height).sum();
+        let under = UNDER_BAR.max(LEGEND_SPACE + legend + 8);
+        let length = (picture_height - BAR_TOP - under).max(SHORTEST_BAR);
+        let legend_top = BAR_TOP + length + LEGEND_SPACE;
+        // The bottom label reaches half a label below the bar.
+        let height = if entries.is_empty() {
+            BAR_TOP + length + LABEL_GAP as i32 / 2 + 2
+        } else {
+            legend_top + legend
+        };
+        Panel {
+            length,
+            legend_top,
+            height,
+        }
+    }
+}
+
+impl Legend {
+    /// The entries the picture needs: the colours it shows that the bar does not cover.
+    fn entries(&self) -> Vec<Entry> {
+        let all = [
+            (self.back_sides, BACK_SIDE, "back side (seen from behind)"),
+            (self.no_data, NO_DATA, "no value (no segment left it)"),
+        ];
+        all.into_iter()
+            .filter(|(shown, ..)| *shown)
+            .map(|(_, colour, text)| Entry { colour, text })
+            .collect()
+    }
 }
 
 /// A whole number with its digits in groups of three (`10 000 000`).

@@ -20,12 +20,12 @@ pub struct BarLabel {
 }
 
 /// The most round ticks a bar carries between its ends.
-const MOST_TICKS: usize = 6;
+const MOST_TICKS: usize = 5;
 
 /// The labels of a bar `length` pixels long whose labels need `gap` pixels each: both ends, marked `≤`
 /// (`≥`) when values beyond them are drawn in the end's colour (`clipped`: low, high); every value of
-/// `marks` within the scale and `gap` from the ends; then the round ticks that keep `gap` from every
-/// label so far. Sorted from the low end.
+/// `marks` within the scale and `gap` from the ends; then round ticks that keep `gap` from every label
+/// and each other. Sorted from the low end.
 pub fn bar_labels(
     scale: &ColourScale,
     clipped: (bool, bool),
@@ -53,30 +53,52 @@ pub fn bar_labels(
             });
         }
     }
-    // About one tick per three label heights, and one more for the ticks that give way to the ends.
-    let about = ((length / (3.0 * gap)).round() as usize + 1).clamp(3, MOST_TICKS);
-    for value in tick_values(scale, about) {
-        let p = scale.position(value);
-        if clear_of(&labels, p) {
-            labels.push(BarLabel {
-                value,
-                position: p,
-                text: short_number(value),
-            });
-        }
-    }
+    let ticks = round_ticks(scale, &labels, length, gap);
+    labels.extend(ticks);
     labels.sort_by(|a, b| a.position.total_cmp(&b.position));
     labels
 }
 
-/// Round values within the scale, about `about` of them on a linear scale; 1, 2 and 5 x 10^k (or
-/// powers of ten over many decades) on a log scale over a decade.
-fn tick_values(scale: &ColourScale, about: usize) -> Vec<f64> {
-    if scale.log && scale.hi / scale.lo > 10.0 {
-        log_ticks(scale.lo, scale.hi)
+/// The round ticks between the labels so far: of the sets of round values [`nice_ticks`] offers (or
+/// [`log_ticks`] on a log scale over a decade), the one that leaves nearest one tick per three label
+/// heights clear of the labels and of each other, the coarsest on a tie.
+fn round_ticks(scale: &ColourScale, placed: &[BarLabel], length: f64, gap: f64) -> Vec<BarLabel> {
+    let wanted = ((length / (3.0 * gap)).round() as usize).clamp(1, MOST_TICKS);
+    let candidates: Vec<Vec<f64>> = if scale.log && scale.hi / scale.lo > 10.0 {
+        vec![log_ticks(scale.lo, scale.hi)]
     } else {
-        nice_ticks(scale.lo, scale.hi, about)
+        (2..=MOST_TICKS + 2)
+            .map(|about| nice_ticks(scale.lo, scale.hi, about))
+            .collect()
+    };
+    candidates
+        .iter()
+        .map(|values| clear_ticks(scale, values, placed, length, gap))
+        .min_by_key(|ticks| ticks.len().abs_diff(wanted))
+        .unwrap_or_default()
+}
+
+/// The labels of `values` that keep `gap` pixels from `placed` and from each other, from the low end.
+fn clear_ticks(
+    scale: &ColourScale,
+    values: &[f64],
+    placed: &[BarLabel],
+    length: f64,
+    gap: f64,
+) -> Vec<BarLabel> {
+    let mut kept: Vec<BarLabel> = Vec::new();
+    for &value in values {
+        let position = scale.position(value);
+        let clear = |l: &BarLabel| ((l.position - position) * length).abs() >= gap;
+        if placed.iter().all(clear) && kept.iter().all(clear) {
+            kept.push(BarLabel {
+                value,
+                position,
+                text: short_number(value),
+            });
+        }
     }
+    kept
 }
 
 /// The label of an end of the scale at `value`, after `mark` when values beyond it are clipped.

@@ -6,6 +6,7 @@
 //!   pixels (shaded by the viewing angle, back sides grey, patch outlines darkened);
 //! * [`colour`]: the quantities and the viridis colour scale;
 //! * [`bar`]: the colour bar's labels, both ends and round ticks;
+//! * [`title`]: the title fitted to the picture's width;
 //! * [`ply`]: the mesh with a colour per patch;
 //! * [`noise`]: whether the colours are mostly noise, and the lines that would fix it.
 
@@ -15,6 +16,7 @@ pub mod colour;
 pub mod image;
 pub mod noise;
 pub mod ply;
+pub mod title;
 
 pub use bar::{bar_labels, BarLabel};
 pub use camera::{default_camera, view_score, Camera, CameraError, ViewScore};
@@ -22,3 +24,4 @@ pub use colour::{ColourScale, Quantity, Tick, NO_DATA};
 pub use image::{trace_view, PatchImage, Sample, BACKGROUND, BACK_SIDE};
 pub use noise::{noise_summary, NoiseSummary};
 pub use ply::{write_ply, PlyFormat};
+pub use title::{fit_title, TitleLayout, TitleParts};

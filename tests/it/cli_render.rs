@@ -502,3 +502,77 @@ fn the_size_help_says_how_large_the_file_is() {
         .clone();
     assert_eq!((info.width, info.height), (100 + panel, 80 + header));
 }
+
+/// A decoded PNG: width, height and RGB bytes row by row.
+fn decode_rgb(path: &std::path::Path) -> (usize, usize, Vec<u8>) {
+    let decoder = png::Decoder::new(std::fs::File::open(path).unwrap());
+    let mut reader = decoder.read_info().unwrap();
+    let mut buf = vec![0; reader.output_buffer_size()];
+    let info = reader.next_frame(&mut buf).unwrap();
+    assert_eq!(info.color_type, png::ColorType::Rgb, "RGB pixels");
+    buf.truncate(info.buffer_size());
+    (info.width as usize, info.height as usize, buf)
+}
+
+/// The columns of rows `rows` that hold ink (a pixel darker than light grey).
+fn inked_columns(
+    (w, _, rgb): &(usize, usize, Vec<u8>),
+    rows: std::ops::Range<usize>,
+) -> Vec<usize> {
+    (0..*w)
+        .filter(|&x| {
+            rows.clone().any(|y| {
+                let at = 3 * (y * w + x);
+                rgb[at..at + 3].iter().any(|&c| c < 160)
+            })
+        })
+        .collect()
+}
+
+/// At 640x480 a long title (a scene file with a long name, the longest quantity) is drawn whole within
+/// the 34-pixel strip: its ink keeps clear of the file's right edge, where a title too long was cut.
+#[test]
+fn a_long_title_is_not_cut_at_640x480() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir
+        .path()
+        .join("a_scene_file_with_a_rather_long_descriptive_name_for_the_title_of_its_picture.obj");
+    let png = dir.path().join("p.png");
+    let (scene, png_path) = (scene.to_str().unwrap(), png.to_str().unwrap());
+    let out = scx(&["export", "@cube:2", "-o", scene]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let out = scx(&[
+        "render",
+        scene,
+        "--color",
+        "lost-information-corrected",
+        "--per-area",
+        "--lines",
+        "1e4",
+        "--threads",
+        "1",
+        "--size",
+        "640x480",
+        "-o",
+        png_path,
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let image = decode_rgb(&png);
+    assert_eq!((image.0, image.1), (640 + 210, 480 + 34));
+    let ink = inked_columns(&image, 0..34);
+    let (first, last) = (ink[0], ink[ink.len() - 1]);
+    assert!(first >= 8, "the title starts at column {first}");
+    assert!(
+        last + 8 < image.0,
+        "the title runs to column {last} of {}",
+        image.0
+    );
+}

@@ -363,3 +363,91 @@ fn every_colour_bar_has_both_ends_labelled_and_labels_apart() {
         }
     }
 }
+
+/// A width model for titles, independent of any font file: every character 0.6 of the size wide.
+fn model_width(text: &str, size: f64) -> f64 {
+    text.chars().count() as f64 * 0.6 * size
+}
+
+/// The words of `text`, without the `…` of an elision.
+fn words(text: &str) -> Vec<String> {
+    text.split_whitespace().map(str::to_string).collect()
+}
+
+/// At 640x480 (a file 850 wide, 830 for the title) the longest quantity's title with a real file's
+/// path fits in the 34-pixel strip: one line in a smaller font, or two, every word there in order.
+#[test]
+fn a_long_title_fits_a_640_pixel_picture_whole() {
+    use scene_complexity::render::{fit_title, TitleParts};
+    let parts = TitleParts {
+        scene: "/work/shared/real-scenes/objects/teapot.obj",
+        quantity: "information lost, I_i^c - I_i (corrected) [bit per unit area fraction]",
+        lines: "10 000 000 lines",
+    };
+    let width = 850.0 - 20.0;
+    let layout = fit_title(&parts, width, &model_width);
+    assert!(layout.lines.len() <= 2, "{layout:?}");
+    assert_eq!(layout.height(), 34.0);
+    assert!(layout.size >= 12.0, "{layout:?}");
+    for line in &layout.lines {
+        assert!(model_width(line, layout.size) <= width, "{line}");
+    }
+    let mut shown: Vec<String> = layout.lines.iter().flat_map(|l| words(l)).collect();
+    let mut said: Vec<String> = [parts.scene, parts.quantity, parts.lines]
+        .iter()
+        .flat_map(|p| words(p))
+        .collect();
+    shown.sort();
+    said.sort();
+    assert_eq!(shown, said, "every word of the title, none cut");
+}
+
+/// A path too long for its line keeps its start and its file's name around `…`; the line count stays.
+#[test]
+fn a_long_path_in_a_title_is_elided_in_the_middle() {
+    use scene_complexity::render::{fit_title, TitleParts};
+    let folder = "/home/someone/projects/lighting/scenes/archive/2019/".repeat(3);
+    let scene = format!("{folder}living_room_final.obj");
+    let parts = TitleParts {
+        scene: &scene,
+        quantity: "row entropy H_i [bit]",
+        lines: "1 000 000 lines",
+    };
+    let width = 830.0;
+    let layout = fit_title(&parts, width, &model_width);
+    assert_eq!(layout.lines.len(), 2, "{layout:?}");
+    let first = &layout.lines[0];
+    assert!(model_width(first, layout.size) <= width, "{first}");
+    let (start, end) = first.split_once('…').expect("an ellipsis");
+    assert!(scene.starts_with(start) && start.len() > 10, "{first}");
+    assert!(
+        end.ends_with("living_room_final.obj   1 000 000 lines"),
+        "{first}"
+    );
+    assert_eq!(layout.lines[1], parts.quantity);
+}
+
+/// A picture too narrow for the quantity on one line (64 pixels: a file 274 wide) wraps the title on a
+/// taller strip; no line is wider than the room.
+#[test]
+fn a_title_wraps_in_a_narrow_picture() {
+    use scene_complexity::render::{fit_title, TitleParts};
+    let parts = TitleParts {
+        scene: "@fig2:a",
+        quantity: "information lost, I_i^c - I_i (corrected) [bit per unit area fraction]",
+        lines: "1 000 000 lines",
+    };
+    let width = 274.0 - 20.0;
+    let layout = fit_title(&parts, width, &model_width);
+    assert!(layout.lines.len() >= 3, "{layout:?}");
+    assert!(layout.height() > 34.0);
+    assert!(layout.top(layout.lines.len() - 1) + layout.size <= layout.height());
+    for line in &layout.lines {
+        assert!(model_width(line, layout.size) <= width, "{line}");
+    }
+    assert_eq!(layout.lines[0], "@fig2:a");
+    assert_eq!(
+        layout.lines[1..].join(" ").replace("   ", " "),
+        format!("{} {}", parts.quantity, parts.lines)
+    );
+}
