@@ -49,7 +49,8 @@ pub struct RenderArgs {
     run: RunOptions,
     /// The camera, in the scene's units: `ex,ey,ez,tx,ty,tz,ux,uy,uz,fov` (eye, target, up, vertical
     /// field of view in degrees). Default: chosen from the geometry (+y up): small probe pictures
-    /// from inside each wall of the bounding box, from outside each side (a room open on one side is
+    /// from inside each wall of the bounding box (three quarters up, framing the far wall, the floor
+    /// and the lights), from outside each side (a room open on one side is
     /// seen through the opening) and around an object, the one showing most of the scene's area from
     /// the front, with fewest back sides, kept (the classic view from the -z wall unless another is
     /// over 10% better).

@@ -451,3 +451,77 @@ fn a_title_wraps_in_a_narrow_picture() {
         format!("{} {}", parts.quantity, parts.lines)
     );
 }
+
+/// The share of `samples` that see the front of a patch for which `pick` holds.
+fn share_showing(samples: &[Sample], pick: impl Fn(u32) -> bool) -> f64 {
+    let n = samples
+        .iter()
+        .filter(|s| matches!(s, Sample::Front { patch, .. } if pick(*patch)))
+        .count();
+    n as f64 / samples.len() as f64
+}
+
+/// Whether every corner of patch `p` lies within `eps` of `value` on `axis` (scene units).
+fn patch_on_plane(scene: &Scene, p: u32, axis: usize, value: f64, eps: f64) -> bool {
+    let patch = &scene.patches[p as usize];
+    scene
+        .polygon(patch)
+        .iter()
+        .all(|&v| (scene.vertices[v as usize][axis] - value).abs() <= eps)
+}
+
+/// The default view of a closed room stands inside it (the renderer draws the near wall's back, so a
+/// camera outside would see nothing else) and shows what a picture of a room is for: the floor (the
+/// patches in the plane of the lowest y), the far wall (in the plane of the bounds the camera faces)
+/// and, in the Cornell box, the light (the emitting patches), each on a visible part of the picture.
+#[test]
+fn the_default_view_of_a_room_shows_its_floor_light_and_far_wall() {
+    for spec in ["@cornell", "@cornell:4", "@cube:4"] {
+        let scene = scenes::load(spec).unwrap();
+        let tracer = make_tracer(Backend::Rust, &scene, Query::Single).unwrap();
+        let camera = default_camera(&scene, tracer.as_ref()).unwrap();
+        eprintln!("{spec}: {camera:?}");
+        assert!(
+            eye_inside_or_at(&scene, camera.eye, None),
+            "{spec}: {camera:?}"
+        );
+        let s = trace_view(&scene, tracer.as_ref(), &camera, 160, 120)
+            .unwrap()
+            .samples;
+        let (lo, hi) = scene.vertices.iter().fold(
+            (Point::splat(f64::INFINITY), Point::splat(f64::NEG_INFINITY)),
+            |(lo, hi), v| (lo.min(*v), hi.max(*v)),
+        );
+        let eps = 1e-6 * (hi - lo).max_element();
+        // The far wall: across the axis the camera looks along most, on the side it looks to.
+        let view = camera.target - camera.eye;
+        let axis = if view.x.abs() > view.z.abs() { 0 } else { 2 };
+        let far = if view[axis] > 0.0 { hi[axis] } else { lo[axis] };
+        let floor = share_showing(&s, |p| patch_on_plane(&scene, p, 1, lo.y, eps));
+        let wall = share_showing(&s, |p| patch_on_plane(&scene, p, axis, far, eps));
+        assert!(
+            floor > 0.02,
+            "{spec}: the floor on {floor:.3} of the picture"
+        );
+        assert!(
+            wall > 0.05,
+            "{spec}: the far wall on {wall:.3} of the picture"
+        );
+        let emits = |p: u32| {
+            let patch = &scene.patches[p as usize];
+            scene.materials[patch.material as usize].emission > 0.0
+        };
+        if scene
+            .patches
+            .iter()
+            .enumerate()
+            .any(|(p, _)| emits(p as u32))
+        {
+            let light = share_showing(&s, emits);
+            assert!(
+                light > 0.01,
+                "{spec}: the light on {light:.3} of the picture"
+            );
+        }
+    }
+}
