@@ -24,8 +24,8 @@ const MOST_TICKS: usize = 5;
 
 /// The labels of a bar `length` pixels long whose labels need `gap` pixels each: both ends, marked `≤`
 /// (`≥`) when values beyond them are drawn in the end's colour (`clipped`: low, high); every value of
-/// `marks` within the scale and `gap` from the ends; then round ticks that keep `gap` from every label
-/// and each other. Sorted from the low end.
+/// `marks` within the scale and `gap` from the ends; then evenly spaced round ticks that keep `gap` from
+/// every label and each other. Sorted from the low end.
 pub fn bar_labels(
     scale: &ColourScale,
     clipped: (bool, bool),
@@ -60,12 +60,20 @@ pub fn bar_labels(
 }
 
 /// The round ticks between the labels so far: of the sets of round values [`nice_ticks`] offers (or
-/// [`log_ticks`] on a log scale over a decade), the one that leaves nearest one tick per three label
-/// heights clear of the labels and of each other, the coarsest on a tie.
+/// [`log_ticks`] on a log scale over a decade) whose ticks keep clear of each other, the one that leaves
+/// nearest one tick per three label heights clear of the labels, the coarsest on a tie.
 fn round_ticks(scale: &ColourScale, placed: &[BarLabel], length: f64, gap: f64) -> Vec<BarLabel> {
     let wanted = ((length / (3.0 * gap)).round() as usize).clamp(1, MOST_TICKS);
     let candidates: Vec<Vec<f64>> = if scale.log && scale.hi / scale.lo > 10.0 {
-        vec![log_ticks(scale.lo, scale.hi)]
+        let ticks = log_ticks(scale.lo, scale.hi);
+        // Coarser: the powers of ten among them, then every second and third.
+        let decades: Vec<f64> = ticks
+            .iter()
+            .copied()
+            .filter(|t| (t.log10() - t.log10().round()).abs() < 1e-9)
+            .collect();
+        let every = |n: usize| decades.iter().copied().step_by(n).collect();
+        vec![ticks.clone(), every(1), every(2), every(3)]
     } else {
         (2..=MOST_TICKS + 2)
             .map(|about| nice_ticks(scale.lo, scale.hi, about))
@@ -73,32 +81,9 @@ fn round_ticks(scale: &ColourScale, placed: &[BarLabel], length: f64, gap: f64) 
     };
     candidates
         .iter()
-        .map(|values| clear_ticks(scale, values, placed, length, gap))
+        .filter_map(|values| clear_ticks(scale, values, placed, length, gap))
         .min_by_key(|ticks| ticks.len().abs_diff(wanted))
         .unwrap_or_default()
-}
-
-/// The labels of `values` that keep `gap` pixels from `placed` and from each other, from the low end.
-fn clear_ticks(
-    scale: &ColourScale,
-    values: &[f64],
-    placed: &[BarLabel],
-    length: f64,
-    gap: f64,
-) -> Vec<BarLabel> {
-    let mut kept: Vec<BarLabel> = Vec::new();
-    for &value in values {
-        let position = scale.position(value);
-        let clear = |l: &BarLabel| ((l.position - position) * length).abs() >= gap;
-        if placed.iter().all(clear) && kept.iter().all(clear) {
-            kept.push(BarLabel {
-                value,
-                position,
-                text: short_number(value),
-            });
-        }
-    }
-    kept
 }
 
 /// The label of an end of the scale at `value`, after `mark` when values beyond it are clipped.
@@ -139,4 +124,32 @@ fn significant(v: f64, digits: usize) -> f64 {
     format!("{v:.*e}", digits.saturating_sub(1))
         .parse()
         .unwrap_or(v)
+}
+
+/// The labels of `values` that keep `gap` pixels from `placed`; `None` when two of them crowd each
+/// other (dropping one would leave the ticks unevenly spaced: a coarser set does better).
+fn clear_ticks(
+    scale: &ColourScale,
+    values: &[f64],
+    placed: &[BarLabel],
+    length: f64,
+    gap: f64,
+) -> Option<Vec<BarLabel>> {
+    let mut kept: Vec<BarLabel> = Vec::new();
+    for &value in values {
+        let position = scale.position(value);
+        let clear = |l: &BarLabel| ((l.position - position) * length).abs() >= gap;
+        if !placed.iter().all(clear) {
+            continue;
+        }
+        if !kept.iter().all(clear) {
+            return None;
+        }
+        kept.push(BarLabel {
+            value,
+            position,
+            text: short_number(value),
+        });
+    }
+    Some(kept)
 }

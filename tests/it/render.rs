@@ -330,8 +330,8 @@ fn a_colour_bar_labels_both_ends_and_round_ticks_between() {
     );
 }
 
-/// On any scale and bar length, the first label is the low end and the last the high end, and no two
-/// labels are closer than the room a label needs.
+/// On any scale and bar length, the first label is the low end and the last the high end, no two labels
+/// are closer than the room a label needs, and the round ticks between are evenly spaced.
 #[test]
 fn every_colour_bar_has_both_ends_labelled_and_labels_apart() {
     use scene_complexity::render::{bar_labels, ColourScale};
@@ -359,6 +359,20 @@ fn every_colour_bar_has_both_ends_labelled_and_labels_apart() {
             for pair in labels.windows(2) {
                 let apart = (pair[1].position - pair[0].position) * length;
                 assert!(apart >= 16.0 || labels.len() == 2, "{length}: {labels:?}");
+            }
+            // On a linear scale the round ticks between the ends (and the mark at 0) are evenly
+            // spaced: none left out between two others.
+            let inner: Vec<f64> = labels[1..labels.len() - 1]
+                .iter()
+                .filter(|l| l.value != 0.0)
+                .map(|l| l.value)
+                .collect();
+            if !log && inner.len() >= 3 {
+                let step = inner[1] - inner[0];
+                for pair in inner.windows(2) {
+                    let d = pair[1] - pair[0];
+                    assert!((d - step).abs() < 1e-9 * step, "{length}: {labels:?}");
+                }
             }
         }
     }
