@@ -4,6 +4,7 @@
 use std::path::{Path, PathBuf};
 
 use plotters::prelude::*;
+use scene_complexity::render::colour::viridis;
 use scene_complexity::render::{
     bar_labels, default_camera, fit_title, noise_summary, trace_view, write_ply, Camera,
     ColourScale, PlyFormat, Quantity, Sample, TitleLayout, TitleParts, BACK_SIDE, NO_DATA,
@@ -11,6 +12,7 @@ use scene_complexity::render::{
 use scene_complexity::PatchMaterials;
 use scene_complexity::Scene;
 use scene_complexity::{Measures, RunSpec, StopReason};
+use scene_complexity::{PatchMeasure, RunWarningKind};
 use scene_complexity::{Point, Vector};
 
 use super::args::{parse_count, RunOptions};
@@ -281,6 +283,7 @@ pub fn run(args: &RenderArgs) -> Result<Exit, Failure> {
             .any(|s| matches!(s, Sample::Front { patch, .. } if values[*patch as usize].is_none())),
         clipped_low: values.iter().flatten().any(|&v| v < scale.lo),
         clipped_high: values.iter().flatten().any(|&v| v > scale.hi),
+        below_theory: below_theory(args.color, &analysis, &scale),
     };
     let (pw, ph, pixels) = image.to_rgb(&colours, SUPERSAMPLING);
     let quantity = format!(
@@ -384,6 +387,34 @@ struct Legend {
     no_data: bool,
     clipped_low: bool,
     clipped_high: bool,
+    /// The least value the theory allows, when the bar runs below it, and what the part below is.
+    below_theory: Option<(f64, &'static str)>,
+}
+
+/// The least value the theory allows the quantity, when the colour scale runs below it, and what the
+/// readings below it are: the run's own warning names the plug-in bias when it counted such patches.
+fn below_theory(
+    quantity: Quantity,
+    analysis: &scene_complexity::Analysis,
+    scale: &ColourScale,
+) -> Option<(f64, &'static str)> {
+    let closed = analysis.escapes == 0 && analysis.pairs > 0;
+    let least = quantity
+        .least_in_theory(closed)
+        .filter(|&least| scale.lo < least)?;
+    let warned = analysis
+        .warnings
+        .iter()
+        .any(|w| w.kind == RunWarningKind::NegativeLostInformation);
+    let plug_in = quantity == Quantity::Patch(PatchMeasure::LostInformation);
+    Some((
+        least,
+        if plug_in && warned {
+            "below 0: plug-in bias, see warning"
+        } else {
+            "below 0: the estimate's error (0 or more in theory)"
+        },
+    ))
 }
 
 fn draw_png(
@@ -465,18 +496,25 @@ fn draw_bar<DB: DrawingBackend>(
     let (top, height) = (BAR_TOP, panel.length);
     for k in 0..height {
         let t = 1.0 - f64::from(k) / f64::from(height - 1);
-        let [r, g, b] = scene_complexity::render::colour::viridis(t);
+        let [r, g, b] = viridis(t);
         root.draw(&Rectangle::new(
             [(x0, top + k), (x0 + 26, top + k + 1)],
             RGBColor(r, g, b).filled(),
         ))?;
     }
-    root.draw(&Rectangle::new([(x0, top), (x0 + 26, top + height)], BLACK))?;
     let y_of = |position: f64| top + ((1.0 - position) * f64::from(height - 1)).round() as i32;
+    let marks: Vec<f64> = legend.below_theory.iter().map(|b| b.0).collect();
+    if let Some(&least) = marks.first() {
+        hatch(
+            root,
+            [(x0, y_of(scale.position(least))), (x0 + 26, top + height)],
+        )?;
+    }
+    root.draw(&Rectangle::new([(x0, top), (x0 + 26, top + height)], BLACK))?;
     let labels = bar_labels(
         scale,
         (legend.clipped_low, legend.clipped_high),
-        &[],
+        &marks,
         f64::from(height - 1),
         f64::from(LABEL_GAP),
     );
@@ -499,6 +537,9 @@ fn draw_entries<DB: DrawingBackend>(
         let [r, g, b] = entry.colour;
         let swatch = [(x0, y), (x0 + 18, y + 14)];
         root.draw(&Rectangle::new(swatch, RGBColor(r, g, b).filled()))?;
+        if entry.hatched {
+            hatch(root, swatch)?;
+        }
         root.draw(&Rectangle::new(swatch, BLACK))?;
         for (k, line) in entry.lines().iter().enumerate() {
             root.draw(&Text::new(
@@ -523,9 +564,34 @@ const LEGEND_SPACE: i32 = 22;
 /// The distance between two lines of a legend entry, pixels.
 const ENTRY_LINE: i32 = 16;
 
+/// Light diagonal lines over the rectangle from its top left to its bottom right corner: the part of
+/// the bar the theory rules out, its colours still showing between them.
+fn hatch<DB: DrawingBackend>(
+    root: &DrawingArea<DB, plotters::coord::Shift>,
+    [(x0, y0), (x1, y1)]: [(i32, i32); 2],
+) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
+    let style = WHITE.mix(0.75).stroke_width(1);
+    // The lines x - y = c through the rectangle, each from where it enters to where it leaves.
+    for c in ((x0 - y1)..=(x1 - y0)).step_by(HATCH_SPACING) {
+        let (top, bottom) = (y0.max(x0 - c), y1.min(x1 - c));
+        if top < bottom {
+            root.draw(&PathElement::new(
+                vec![(top + c, top), (bottom + c, bottom)],
+                style,
+            ))?;
+        }
+    }
+    Ok(())
+}
+
+/// The distance between hatching lines along the bar, pixels.
+const HATCH_SPACING: usize = 6;
+
 /// An entry of the legend under the bar.
 struct Entry {
     colour: [u8; 3],
+    /// Hatched: the part of the bar below what the theory allows.
+    hatched: bool,
     text: &'static str,
 }
 
@@ -578,9 +644,19 @@ impl Legend {
             (self.back_sides, BACK_SIDE, "back side (seen from behind)"),
             (self.no_data, NO_DATA, "no value (no segment left it)"),
         ];
+        let below = self.below_theory.map(|(_, text)| Entry {
+            colour: viridis(0.0),
+            hatched: true,
+            text,
+        });
         all.into_iter()
             .filter(|(shown, ..)| *shown)
-            .map(|(_, colour, text)| Entry { colour, text })
+            .map(|(_, colour, text)| Entry {
+                colour,
+                hatched: false,
+                text,
+            })
+            .chain(below)
             .collect()
     }
 }

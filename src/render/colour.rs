@@ -71,6 +71,19 @@ impl Quantity {
         matches!(self, Quantity::Patch(m) if m.info().unit == Unit::Radiosity)
     }
 
+    /// The least value the theory allows a patch, when it bounds the quantity: in a closed scene every
+    /// row's I_i^c is at least its I_i (the log-sum inequality: averaging the kernel over a pair of
+    /// patches loses information), so the information lost is at least 0 there, and a reading below 0
+    /// is the estimate's error (the plug-in I_i's bias on a thinly sampled row), not the patch's. Open
+    /// scenes' rows do not sum to 1, and the bound does not hold for them.
+    pub fn least_in_theory(self, closed: bool) -> Option<f64> {
+        let lost = [
+            PatchMeasure::LostInformation,
+            PatchMeasure::LostInformationCorrected,
+        ];
+        matches!(self, Quantity::Patch(m) if closed && lost.contains(&m)).then_some(0.0)
+    }
+
     /// The patch's value; `None` when the run has none (an unsampled patch, no light, no I_s^c).
     pub fn of(self, p: &PatchResult) -> Option<f64> {
         match self {
