@@ -8,6 +8,7 @@ use std::path::Path;
 
 use plotters::prelude::*;
 use plotters::style::FontStyle;
+use scene_complexity::render::colour::log_ticks;
 
 use super::file_kind::{check_extension, extension};
 
@@ -112,7 +113,8 @@ fn tick(v: f64) -> String {
     s.replace("e0", "")
 }
 
-fn bounds(curves: &[Curve]) -> ((f64, f64), (f64, f64)) {
+/// The points' extent in seconds and in error, `None` without points.
+fn extent(curves: &[Curve]) -> Option<((f64, f64), (f64, f64))> {
     let pts = curves.iter().flat_map(|c| c.points.iter());
     let (mut x0, mut x1, mut y0, mut y1) = (f64::INFINITY, 0.0f64, f64::INFINITY, 0.0f64);
     for &(x, y, _) in pts {
@@ -121,10 +123,63 @@ fn bounds(curves: &[Curve]) -> ((f64, f64), (f64, f64)) {
         y0 = y0.min(y);
         y1 = y1.max(y);
     }
-    if !(x0.is_finite() && y0.is_finite()) {
-        return ((0.01, 1.0), (1e-4, 1.0));
+    (x0.is_finite() && y0.is_finite()).then_some(((x0, x1), (y0, y1)))
+}
+
+/// A log axis: its range and its labelled ticks.
+#[derive(Clone, Debug, PartialEq)]
+struct LogAxis {
+    range: (f64, f64),
+    ticks: Vec<f64>,
+}
+
+/// The fewest labelled ticks an axis gets.
+const FEWEST_TICKS: usize = 3;
+
+impl LogAxis {
+    /// An axis over `lo..hi` (positive) with `pad` (below, above) as factors of room, ticked on 1, 2 and
+    /// 5 x 10^k (powers of ten over many decades). A range holding fewer than [`FEWEST_TICKS`] of them
+    /// (the points of one line count lie within a factor of a few) is widened to the powers of ten
+    /// around it, which hold four.
+    fn new(lo: f64, hi: f64, pad: (f64, f64)) -> Self {
+        let (lo, hi) = (lo / pad.0, hi * pad.1);
+        let ticks = log_ticks(lo, hi);
+        if ticks.len() >= FEWEST_TICKS {
+            return LogAxis {
+                range: (lo, hi),
+                ticks,
+            };
+        }
+        let (below, mut above) = (lo.log10().floor() as i32, hi.log10().ceil() as i32);
+        if above == below {
+            above += 1;
+        }
+        let range = (10f64.powi(below), 10f64.powi(above));
+        LogAxis {
+            range,
+            ticks: log_ticks(range.0, range.1),
+        }
     }
-    ((x0 / 1.6, x1 * 2.5), (y0 / 2.5, y1 * 2.5))
+
+    /// The faint grid lines: 1 to 9 x 10^k within the range.
+    fn grid(&self) -> Vec<f64> {
+        let (lo, hi) = self.range;
+        let (first, last) = (lo.log10().floor() as i32, hi.log10().ceil() as i32);
+        (first..=last)
+            .flat_map(|k| (1..10).map(move |m| f64::from(m) * 10f64.powi(k)))
+            .filter(|v| *v >= lo && *v <= hi)
+            .collect()
+    }
+}
+
+/// The axes of the plot: seconds and error, each with room around the points; a plot without points
+/// gets the axes of a typical run.
+fn axes(curves: &[Curve]) -> (LogAxis, LogAxis) {
+    let ((x0, x1), (y0, y1)) = extent(curves).unwrap_or(((0.016, 0.4), (4e-4, 0.4)));
+    (
+        LogAxis::new(x0, x1, (1.6, 2.5)),
+        LogAxis::new(y0, y1, (2.5, 2.5)),
+    )
 }
 
 /// The marker of a series: circle, triangle, square, diamond, cross.
@@ -150,13 +205,19 @@ fn draw<DB: DrawingBackend>(
     curves: &[Curve],
 ) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
     area.fill(&WHITE)?;
-    let ((x0, x1), (y0, y1)) = bounds(curves);
+    let (x, y) = axes(curves);
+    let coordinates = |axis: &LogAxis| {
+        (axis.range.0..axis.range.1)
+            .log_scale()
+            .with_key_points(axis.ticks.clone())
+            .with_light_points(axis.grid())
+    };
     let mut chart = ChartBuilder::on(&area)
         .caption(title, ("sans-serif", 22))
         .margin(16)
         .x_label_area_size(52)
         .y_label_area_size(76)
-        .build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())?;
+        .build_cartesian_2d(coordinates(&x), coordinates(&y))?;
     chart
         .configure_mesh()
         .x_desc("run time (s, log scale)")
@@ -222,5 +283,22 @@ mod tests {
         assert_eq!(tick(1.0), "1");
         assert_eq!(tick(100.0), "1e2");
         assert_eq!(tick(0.002), "2e-3");
+    }
+
+    /// Errors of one line count whose padded range holds two round ticks get the decade around them;
+    /// points over decades keep their padded range and its ticks.
+    #[test]
+    fn a_narrow_axis_widens_to_whole_decades() {
+        let one = LogAxis::new(0.03, 0.031, (2.5, 2.5));
+        assert_eq!(one.range, (0.01, 0.1));
+        let labels = |a: &LogAxis| a.ticks.iter().map(|&t| tick(t)).collect::<Vec<_>>();
+        assert_eq!(labels(&one), ["1e-2", "2e-2", "5e-2", "1e-1"]);
+        let many = LogAxis::new(1e-4, 0.1, (2.5, 2.5));
+        assert_eq!(many.range, (1e-4 / 2.5, 0.1 * 2.5));
+        assert_eq!(labels(&many), ["1e-4", "1e-3", "1e-2", "1e-1"]);
+        assert!(many
+            .grid()
+            .iter()
+            .all(|v| *v >= many.range.0 && *v <= many.range.1));
     }
 }

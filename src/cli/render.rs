@@ -4,14 +4,15 @@
 use std::path::{Path, PathBuf};
 
 use plotters::prelude::*;
-use scene_complexity::render::colour::short_number;
+use scene_complexity::render::colour::viridis;
 use scene_complexity::render::{
-    default_camera, noise_summary, trace_view, write_ply, Camera, ColourScale, PlyFormat, Quantity,
-    Sample, BACK_SIDE, NO_DATA,
+    bar_labels, default_camera, fit_title, noise_summary, trace_view, write_ply, Camera,
+    ColourScale, PlyFormat, Quantity, Sample, TitleLayout, TitleParts, BACK_SIDE, NO_DATA,
 };
 use scene_complexity::PatchMaterials;
 use scene_complexity::Scene;
 use scene_complexity::{Measures, RunSpec, StopReason};
+use scene_complexity::{PatchMeasure, RunWarningKind};
 use scene_complexity::{Point, Vector};
 
 use super::args::{parse_count, RunOptions};
@@ -51,14 +52,17 @@ pub struct RenderArgs {
     run: RunOptions,
     /// The camera, in the scene's units: `ex,ey,ez,tx,ty,tz,ux,uy,uz,fov` (eye, target, up, vertical
     /// field of view in degrees). Default: chosen from the geometry (+y up): small probe pictures
-    /// from inside each wall of the bounding box, from outside each side (a room open on one side is
+    /// from inside each wall of the bounding box (three quarters up, framing the far wall, the floor
+    /// and the lights), from outside each side (a room open on one side is
     /// seen through the opening) and around an object, the one showing most of the scene's area from
     /// the front, with fewest back sides, kept (the classic view from the -z wall unless another is
     /// over 10% better).
     #[arg(long, value_parser = parse_camera, allow_hyphen_values = true)]
     camera: Option<Camera>,
     /// The size of the scene's picture in pixels, WIDTHxHEIGHT; the file is larger by the colour bar on
-    /// the right (210 pixels) and the title strip above (34): 800x600 makes a file of 1010x634.
+    /// the right (210 pixels) and the title strip above (34): 800x600 makes a file of 1010x634. A long
+    /// title takes two lines in a smaller font; a picture too narrow even for that wraps it on a taller
+    /// strip.
     #[arg(long, default_value = "800x600", value_parser = parse_size)]
     size: (usize, usize),
     /// Divide the shares of a sum over patches (mutual-information, continuous-mutual-information,
@@ -162,8 +166,10 @@ fn parse_range(s: &str) -> Result<(f64, f64), String> {
 const SUPERSAMPLING: usize = 2;
 /// The width of the colour-bar panel right of the picture, pixels.
 const PANEL: u32 = 210;
-/// The height of the title strip above the picture, pixels.
-const HEADER: u32 = 34;
+/// The space left and right of the title, pixels.
+const MARGIN: u32 = 10;
+/// The room a colour bar's label needs (its 14-pixel text and a little space), pixels.
+const LABEL_GAP: u32 = 16;
 
 /// Runs `scx render`.
 pub fn run(args: &RenderArgs) -> Result<Exit, Failure> {
@@ -278,15 +284,20 @@ pub fn run(args: &RenderArgs) -> Result<Exit, Failure> {
             .any(|s| matches!(s, Sample::Front { patch, .. } if values[*patch as usize].is_none())),
         clipped_low: values.iter().flatten().any(|&v| v < scale.lo),
         clipped_high: values.iter().flatten().any(|&v| v > scale.hi),
+        below_theory: below_theory(args.color, &analysis, &scale),
     };
     let (pw, ph, pixels) = image.to_rgb(&colours, SUPERSAMPLING);
-    let title = format!(
-        "{}   {} [{}]   {} lines",
-        scene.name,
+    let quantity = format!(
+        "{} [{}]",
         args.color.label(),
-        args.color.unit(args.per_area),
-        grouped(analysis.lines)
+        args.color.unit(args.per_area)
     );
+    let lines = format!("{} lines", grouped(analysis.lines));
+    let title = TitleParts {
+        scene: &scene.name,
+        quantity: &quantity,
+        lines: &lines,
+    };
     let mut picture = Some((pw, ph, pixels));
     output::write_via(&args.output, "png", |temporary| {
         let picture = picture.take().unwrap_or_default();
@@ -361,109 +372,278 @@ struct Legend {
     no_data: bool,
     clipped_low: bool,
     clipped_high: bool,
+    /// The least value the theory allows, when the bar runs below it, and what the part below is.
+    below_theory: Option<(f64, &'static str)>,
+}
+
+/// The least value the theory allows the quantity, when the colour scale runs below it, and what the
+/// readings below it are: the run's own warning names the plug-in bias when it counted such patches.
+fn below_theory(
+    quantity: Quantity,
+    analysis: &scene_complexity::Analysis,
+    scale: &ColourScale,
+) -> Option<(f64, &'static str)> {
+    let closed = analysis.escapes == 0 && analysis.pairs > 0;
+    let least = quantity
+        .least_in_theory(closed)
+        .filter(|&least| scale.lo < least)?;
+    let warned = analysis
+        .warnings
+        .iter()
+        .any(|w| w.kind == RunWarningKind::NegativeLostInformation);
+    let plug_in = quantity == Quantity::Patch(PatchMeasure::LostInformation);
+    Some((
+        least,
+        if plug_in && warned {
+            "below 0: plug-in bias, see warning"
+        } else {
+            "below 0: the estimate's error (0 or more in theory)"
+        },
+    ))
 }
 
 fn draw_png(
     path: &Path,
     (w, h, pixels): (usize, usize, Vec<u8>),
-    title: &str,
+    title: &TitleParts,
     scale: &ColourScale,
     legend: &Legend,
 ) -> Result<(), Failure> {
     register_font().map_err(Failure::bad_input)?;
-    let size = (w as u32 + PANEL, h as u32 + HEADER);
+    let title = fit_title(title, f64::from(w as u32 + PANEL - 2 * MARGIN), &text_width);
+    let header = title.height().ceil() as u32;
+    let panel = Panel::new(h as i32, &legend.entries());
+    let size = (
+        w as u32 + PANEL,
+        (h as u32).max(panel.height as u32) + header,
+    );
     let fail = |e: &dyn std::fmt::Display| Failure {
         code: Exit::Io,
         message: format!("cannot draw {}: {e}", path.display()),
     };
     let root = BitMapBackend::new(path, size).into_drawing_area();
-    draw(&root, (w, h, pixels), title, scale, legend).map_err(|e| fail(&e))?;
+    let (title_area, rest) = root.split_vertically(header);
+    draw_title(&title_area, &title).map_err(|e| fail(&e))?;
+    draw(&rest, (w, h, pixels), scale, legend).map_err(|e| fail(&e))?;
     root.present().map_err(|e| fail(&e))
+}
+
+/// The width of `text` in the labels' font at `size`, pixels (unmeasurable text counts as too wide).
+fn text_width(text: &str, size: f64) -> f64 {
+    ("sans-serif", size)
+        .into_font()
+        .box_size(text)
+        .map_or(f64::INFINITY, |(w, _)| f64::from(w))
+}
+
+fn draw_title<DB: DrawingBackend>(
+    area: &DrawingArea<DB, plotters::coord::Shift>,
+    title: &TitleLayout,
+) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
+    area.fill(&WHITE)?;
+    let font = ("sans-serif", title.size).into_font().color(&BLACK);
+    for (k, line) in title.lines.iter().enumerate() {
+        let at = (MARGIN as i32, title.top(k) as i32);
+        area.draw(&Text::new(line.clone(), at, font.clone()))?;
+    }
+    Ok(())
 }
 
 fn draw<DB: DrawingBackend>(
     root: &DrawingArea<DB, plotters::coord::Shift>,
     (w, h, pixels): (usize, usize, Vec<u8>),
-    title: &str,
     scale: &ColourScale,
     legend: &Legend,
 ) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
     root.fill(&WHITE)?;
-    let text = |size: u32| ("sans-serif", size).into_font().color(&BLACK);
-    root.draw(&Text::new(title.to_string(), (10, 8), text(17)))?;
-    let picture =
-        BitMapElement::with_owned_buffer((0, HEADER as i32), (w as u32, h as u32), pixels)
-            .expect("the buffer has 3 bytes per pixel");
+    let picture = BitMapElement::with_owned_buffer((0, 0), (w as u32, h as u32), pixels)
+        .expect("the buffer has 3 bytes per pixel");
     root.draw(&picture)?;
-
-    // The bar: viridis from the bottom (lo) to the top (hi), ticks on its right.
+    let entries = legend.entries();
+    let panel = Panel::new(h as i32, &entries);
     let x0 = w as i32 + 22;
-    let (top, bottom) = (HEADER as i32 + 28, HEADER as i32 + h as i32 - 130);
-    let height = (bottom - top).max(20);
+    draw_bar(root, x0, &panel, scale, legend)?;
+    draw_entries(root, x0, panel.legend_top, &entries)
+}
+
+fn label_font(size: u32) -> TextStyle<'static> {
+    ("sans-serif", size).into_font().color(&BLACK)
+}
+
+/// The bar: viridis from the bottom (lo) to the top (hi), labels on its right.
+fn draw_bar<DB: DrawingBackend>(
+    root: &DrawingArea<DB, plotters::coord::Shift>,
+    x0: i32,
+    panel: &Panel,
+    scale: &ColourScale,
+    legend: &Legend,
+) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
+    let (top, height) = (BAR_TOP, panel.length);
     for k in 0..height {
         let t = 1.0 - f64::from(k) / f64::from(height - 1);
-        let [r, g, b] = scene_complexity::render::colour::viridis(t);
+        let [r, g, b] = viridis(t);
         root.draw(&Rectangle::new(
             [(x0, top + k), (x0 + 26, top + k + 1)],
             RGBColor(r, g, b).filled(),
         ))?;
     }
+    let y_of = |position: f64| top + ((1.0 - position) * f64::from(height - 1)).round() as i32;
+    let marks: Vec<f64> = legend.below_theory.iter().map(|b| b.0).collect();
+    if let Some(&least) = marks.first() {
+        hatch(
+            root,
+            [(x0, y_of(scale.position(least))), (x0 + 26, top + height)],
+        )?;
+    }
     root.draw(&Rectangle::new([(x0, top), (x0 + 26, top + height)], BLACK))?;
-    let y_of =
-        |value: f64| top + ((1.0 - scale.position(value)) * f64::from(height - 1)).round() as i32;
-    // Values beyond an end take its colour: the end is labelled `≥`/`≤` with its value to three
-    // significant digits, and round ticks too close to it give way.
-    let ends = [
-        (legend.clipped_high, scale.hi, "≥"),
-        (legend.clipped_low, scale.lo, "≤"),
-    ];
-    let mut labels: Vec<(i32, String)> = ends
-        .iter()
-        .filter(|(clipped, ..)| *clipped)
-        .map(|&(_, value, mark)| (y_of(value), format!("{mark} {}", three_digits(value))))
-        .collect();
-    for tick in scale.ticks() {
-        let y = y_of(tick.value);
-        if labels.iter().all(|(at, _)| (at - y).abs() >= 16) {
-            labels.push((y, tick.label));
-        }
-    }
-    for (y, label) in labels {
+    let labels = bar_labels(
+        scale,
+        (legend.clipped_low, legend.clipped_high),
+        &marks,
+        f64::from(height - 1),
+        f64::from(LABEL_GAP),
+    );
+    for label in labels {
+        let y = y_of(label.position);
         root.draw(&PathElement::new(vec![(x0 + 26, y), (x0 + 32, y)], BLACK))?;
-        root.draw(&Text::new(label, (x0 + 36, y - 7), text(14)))?;
-    }
-
-    // Swatches for what the bar does not cover.
-    let mut y = bottom + 22;
-    let swatches = [
-        (legend.back_sides, BACK_SIDE, "back side (seen from behind)"),
-        (legend.no_data, NO_DATA, "no value (no segment left it)"),
-    ];
-    for (shown, [r, g, b], label) in swatches {
-        if !shown {
-            continue;
-        }
-        root.draw(&Rectangle::new(
-            [(x0, y), (x0 + 18, y + 14)],
-            RGBColor(r, g, b).filled(),
-        ))?;
-        root.draw(&Rectangle::new([(x0, y), (x0 + 18, y + 14)], BLACK))?;
-        for (k, line) in wrap(label, 20).iter().enumerate() {
-            root.draw(&Text::new(
-                line.clone(),
-                (x0 + 24, y + 16 * k as i32),
-                text(13),
-            ))?;
-        }
-        y += 44;
+        root.draw(&Text::new(label.text, (x0 + 36, y - 7), label_font(14)))?;
     }
     Ok(())
 }
 
-/// `v` to three significant digits, without trailing zeros (an end of the bar is not a round value).
-fn three_digits(v: f64) -> String {
-    let rounded: f64 = format!("{v:.2e}").parse().unwrap_or(v);
-    short_number(rounded)
+/// The legend under the bar: a swatch and its wrapped text per entry, from `y` down.
+fn draw_entries<DB: DrawingBackend>(
+    root: &DrawingArea<DB, plotters::coord::Shift>,
+    x0: i32,
+    mut y: i32,
+    entries: &[Entry],
+) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
+    for entry in entries {
+        let [r, g, b] = entry.colour;
+        let swatch = [(x0, y), (x0 + 18, y + 14)];
+        root.draw(&Rectangle::new(swatch, RGBColor(r, g, b).filled()))?;
+        if entry.hatched {
+            hatch(root, swatch)?;
+        }
+        root.draw(&Rectangle::new(swatch, BLACK))?;
+        for (k, line) in entry.lines().iter().enumerate() {
+            root.draw(&Text::new(
+                line.clone(),
+                (x0 + 24, y + ENTRY_LINE * k as i32),
+                label_font(13),
+            ))?;
+        }
+        y += entry.height();
+    }
+    Ok(())
+}
+
+/// The top of the colour bar in the panel right of the picture, pixels (room for its top label).
+const BAR_TOP: i32 = 28;
+/// What a picture of ordinary height leaves under the bar for the legend, pixels.
+const UNDER_BAR: i32 = 130;
+/// The shortest bar: room for its two ends' labels and a tick between, pixels.
+const SHORTEST_BAR: i32 = 40;
+/// The space between the bar and the legend, pixels.
+const LEGEND_SPACE: i32 = 22;
+/// The distance between two lines of a legend entry, pixels.
+const ENTRY_LINE: i32 = 16;
+
+/// Light diagonal lines over the rectangle from its top left to its bottom right corner: the part of
+/// the bar the theory rules out, its colours still showing between them.
+fn hatch<DB: DrawingBackend>(
+    root: &DrawingArea<DB, plotters::coord::Shift>,
+    [(x0, y0), (x1, y1)]: [(i32, i32); 2],
+) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
+    let style = WHITE.mix(0.75).stroke_width(1);
+    // The lines x - y = c through the rectangle, each from where it enters to where it leaves.
+    for c in ((x0 - y1)..=(x1 - y0)).step_by(HATCH_SPACING) {
+        let (top, bottom) = (y0.max(x0 - c), y1.min(x1 - c));
+        if top < bottom {
+            root.draw(&PathElement::new(
+                vec![(top + c, top), (bottom + c, bottom)],
+                style,
+            ))?;
+        }
+    }
+    Ok(())
+}
+
+/// The distance between hatching lines along the bar, pixels.
+const HATCH_SPACING: usize = 6;
+
+/// An entry of the legend under the bar.
+struct Entry {
+    colour: [u8; 3],
+    /// Hatched: the part of the bar below what the theory allows.
+    hatched: bool,
+    text: &'static str,
+}
+
+impl Entry {
+    fn lines(&self) -> Vec<String> {
+        wrap(self.text, 20)
+    }
+
+    /// Its lines and the space after it, pixels.
+    fn height(&self) -> i32 {
+        ENTRY_LINE * self.lines().len() as i32 + 12
+    }
+}
+
+/// Where the bar and the legend go in the panel, pixels from its top.
+struct Panel {
+    /// The bar's length.
+    length: i32,
+    /// The top of the legend.
+    legend_top: i32,
+    /// The height the bar and the legend need: a small picture's file grows to it.
+    height: i32,
+}
+
+impl Panel {
+    /// The bar as long as the picture allows with the legend under it, at least [`SHORTEST_BAR`].
+    fn new(picture_height: i32, entries: &[Entry]) -> Self {
+        let legend: i32 = entries.iter().map(Entry::height).sum();
+        let under = UNDER_BAR.max(LEGEND_SPACE + legend + 8);
+        let length = (picture_height - BAR_TOP - under).max(SHORTEST_BAR);
+        let legend_top = BAR_TOP + length + LEGEND_SPACE;
+        // The bottom label reaches half a label below the bar.
+        let height = if entries.is_empty() {
+            BAR_TOP + length + LABEL_GAP as i32 / 2 + 2
+        } else {
+            legend_top + legend
+        };
+        Panel {
+            length,
+            legend_top,
+            height,
+        }
+    }
+}
+
+impl Legend {
+    /// The entries the picture needs: the colours it shows that the bar does not cover.
+    fn entries(&self) -> Vec<Entry> {
+        let all = [
+            (self.back_sides, BACK_SIDE, "back side (seen from behind)"),
+            (self.no_data, NO_DATA, "no value (no segment left it)"),
+        ];
+        let below = self.below_theory.map(|(_, text)| Entry {
+            colour: viridis(0.0),
+            hatched: true,
+            text,
+        });
+        all.into_iter()
+            .filter(|(shown, ..)| *shown)
+            .map(|(_, colour, text)| Entry {
+                colour,
+                hatched: false,
+                text,
+            })
+            .chain(below)
+            .collect()
+    }
 }
 
 /// A whole number with its digits in groups of three (`10 000 000`).
@@ -516,9 +696,6 @@ mod tests {
         assert!(parse_size("640").is_err() && parse_size("10x10").is_err());
         assert_eq!(parse_range("-1,2"), Ok((-1.0, 2.0)));
         assert!(parse_range("2,1").is_err());
-        assert_eq!(three_digits(0.48884), "0.489");
-        assert_eq!(three_digits(0.0118), "0.0118");
-        assert_eq!(three_digits(2.0), "2");
         assert_eq!(grouped(10_000_000), "10 000 000");
         assert_eq!(grouped(999), "999");
     }

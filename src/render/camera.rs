@@ -13,10 +13,12 @@
 //!
 //! The candidates, each a way to look at a room or at an object:
 //!
-//! * from inside, near the middle of each vertical wall of the bounding box (`-z` first: the Cornell
-//!   box's own view, the classic view), looking at the opposite wall, the field of view a little wider
-//!   than that wall, the eye moved further in or aside until almost every ray from it meets a front
-//!   side (a closed room);
+//! * from inside, near each vertical wall of the bounding box (`-z` first: the Cornell box's own view,
+//!   the classic view), three quarters of the way up, the eye moved further in or aside until almost
+//!   every ray from it meets a front side (a closed room: the picture draws the wall behind the eye
+//!   from behind, so the eye must be inside to see anything else); looking towards the opposite wall,
+//!   tilted and as wide as it takes to show that wall whole, the floor from the middle of the room on
+//!   and the lights ahead (the emitting patches), up to 100 degrees;
 //! * from outside the bounding sphere, above and from each of the four diagonals around it, front and
 //!   right first (an object in open space);
 //! * from outside, in front of each of the four vertical faces of the bounding box and above it,
@@ -106,6 +108,19 @@ const PROBE: (usize, usize) = (64, 48);
 /// without bound).
 const GRAZING: f64 = 0.2;
 
+/// How high the eye stands in a room, as a share of its height: above the middle, as a person looking
+/// in, so that the floor shows at a slant and a ceiling light not far above the view.
+const EYE_HEIGHT: f64 = 0.75;
+
+/// How far towards the far wall the floor must show from inside, as a share of the depth.
+const FLOOR_DEPTH: f64 = 0.5;
+
+/// The steepest tilt up or down of a view from inside, degrees.
+const MOST_TILT: i32 = 60;
+
+/// The widest field of view from inside, degrees: wider distorts the picture's edges beyond reading.
+const WIDEST: f64 = 100.0;
+
 /// The width over the height the views are framed for.
 const ASPECT: f64 = 4.0 / 3.0;
 
@@ -128,10 +143,11 @@ const THINNEST: f64 = 0.05;
 /// The default view of a scene (module documentation).
 pub fn default_camera(scene: &Scene, tracer: &dyn Tracer) -> Result<Camera, TraceError> {
     let bounds = Bounds::of(scene);
+    let lights = light_corners(scene);
     let mut candidates = Vec::new();
     for (axis, sign) in [(2, 1.0), (2, -1.0), (0, 1.0), (0, -1.0)] {
         let eye = inside_place(scene, tracer, &bounds, axis, sign)?;
-        candidates.push(bounds.inside_view(eye, axis, sign));
+        candidates.push(bounds.inside_view(eye, axis, sign, &lights));
     }
     candidates.extend(bounds.object_views());
     candidates.extend(
@@ -249,9 +265,9 @@ pub fn view_score(
     })
 }
 
-/// The first place near the wall at the `-sign` end of `axis`, in from it by a growing share of the
-/// depth and moved aside a little, from which almost every ray meets a front side; the best-surrounded
-/// place tried when none does.
+/// The first place near the wall at the `-sign` end of `axis`, [`EYE_HEIGHT`] up, in from the wall by a
+/// growing share of the depth and moved aside a little, from which almost every ray meets a front side;
+/// the best-surrounded place tried when none does.
 fn inside_place(
     scene: &Scene,
     tracer: &dyn Tracer,
@@ -267,7 +283,7 @@ fn inside_place(
             let mut eye = middle.to_array();
             eye[axis] = bounds.wall(axis, -sign) + sign * depth * size[axis];
             eye[across] += a * size[across];
-            eye[1] += b * size.y;
+            eye[1] = bounds.lo.y + (EYE_HEIGHT + b) * size.y;
             let eye = Point::from_array(eye);
             let surround = surround(scene, tracer, eye)?;
             if surround.front >= INSIDE_SHARE {
@@ -279,6 +295,53 @@ fn inside_place(
         }
     }
     Ok(best.expect("places were tried").0)
+}
+
+/// The half-height of the picture, as a tangent, that shows every one of `points` from `eye` looking
+/// along `forward` (up +y) in a picture of [`ASPECT`]; infinite when one is behind the eye.
+fn spread(eye: Point, forward: Vector, points: &[Point]) -> f64 {
+    let right = unit_vector(forward.cross(Vector::Y));
+    let up = right.cross(forward);
+    points
+        .iter()
+        .map(|&p| {
+            let to = p - eye;
+            let depth = to.dot(forward);
+            if depth <= 1e-9 * to.length() {
+                return f64::INFINITY;
+            }
+            (to.dot(up) / depth)
+                .abs()
+                .max((to.dot(right) / depth).abs() / ASPECT)
+        })
+        .fold(0.0, f64::max)
+}
+
+/// The corners of the box around the emitting patches (scene units); none when nothing emits.
+fn light_corners(scene: &Scene) -> Vec<Point> {
+    let emitting = scene
+        .patches
+        .iter()
+        .filter(|p| scene.materials[p.material as usize].emission > 0.0);
+    let (lo, hi) = emitting
+        .flat_map(|p| scene.polygon(p))
+        .map(|&v| scene.vertices[v as usize])
+        .fold(
+            (Point::splat(f64::INFINITY), Point::splat(f64::NEG_INFINITY)),
+            |(lo, hi), v| (lo.min(v), hi.max(v)),
+        );
+    if !lo.is_finite() {
+        return Vec::new();
+    }
+    (0..8)
+        .map(|k| {
+            Point::new(
+                if k & 1 == 0 { lo.x } else { hi.x },
+                if k & 2 == 0 { lo.y } else { hi.y },
+                if k & 4 == 0 { lo.z } else { hi.z },
+            )
+        })
+        .collect()
 }
 
 /// The scene's axis-aligned bounds in its own units.
@@ -323,20 +386,55 @@ impl Bounds {
         }
     }
 
-    /// From `eye` inside, looking along `sign` x `axis` (horizontal) at the middle of the far wall, the
-    /// field of view wider than that wall so that the floor, the ceiling and the side walls show.
-    fn inside_view(&self, eye: Point, axis: usize, sign: f64) -> Camera {
-        let size = self.size();
-        let mut target = self.middle().to_array();
-        target[axis] = self.wall(axis, sign);
-        let far = (target[axis] - eye[axis]).abs();
-        let half = 0.5 * size[2 - axis].max(size.y);
+    /// From `eye` inside, looking along `sign` x `axis` towards the far wall, tilted and as wide as it
+    /// takes to show [`Bounds::must_see`] with a margin (at most [`WIDEST`]).
+    fn inside_view(&self, eye: Point, axis: usize, sign: f64, lights: &[Point]) -> Camera {
+        let mut level = Vector::ZERO;
+        level[axis] = sign;
+        let must = self.must_see(eye, axis, sign, lights);
+        let (forward, spread) = (-MOST_TILT..=MOST_TILT)
+            .map(|degrees| {
+                let tilt = f64::from(degrees).to_radians();
+                let forward = tilt.cos() * level + tilt.sin() * Vector::Y;
+                (forward, spread(eye, forward, &must))
+            })
+            .min_by(|a, b| a.1.total_cmp(&b.1))
+            .expect("tilts were tried");
+        let far = (self.wall(axis, sign) - eye[axis]).abs();
         Camera {
             eye,
-            target: Point::from_array(target),
+            target: eye + far * forward,
             up: Vector::Y,
-            fov_degrees: (2.0 * (1.3 * half / far).atan()).to_degrees().min(120.0),
+            fov_degrees: (2.0 * (1.05 * spread).atan()).to_degrees().min(WIDEST),
         }
+    }
+
+    /// What a view from inside must show: the far wall's corners, the floor across the middle
+    /// [`FLOOR_DEPTH`] of the way to the far wall, and the corners of the lights' box where they are
+    /// ahead of the eye (a light above or behind the eye cannot be framed with the far wall).
+    fn must_see(&self, eye: Point, axis: usize, sign: f64, lights: &[Point]) -> Vec<Point> {
+        let across = 2 - axis;
+        let far = self.wall(axis, sign);
+        let mut points: Vec<Point> = [(0, 0), (0, 1), (1, 0), (1, 1)]
+            .map(|(a, b)| {
+                let mut p = [0.0; 3];
+                p[axis] = far;
+                p[across] = if a == 0 {
+                    self.lo[across]
+                } else {
+                    self.hi[across]
+                };
+                p[1] = if b == 0 { self.lo.y } else { self.hi.y };
+                Point::from_array(p)
+            })
+            .to_vec();
+        let mut floor = self.middle().to_array();
+        floor[axis] = eye[axis] + FLOOR_DEPTH * (far - eye[axis]);
+        floor[1] = self.lo.y;
+        points.push(Point::from_array(floor));
+        let ahead = |p: &&Point| sign * (p[axis] - eye[axis]) > 0.1 * (far - eye[axis]).abs();
+        points.extend(lights.iter().filter(ahead));
+        points
     }
 
     /// From outside the face at the `-sign` end of `axis`, looking along `sign` x `axis` at the middle,

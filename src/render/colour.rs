@@ -71,6 +71,19 @@ impl Quantity {
         matches!(self, Quantity::Patch(m) if m.info().unit == Unit::Radiosity)
     }
 
+    /// The least value the theory allows a patch, when it bounds the quantity: in a closed scene every
+    /// row's I_i^c is at least its I_i (the log-sum inequality: averaging the kernel over a pair of
+    /// patches loses information), so the information lost is at least 0 there, and a reading below 0
+    /// is the estimate's error (the plug-in I_i's bias on a thinly sampled row), not the patch's. Open
+    /// scenes' rows do not sum to 1, and the bound does not hold for them.
+    pub fn least_in_theory(self, closed: bool) -> Option<f64> {
+        let lost = [
+            PatchMeasure::LostInformation,
+            PatchMeasure::LostInformationCorrected,
+        ];
+        matches!(self, Quantity::Patch(m) if closed && lost.contains(&m)).then_some(0.0)
+    }
+
     /// The patch's value; `None` when the run has none (an unsampled patch, no light, no I_s^c).
     pub fn of(self, p: &PatchResult) -> Option<f64> {
         match self {
@@ -234,7 +247,7 @@ pub fn nice_ticks(lo: f64, hi: f64, about: usize) -> Vec<f64> {
 
 /// 1, 2 and 5 x 10^k from `lo` to `hi` (`0 < lo < hi`) when they span at most three decades; powers of
 /// ten over more, every second, third... so that at most about [`TICKS`] + 2 remain.
-fn log_ticks(lo: f64, hi: f64) -> Vec<f64> {
+pub fn log_ticks(lo: f64, hi: f64) -> Vec<f64> {
     let (first, last) = (lo.log10().floor() as i32, hi.log10().ceil() as i32);
     let decades = last - first;
     let within = |v: &f64| *v >= lo * (1.0 - 1e-9) && *v <= hi * (1.0 + 1e-9);

@@ -318,6 +318,64 @@ fn convergence_writes_a_table_a_csv_and_a_plot() {
     );
 }
 
+/// The texts of an SVG's `<text>` elements anchored as `anchor` that read as numbers: the tick labels of
+/// the y axis (`end`, right of the labels) or of the x axis (`middle`, with the titles, which do not
+/// read as numbers).
+fn svg_tick_values(svg: &str, anchor: &str) -> Vec<f64> {
+    let marker = format!("text-anchor=\"{anchor}\"");
+    svg.split("<text ")
+        .skip(1)
+        .filter(|element| element.split('>').next().unwrap_or("").contains(&marker))
+        .filter_map(|element| {
+            let body = element.split_once('>')?.1.split("</text>").next()?;
+            body.trim().parse::<f64>().ok()
+        })
+        .collect()
+}
+
+/// A convergence plot of one line count has a y axis with round ticks (1, 2, 5 x 10^k), at least three,
+/// the lowest below every error plotted and the highest above (the errors are the JSON report's
+/// standard errors of the plotted measures), and an x axis with ticks too.
+#[test]
+fn a_convergence_plot_of_one_line_count_has_ticks_around_its_points() {
+    let dir = tempfile::tempdir().unwrap();
+    let svg = dir.path().join("p.svg");
+    let out = scx(&[
+        "convergence",
+        "@cube:4",
+        "--lines",
+        "1e5",
+        "--threads",
+        "1",
+        "--format",
+        "json",
+        "--plot",
+        svg.to_str().unwrap(),
+    ]);
+    let doc = json_of(&out);
+    let plot = std::fs::read_to_string(&svg).unwrap();
+    let y = svg_tick_values(&plot, "end");
+    assert!(y.len() >= 3, "y ticks {y:?}");
+    for v in &y {
+        let mantissa = v / 10f64.powf(v.log10().floor());
+        assert!(
+            [1.0, 2.0, 5.0].iter().any(|m| (mantissa - m).abs() < 1e-9),
+            "{v} is not 1, 2 or 5 x 10^k"
+        );
+    }
+    let (lowest, highest) = (y[0].min(y[y.len() - 1]), y[0].max(y[y.len() - 1]));
+    let measures = doc["runs"][0]["measures"].as_object().unwrap();
+    for key in ["I_s", "I_s_corrected", "I_s^c"] {
+        let e = measures[key]["stderr"].as_f64().unwrap();
+        assert!(
+            lowest < e && e < highest,
+            "{key}: {e} outside the ticks {y:?}"
+        );
+    }
+    let x = svg_tick_values(&plot, "middle");
+    assert!(x.len() >= 2, "x ticks {x:?}");
+}
+
 /// `convergence --format json` carries every reading's verdict, as its help says, and the verdicts are
 /// the CSV's of the same runs.
 #[test]
