@@ -1,7 +1,7 @@
 //! `scx render`: the PNG decodes to the size asked for plus the colour bar, the PLY parses with one
 //! coloured face per patch whose corners are the patch's, and bad requests fail before any line is cast.
 
-use crate::support::scx;
+use crate::support::{self, scx};
 use scene_complexity::internals::scenes;
 
 /// A careful PLY reader for the files `scx render` writes, ASCII or binary little-endian: the header's
@@ -648,7 +648,7 @@ fn the_bar_hatches_the_information_lost_below_0() {
         "{err}"
     );
     let image = decode_rgb(&png);
-    let out = scx(&[
+    support::text_of(scx(&[
         "analyze",
         "@fig2:a",
         "--lines",
@@ -658,12 +658,7 @@ fn the_bar_hatches_the_information_lost_below_0() {
         "-q",
         "--patches",
         csv.to_str().unwrap(),
-    ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    ]));
     let table = std::fs::read_to_string(&csv).unwrap();
     let (lo, hi) = (
         area_quantile(&table, "lost_information", 0.01),
