@@ -246,7 +246,7 @@ pub fn nice_ticks(lo: f64, hi: f64, about: usize) -> Vec<f64> {
 }
 
 /// 1, 2 and 5 x 10^k from `lo` to `hi` (`0 < lo < hi`) when they span at most three decades; powers of
-/// ten over more, every second, third... so that at most about [`TICKS`] + 2 remain.
+/// ten over more, every second, third... so that at most about `TICKS` + 2 remain.
 pub fn log_ticks(lo: f64, hi: f64) -> Vec<f64> {
     let (first, last) = (lo.log10().floor() as i32, hi.log10().ceil() as i32);
     let decades = last - first;
