@@ -26,7 +26,7 @@ use crate::analysis::{analyze, Analysis, AnalysisError};
 use crate::geom::DVec3;
 use crate::measure::{Estimate, Measure};
 use crate::run::{
-    all_batches, map_batches, BatchPlan, LineStream, Measures, RunControl, RunSpec, TraceBuffers,
+    all_batches, map_batches, BatchPlan, LineStream, LinesThrough, Measures, RunControl, RunSpec, TraceBuffers,
 };
 use crate::scene::Scene;
 use crate::trace::rust::bvh::margin;
@@ -517,7 +517,8 @@ pub fn crosscheck(
         groups,
         measures: Measures::VISIBILITY,
         ..RunSpec::new(cfg.lines, cfg.seed)
-    };
+    }
+    .through(scene, LinesThrough::Auto);
     let measures = compare_measures(scene, a, b, &analysis)?;
     Ok(CrossCheck {
         scene: scene.name.clone(),

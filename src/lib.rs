@@ -109,7 +109,9 @@ pub use run::{
     SamplerChoice, SavedRun, SceneRef, Scope, Shard, SpecDifference, SpecError, StartError,
     StopReason, Target, Tracing, DEFAULT_ESTIMATOR, DEFAULT_GROUPS,
 };
-pub use sample::bounds::{lines_to_draw, sphere_lines, sphere_lines_of_drawn, LineBound};
+pub use sample::bounds::{
+    lines_to_draw, sphere_lines, sphere_lines_for_drawn, sphere_lines_of_drawn, LineBound,
+};
 pub use sample::counts::PairCounts;
 pub use sample::lines::{BundleError, LineSource, Sampler, MAX_BUNDLE_GRID};
 pub use sample::tally::{Tally, Wanted};

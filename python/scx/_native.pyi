@@ -230,7 +230,13 @@ class Analysis:
         """The scene analysed."""
     @property
     def lines(self) -> int:
-        """Lines cast."""
+        """Lines cast: drawn through the bound of :attr:`lines_through`."""
+    @property
+    def sphere_lines(self) -> int:
+        """What the lines cast are worth in lines through the bounding sphere, the unit of ``lines=``."""
+    @property
+    def lines_through(self) -> str:
+        """Where the lines were drawn: ``"sphere"``, ``"box"`` or ``"polytope"``."""
     @property
     def seed(self) -> int:
         """The seed of the line streams."""

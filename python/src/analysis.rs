@@ -298,10 +298,25 @@ impl Analysis {
         self.scene.clone_ref(py)
     }
 
-    /// Lines cast.
+    /// Lines cast: drawn through the bound of :attr:`lines_through`.
     #[getter]
     fn lines(&self) -> u64 {
         self.inner.lines
+    }
+
+    /// What the lines cast are worth in lines through the bounding sphere, the unit of ``lines=``
+    /// (the count asked, when the run cast them all): as many as :attr:`lines` through the sphere, more
+    /// through a box or polytope smaller than it.
+    #[getter]
+    fn sphere_lines(&self) -> u64 {
+        let scene = &self.scene.get().inner;
+        scene_complexity::sphere_lines_of_drawn(scene, self.inner.spec.bound, self.inner.lines)
+    }
+
+    /// Where the lines were drawn: ``"sphere"``, ``"box"`` or ``"polytope"``.
+    #[getter]
+    fn lines_through(&self) -> &'static str {
+        self.inner.spec.bound.name()
     }
 
     /// The seed of the line streams.

@@ -176,9 +176,12 @@ def test_to_dict_of_a_run_through_the_box_is_the_json_of_scx_analyze():
         "--lines-through", "box",
     )
     assert without_process(d) == without_process(cli)
-    for kwargs in ({}, {"sampler": "sobol", "lines_through": "sphere"}):
+    for kwargs in ({"lines_through": "sphere"}, {"sampler": "sobol", "lines_through": "sphere"}):
         d = scx.analyze("@cube:4", lines=2e5, seed=3, threads=1, **kwargs).to_dict()
         assert (d["lines_through"], d["lines"], d["sphere_lines"]) == ("sphere", 200000, 200000)
+    # Independent lines (the default with every measure) go through the box too, as many as sobol's.
+    independent = scx.analyze("@cube:4", lines=2e5, seed=3, threads=1).to_dict()
+    assert (independent["lines_through"], independent["lines"]) == ("box", a.lines)
     # The octahedron is its own bounding polytope: auto draws through it; the icosahedron's faces lie in
     # none of the polytope's planes: auto keeps the sphere.
     for name, through in (("@octahedron", "polytope"), ("@icosahedron", "sphere")):
@@ -187,7 +190,8 @@ def test_to_dict_of_a_run_through_the_box_is_the_json_of_scx_analyze():
 
 def test_the_default_sampler_draws_sobol_lines_for_i_s_c_alone():
     # sampler="auto" (the default): Sobol' lines through the box for a run of I_s^c alone, the same
-    # numbers as the command line's default; independent lines for every run that counts patch pairs.
+    # numbers as the command line's default; independent lines (through the box too) for every run that
+    # counts patch pairs.
     alone = scx.analyze("@cube:4", lines=2e5, seed=3, threads=1, measures=["continuous"]).to_dict()
     assert (alone["sampler"], alone["lines_through"]) == ("sobol", "box")
     cli = run_cli(
@@ -196,7 +200,7 @@ def test_the_default_sampler_draws_sobol_lines_for_i_s_c_alone():
     assert without_process(alone) == without_process(cli)
     for kwargs in ({}, {"measures": ["continuous"], "sampler": "independent"}):
         d = scx.analyze("@cube:4", lines=2e5, seed=3, threads=1, **kwargs).to_dict()
-        assert (d["sampler"], d["lines_through"]) == ("independent", "sphere")
+        assert (d["sampler"], d["lines_through"]) == ("independent", "box")
 
 
 def test_an_enclosed_run_has_the_environment_as_its_last_patch(tmp_path):

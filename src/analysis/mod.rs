@@ -35,7 +35,7 @@ use crate::run::{
     BatchPlan, BatchSet, CastHooks, CastOptions, ErrorMethod, FinishedRun, RunControl, RunSpec,
     RunState, SpecError, StartError, StopReason, TargetReading,
 };
-use crate::sample::bounds::sphere_lines;
+use crate::sample::bounds::{sphere_lines, sphere_lines_for_drawn};
 use crate::sample::lines::{LineSource, Sampler};
 use crate::sample::tally::{ObjectSides, Tally, Wanted};
 use crate::scene::Scene;
@@ -364,11 +364,12 @@ pub fn finish(
         (cfg.groups.max(2), visibility.groups),
         covered.len(),
         || {
-            BatchPlan::lines_for_batches(
+            let drawn = BatchPlan::lines_for_batches(
                 cfg.groups.max(2) as u64,
                 cfg.source,
                 cfg.budget.is_open_ended(),
-            )
+            );
+            sphere_lines_for_drawn(scene, cfg.bound, drawn)
         },
     ));
     let closed = total.counters.escapes == 0 && total.counters.pairs > 0;

@@ -171,7 +171,7 @@ pub fn run(args: &ConvergenceArgs) -> Result<Exit, Failure> {
                 "run {} of {total_runs}: {lines:.0e} lines, seed {seed}",
                 k as u32 * args.repeats + r + 1
             );
-            let mut a = runner.analyze(&args.run.spec(lines, seed), Some(lines), &label)?;
+            let mut a = runner.analyze(args.run.spec(lines, seed), &label)?;
             // The counts are not needed any more; keep the measures only.
             a.tally.counts = None;
             let stopped = a.stop_reason != StopReason::Lines;
@@ -305,12 +305,13 @@ fn csv(info: &report::RunInfo, levels: &[Level]) -> String {
     out
 }
 
-/// Every run as JSON: the settings, then each run's lines, seed, seconds and followed measures.
+/// Every run as JSON: the settings, then each run's lines (drawn, and the lines through the bounding
+/// sphere they are worth, the count asked, as `analyze` gives them), seed, seconds and followed measures.
 fn json_report(info: &report::RunInfo, levels: &[Level], repeats: u32) -> String {
     let runs: Vec<serde_json::Value> = levels
         .iter()
-        .flat_map(|l| l.runs.iter())
-        .map(|a| {
+        .flat_map(|l| l.runs.iter().map(move |a| (l.lines, a)))
+        .map(|(sphere_lines, a)| {
             let mut measures = serde_json::Map::new();
             for m in followed() {
                 if let Some(e) = a.estimate(m) {
@@ -328,6 +329,7 @@ fn json_report(info: &report::RunInfo, levels: &[Level], repeats: u32) -> String
             }
             json!({
                 "lines": a.lines,
+                "sphere_lines": sphere_lines,
                 "seed": a.spec.seed,
                 "seconds": a.seconds,
                 "stop_reason": a.stop_reason.name(),
@@ -401,7 +403,7 @@ fn flag_notes(levels: &[Level]) -> Vec<String> {
     let mut notes = Vec::new();
     for l in levels {
         for a in &l.runs {
-            let whose = format!("{} lines, seed {}: ", a.lines, a.spec.seed);
+            let whose = format!("{} lines, seed {}: ", l.lines, a.spec.seed);
             for m in followed() {
                 for f in a.reliability.get(m).iter().flat_map(|r| r.flags.iter()) {
                     let note = report::flag_note(&whose, f);

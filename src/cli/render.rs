@@ -11,7 +11,7 @@ use scene_complexity::render::{
 };
 use scene_complexity::PatchMaterials;
 use scene_complexity::Scene;
-use scene_complexity::{Measures, RunSpec, StopReason};
+use scene_complexity::{sphere_lines_of_drawn, Measures, RunSpec, StopReason};
 use scene_complexity::{PatchMeasure, RunWarningKind};
 use scene_complexity::{Point, Vector};
 
@@ -202,7 +202,7 @@ pub fn run(args: &RenderArgs) -> Result<Exit, Failure> {
         per_patch: true,
         ..args.run.spec(args.lines, args.run.seed.value)
     };
-    let analysis = runner.analyze(&cfg, Some(args.lines), "")?;
+    let analysis = runner.analyze(cfg, "")?;
     for w in &analysis.warnings {
         warn(&w.message);
     }
@@ -231,7 +231,9 @@ pub fn run(args: &RenderArgs) -> Result<Exit, Failure> {
     let scene = &runner.scene;
     let values = patch_values(scene, patches, args.color, args.per_area);
     let areas: Vec<f64> = scene.patches.iter().map(|p| p.area).collect();
-    let noise = noise_summary(patches, &areas, args.color, analysis.lines);
+    // In lines through the sphere, as --lines counts them and the advice gives them back.
+    let sphere_lines = sphere_lines_of_drawn(&runner.scene, analysis.spec.bound, analysis.lines);
+    let noise = noise_summary(patches, &areas, args.color, sphere_lines);
     if let Some(message) = noise.warning(args.color.label()) {
         warn(&format!("{}: {message}", scene.name));
     }
@@ -292,7 +294,7 @@ pub fn run(args: &RenderArgs) -> Result<Exit, Failure> {
         args.color.label(),
         args.color.unit(args.per_area)
     );
-    let lines = format!("{} lines", grouped(analysis.lines));
+    let lines = format!("{} lines", grouped(sphere_lines));
     let title = TitleParts {
         scene: &scene.name,
         quantity: &quantity,
@@ -312,7 +314,7 @@ pub fn run(args: &RenderArgs) -> Result<Exit, Failure> {
             scene.name,
             args.color.label(),
             args.color.unit(args.per_area),
-            analysis.lines,
+            sphere_lines,
             scale.lo,
             scale.hi,
             env!("CARGO_PKG_VERSION")

@@ -80,8 +80,9 @@ pub fn json(run: &RunInfo, a: &Analysis) -> String {
     s
 }
 
-/// One CSV row per reading, with the run's scene, lines, seed and tracer, so that files combine; a
-/// reading that breaks a bound of the theory says which in its `flags` (or `corrected_flags`) cell, and
+/// One CSV row per reading, with the run's scene, lines, seed and tracer (and, last, the lines through
+/// the bounding sphere they are worth and where they were drawn, as JSON's `sphere_lines` and
+/// `lines_through`), so that files combine; a reading that breaks a bound of the theory says which in its `flags` (or `corrected_flags`) cell, and
 /// an `undersampled` one its estimated bias and the lines it would need, as the JSON report does.
 pub fn csv(run: &RunInfo, a: &Analysis) -> String {
     let mut w = csv::Writer::from_writer(Vec::new());
@@ -108,6 +109,8 @@ pub fn csv(run: &RunInfo, a: &Analysis) -> String {
         "lines_needed",
         "corrected_estimated_bias",
         "corrected_lines_needed",
+        "sphere_lines",
+        "lines_through",
     ];
     w.write_record(header).expect("writing to memory");
     let num = |x: Option<f64>| x.map(|v| positive_zero(v).to_string()).unwrap_or_default();
@@ -156,6 +159,8 @@ pub fn csv(run: &RunInfo, a: &Analysis) -> String {
             needed(r.reliability),
             bias(r.corrected_reliability),
             needed(r.corrected_reliability),
+            sphere_lines_of_drawn(&run.scene, a.spec.bound, a.lines).to_string(),
+            a.spec.bound.name().to_string(),
         ])
         .expect("writing to memory");
     }
@@ -450,7 +455,7 @@ pub fn table(run: &RunInfo, a: &Analysis) -> String {
         );
     }
     if let Some(t) = &a.target {
-        let _ = writeln!(s, "{}", target_text(t, a));
+        let _ = writeln!(s, "{}", target_text(t, a, scene));
     }
     if a.stop_reason != StopReason::Lines {
         let _ = writeln!(s, "stopped by: {}", stop_text(a.stop_reason));
@@ -629,8 +634,17 @@ fn covers_line(run: &RunInfo, a: &Analysis) -> Option<String> {
             )
         });
     }
+    // The ranges number the lines drawn; the run's size is also given as --lines gave it.
+    let worth = match a.spec.bound {
+        LineBound::Sphere => String::new(),
+        bound => format!(
+            " ({} through the sphere)",
+            sphere_lines_of_drawn(run.scene, bound, a.plan.lines)
+        ),
+    };
     Some(format!(
-        "covers   lines {ranges} of the run's {}{} (a partial run: every figure is of these lines only)",
+        "covers   lines {ranges} of the run's {}{worth}{} (a partial run: every figure is of these lines \
+         only)",
         a.plan.lines,
         run.shard
             .map(|s| format!(", shard {} of {}", s.index, s.count))
@@ -639,7 +653,7 @@ fn covers_line(run: &RunInfo, a: &Analysis) -> Option<String> {
 }
 
 /// What became of a precision target, and when it was not met, when the run ended.
-fn target_text(t: &TargetOutcome, a: &Analysis) -> String {
+fn target_text(t: &TargetOutcome, a: &Analysis, scene: &Scene) -> String {
     let se = t.stderr.map_or_else(
         || "no standard error".into(),
         |e| format!("standard error {e:.3e}"),
@@ -657,16 +671,17 @@ fn target_text(t: &TargetOutcome, a: &Analysis) -> String {
          only when the standard error is small enough and the reading is ok",
         t.measure.key(),
         t.stderr_goal,
-        unmet_when(a)
+        unmet_when(a, scene)
     )
 }
 
-/// When a run whose precision target was not met ended, and what that leaves to do.
-fn unmet_when(a: &Analysis) -> String {
+/// When a run whose precision target was not met ended, and what that leaves to do (its cap in lines
+/// through the sphere, as `--lines` gave it).
+fn unmet_when(a: &Analysis, scene: &Scene) -> String {
     match a.stop_reason {
         StopReason::Lines if a.is_complete() => format!(
             "when the run reached its cap (--lines) at {} lines (a larger --lines may meet it)",
-            a.lines
+            sphere_lines_of_drawn(scene, a.spec.bound, a.lines)
         ),
         StopReason::Lines => "on the lines this report covers".into(),
         StopReason::Seconds => "when the time budget (--seconds) ran out".into(),

@@ -5,7 +5,7 @@ use std::sync::Arc;
 use scene_complexity::{analyze, Analysis};
 use scene_complexity::{make_tracer, Tracer};
 use scene_complexity::{ReadPolicy, Scene, SceneOptions};
-use scene_complexity::{RunControl, RunSpec, Tracing};
+use scene_complexity::{LinesThrough, RunControl, RunSpec, Tracing};
 
 use super::args::RunOptions;
 use super::exit::{Exit, Failure};
@@ -74,16 +74,15 @@ impl Runner {
         progress::while_running(&self.control, total, label, || self.pool.install(work))
     }
 
-    /// Runs one analysis with a progress bar (of `total` lines when known; `label` says which run).
-    pub fn analyze(
-        &self,
-        cfg: &RunSpec,
-        total: Option<u64>,
-        label: &str,
-    ) -> Result<Analysis, Failure> {
-        progress::while_running(&self.control, total, label, || {
+    /// Runs one analysis of `cfg` with a progress bar (`label` says which run). Its `lines` are counted
+    /// through the bounding sphere, and its bound is the one `--lines-through auto` chooses for the scene
+    /// ([`RunSpec::through`]), as `scx analyze` settles it: the same arguments draw the same lines in
+    /// every command.
+    pub fn analyze(&self, cfg: RunSpec, label: &str) -> Result<Analysis, Failure> {
+        let cfg = cfg.through(&self.scene, LinesThrough::Auto);
+        progress::while_running(&self.control, Some(cfg.lines), label, || {
             self.pool
-                .install(|| analyze(&self.scene, self.tracer(), cfg, &self.control))
+                .install(|| analyze(&self.scene, self.tracer(), &cfg, &self.control))
         })
         .map_err(Failure::of)
     }

@@ -189,7 +189,8 @@ fn round_lines(n: f64) -> String {
 }
 
 /// How noisy `quantity` is over `patches` (patch `k` of the scene is entry `k`, of area `areas[k]`)
-/// after `lines` lines. The segments' own relative error is that of a count, 1/sqrt(N).
+/// after `lines` lines (counted as `--lines` counts them, through the bounding sphere, so that the advice
+/// is in that unit too). The segments' own relative error is that of a count, 1/sqrt(N).
 pub fn noise_summary(
     patches: &[PatchResult],
     areas: &[f64],

@@ -1188,7 +1188,7 @@ mod tests {
     fn states_without_the_per_patch_fields_load() {
         let cfg = RunSpec {
             per_patch: true,
-            ..RunSpec::new(20_000, 2)
+            ..RunSpec::new(20_010, 2)
         };
         let (scene, state) = cube_run(&cfg);
         assert!(state.parts().tail.is_some(), "the run has a partial batch");

@@ -28,8 +28,11 @@ impl BatchPlan {
     /// The fewest lines in a batch (but the last).
     pub const MIN_BATCH: u64 = 256;
 
-    /// The batches a run has at least, when it has the lines for them.
-    pub const MIN_BATCHES: u64 = 64;
+    /// The batches a run has at least, when it has the lines for them: two for each of the default
+    /// standard-error groups. Few enough that runs of modest length have full batches, and so can be
+    /// continued to any count: a run's lines drawn through a box or polytope are fewer than its
+    /// `--lines` (2/pi of them for a cube), and 3e5 of a cube's sphere lines are 190,987 box lines.
+    pub const MIN_BATCHES: u64 = 32;
 
     /// From this many lines on, every run has batches of [`BatchPlan::MAX_BATCH`] lines.
     pub const FULL_FROM: u64 = BatchPlan::MIN_BATCHES * BatchPlan::MAX_BATCH;

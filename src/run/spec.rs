@@ -14,7 +14,7 @@ use super::errors::ErrorMethod;
 use super::plan::BatchPlan;
 use crate::measure::estimators::EntropyEstimator;
 use crate::measure::radiosity::SolveOptions;
-use crate::sample::bounds::{lines_to_draw, tightest_container, LineBound};
+use crate::sample::bounds::{lines_to_draw, smallest_container, tightest_container, LineBound};
 use crate::sample::lines::{LineSource, Sampler};
 use crate::scene::Scene;
 
@@ -238,16 +238,17 @@ impl RunSpec {
     /// The bound `--lines-through auto` chooses for `scene`: for the Sobol' sampler, the tightest
     /// container of the scene ([`tightest_container`]: the box for rooms, the polytope for solids and
     /// objects, the sphere when neither is smaller), whose lines cover the space of lines far more evenly
-    /// (docs/sampling.md, "Lines through the bounding box"); the sphere otherwise. Independent lines keep
-    /// the paper's sphere, as every other command draws them (a smaller container would leave their
-    /// estimates' distribution alone and save time: measured in the docs); bundles and the environment
-    /// of `enclose` need the sphere.
+    /// (docs/sampling.md, "Lines through the bounding box"); for independent lines, the smallest container
+    /// ([`smallest_container`]), which leaves every estimate's distribution as the sphere's lines give it
+    /// and does not draw the lines that would miss the scene. Bundles and the environment of `enclose`
+    /// need the sphere.
     pub fn auto_bound(&self, scene: &Scene) -> LineBound {
-        let sobol = self.sampler == Sampler::Sobol && self.source == LineSource::Independent;
-        if sobol && !self.enclose {
-            tightest_container(scene)
-        } else {
-            LineBound::Sphere
+        if self.source != LineSource::Independent || self.enclose {
+            return LineBound::Sphere;
+        }
+        match self.sampler {
+            Sampler::Sobol => tightest_container(scene),
+            Sampler::Independent => smallest_container(scene),
         }
     }
 
@@ -552,12 +553,12 @@ mod tests {
             run.extended_to(100_000),
             Err(ExtendError::Fewer { .. })
         ));
-        let short = RunSpec::new(200_000, 1);
-        let e = short.extended_to(300_000).unwrap_err().to_string();
-        assert!(e.contains("batches of 3125") && e.contains("262144"), "{e}");
-        // 200,000 / 64 = 3125 lines a batch, as long as lines / 64 rounds down to 3125: up to 200,063.
-        assert!(e.contains("at most 200063"), "{e}");
-        assert_eq!(short.extended_to(200_063).unwrap().lines, 200_063);
-        assert!(short.extended_to(200_064).is_err());
+        let short = RunSpec::new(100_000, 1);
+        let e = short.extended_to(200_000).unwrap_err().to_string();
+        assert!(e.contains("batches of 3125") && e.contains("131072"), "{e}");
+        // 100,000 / 32 = 3125 lines a batch, as long as lines / 32 rounds down to 3125: up to 100,031.
+        assert!(e.contains("at most 100031"), "{e}");
+        assert_eq!(short.extended_to(100_031).unwrap().lines, 100_031);
+        assert!(short.extended_to(100_032).is_err());
     }
 }

@@ -337,6 +337,24 @@ pub fn sphere_lines_of_drawn(scene: &Scene, bound: LineBound, drawn: u64) -> u64
         .unwrap_or(worth.round() as u64)
 }
 
+/// The fewest lines through `scene`'s bounding sphere (the unit of `--lines`) whose run draws at least
+/// `drawn` lines as `bound` says ([`lines_to_draw`]): how a count of lines drawn that a run needs (for
+/// its batches, its groups) is given back to the user.
+pub fn sphere_lines_for_drawn(scene: &Scene, bound: LineBound, drawn: u64) -> u64 {
+    if bound == LineBound::Sphere {
+        return drawn;
+    }
+    let mut n = sphere_lines(scene, bound, drawn).ceil() as u64;
+    // The f64 worth is within a line or two of the count: walk to the fewest that draws enough.
+    while n > 0 && lines_to_draw(scene, bound, n - 1) >= drawn {
+        n -= 1;
+    }
+    while lines_to_draw(scene, bound, n) < drawn {
+        n += 1;
+    }
+    n
+}
+
 /// How many decimal zeros end `n` (none for 0).
 fn trailing_decimal_zeros(mut n: u64) -> u32 {
     let mut zeros = 0;
@@ -377,6 +395,24 @@ pub fn tightest_container(scene: &Scene) -> LineBound {
     if boxed < 1.0 && boxed <= BOX_PREFERENCE * polytope {
         LineBound::Box
     } else if polytope < 1.0 && share_of_area_on_faces(scene) >= ON_FACES {
+        LineBound::Polytope
+    } else {
+        LineBound::Sphere
+    }
+}
+
+/// The container independent lines are drawn through on `scene` (`--lines-through auto`): the smaller
+/// of the box and the polytope when it is smaller than the sphere (the box when it is within
+/// [`BOX_PREFERENCE`] of the polytope: its lines are cheaper to draw), else the sphere. Independent lines
+/// through a container are distributed as the sphere's lines that meet it, so every estimate keeps its
+/// distribution for the same `--lines`; the lines that would have missed the container, and so the
+/// scene, are simply not drawn (docs/sampling.md, "Lines through the bounding box").
+pub fn smallest_container(scene: &Scene) -> LineBound {
+    let boxed = share_of_sphere(scene, LineBound::Box);
+    let polytope = share_of_sphere(scene, LineBound::Polytope);
+    if boxed < 1.0 && boxed <= BOX_PREFERENCE * polytope {
+        LineBound::Box
+    } else if polytope < 1.0 {
         LineBound::Polytope
     } else {
         LineBound::Sphere

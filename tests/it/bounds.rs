@@ -118,13 +118,15 @@ fn box_lines_with_bundles_or_the_environment_are_refused() {
     }
 }
 
-/// `--lines-through auto` draws through the box only for the Sobol' sampler on a scene whose box is the
+/// `--lines-through auto` draws the Sobol' sampler's lines through the box on a scene whose box is the
 /// smaller container (its surface below the unit sphere's 4 pi, Cauchy: fewer lines meet it), through
 /// the polytope for the octahedron (its box reaches out of its sphere; its faces are its polytope's),
-/// and keeps the sphere for independent lines, for the icosahedron (whose faces lie in none of the
-/// polytope's planes), and with the environment patch; a bound asked for is kept.
+/// and through the sphere for the icosahedron (whose faces lie in none of the polytope's planes);
+/// independent lines through the smallest container (the icosahedron's polytope too: their estimates'
+/// distribution does not depend on it); bundles and the environment patch keep the sphere; a bound
+/// asked for is kept.
 #[test]
-fn auto_draws_through_the_box_only_for_sobol_on_a_smaller_box() {
+fn auto_draws_through_the_container_the_sampler_gains_from() {
     let four_pi = 4.0 * std::f64::consts::PI;
     let (cube, cornell, octahedron) = (
         scenes::load("@cube:4").unwrap(),
@@ -144,12 +146,23 @@ fn auto_draws_through_the_box_only_for_sobol_on_a_smaller_box() {
     assert_eq!(auto(&sobol, &octahedron), LineBound::Polytope);
     let icosahedron = scenes::load("@icosahedron").unwrap();
     assert_eq!(auto(&sobol, &icosahedron), LineBound::Sphere);
-    assert_eq!(auto(&RunSpec::new(1_000_000, 1), &cube), LineBound::Sphere);
-    let enclosed = RunSpec {
-        enclose: true,
-        ..sobol.clone()
+    let independent = RunSpec::new(1_000_000, 1);
+    assert_eq!(auto(&independent, &cube), LineBound::Box);
+    assert_eq!(auto(&independent, &cornell), LineBound::Box);
+    assert_eq!(auto(&independent, &octahedron), LineBound::Polytope);
+    assert_eq!(auto(&independent, &icosahedron), LineBound::Polytope);
+    let bundles = RunSpec {
+        source: LineSource::bundles(4).unwrap(),
+        ..independent.clone()
     };
-    assert_eq!(auto(&enclosed, &cube), LineBound::Sphere);
+    assert_eq!(auto(&bundles, &cube), LineBound::Sphere);
+    for spec in [&sobol, &independent] {
+        let enclosed = RunSpec {
+            enclose: true,
+            ..spec.clone()
+        };
+        assert_eq!(auto(&enclosed, &cube), LineBound::Sphere);
+    }
     for bound in [LineBound::Sphere, LineBound::Box] {
         let kept = sobol
             .clone()
@@ -309,7 +322,8 @@ fn box_runs_split_resumed_and_merged_are_the_single_run() {
 
 /// `scx analyze`: without `--lines-through`, `--sampler sobol` draws through the box of a cube (fewer
 /// lines, worth the `--lines` asked), through the polytope of the octahedron and through the sphere of
-/// the icosahedron; independent lines through the sphere, `--lines` of them.
+/// the icosahedron; independent lines (the default with every measure) through the cube's box, and
+/// bundles through the sphere, `--lines` of them.
 #[cfg(feature = "cli")]
 #[test]
 fn the_cli_chooses_the_bound_by_sampler_and_scene() {
@@ -333,9 +347,13 @@ fn the_cli_chooses_the_bound_by_sampler_and_scene() {
         "{}",
         octahedron["lines"]
     );
+    let independent = run("@cube:6", &[]);
+    assert_eq!(independent["lines_through"], "box");
+    assert_eq!(field(&independent, "lines"), field(&cube, "lines"));
+    assert_eq!(field(&independent, "sphere_lines"), 2e5);
     for (scene, more) in [
         ("@icosahedron", &["--sampler", "sobol"][..]),
-        ("@cube:6", &[][..]),
+        ("@cube:6", &["--bundle", "4"][..]),
     ] {
         let v = run(scene, more);
         assert_eq!(v["lines_through"], "sphere", "{scene} {more:?}");

@@ -191,7 +191,11 @@ fn open_scenes_and_a_flipped_face_are_read_per_area() {
         ] {
             let s = summary(report, measure, Basis::PerArea);
             assert!(s.coverage().unwrap() >= floor(s.runs), "{scene}: {s:?}");
-            assert!(s.mean_z.abs() < 0.3, "{scene}: {s:?}");
+            // No bias beyond a small share of the error bar, allowing for the mean's own noise over
+            // the seeds: the corrected I_s per area reads a true mean z of -0.18 to -0.27 here (1000
+            // seeds, through the sphere or the box), so 200 seeds read -0.42 in one draw of them.
+            let noise = 3.0 * s.sd_z / (s.runs as f64).sqrt();
+            assert!(s.mean_z.abs() < 0.3 + noise, "{scene}: {s:?}");
         }
         for measure in [
             Measure::MutualInformationCorrected,
@@ -260,7 +264,7 @@ fn the_command_prints_the_table_and_writes_csv() {
         "--scene",
         "@tetrahedron:1,two-squares:perpendicular",
         "--lines",
-        "1e4",
+        "2e4",
         "--seeds",
         "3",
         "--threads",
@@ -281,13 +285,13 @@ fn the_command_prints_the_table_and_writes_csv() {
         "{stdout}"
     );
     assert!(
-        stdout.contains("| `@tetrahedron:1` | 1e4 | 3 | I_s^c | 2.619458 |"),
+        stdout.contains("| `@tetrahedron:1` | 2e4 | 3 | I_s^c | 2.619458 |"),
         "{stdout}"
     );
     assert!(stdout.contains("I_s^c (per visible pair)"), "{stdout}");
     let table = std::fs::read_to_string(&csv).unwrap();
     assert!(table.starts_with("scene,lines,"), "{table}");
-    assert!(table.contains("@tetrahedron:1,10000,,,3,"), "{table}");
+    assert!(table.contains("@tetrahedron:1,20000,,,3,"), "{table}");
     let rows = std::fs::read_to_string(&readings).unwrap();
     // 3 seeds of each scene, one row per reading.
     assert_eq!(
@@ -334,9 +338,9 @@ fn the_command_prints_the_table_and_writes_csv() {
     }
 }
 
-/// A cell's runs are `scx analyze`'s: its lines are the sphere's, and with the Sobol' sampler `auto`
-/// draws them through the box of a cube (the fewest worth as many), independent lines and a cell that
-/// asks for the sphere through the sphere.
+/// A cell's runs are `scx analyze`'s: its lines are the sphere's, `auto` draws them through the box of
+/// a cube (the fewest worth as many) for the Sobol' sampler and for independent lines, and a cell that
+/// asks for the sphere draws through the sphere.
 #[test]
 fn a_cells_runs_draw_their_lines_as_scx_analyze_does() {
     use scene_complexity::calibrate::driver::run_spec;
@@ -345,14 +349,21 @@ fn a_cells_runs_draw_their_lines_as_scx_analyze_does() {
     let scene = CalibrationScene::parse("@cube:4").unwrap();
     let built = scene_complexity::internals::scenes::load("@cube:4").unwrap();
     let cell = Cell::new(scene, 100_000, 3);
-    let sobol = run_spec(&cell.with_sampler(Sampler::Sobol), 1, &built);
-    assert_eq!(sobol.bound, LineBound::Box);
-    assert_eq!(sobol.lines, lines_to_draw(&built, LineBound::Box, 100_000));
-    assert!((63_000..64_500).contains(&sobol.lines), "{}", sobol.lines);
+    for spec in [
+        run_spec(&cell.clone().with_sampler(Sampler::Sobol), 1, &built),
+        run_spec(&cell, 1, &built),
+    ] {
+        assert_eq!(spec.bound, LineBound::Box);
+        assert_eq!(spec.lines, lines_to_draw(&built, LineBound::Box, 100_000));
+        assert!((63_000..64_500).contains(&spec.lines), "{}", spec.lines);
+    }
     let sphere = cell
         .with_sampler(Sampler::Sobol)
         .with_bound(LinesThrough::Bound(LineBound::Sphere));
-    for spec in [run_spec(&cell, 1, &built), run_spec(&sphere, 1, &built)] {
+    for spec in [
+        run_spec(&sphere, 1, &built),
+        run_spec(&sphere.with_sampler(Sampler::Independent), 1, &built),
+    ] {
         assert_eq!((spec.bound, spec.lines), (LineBound::Sphere, 100_000));
     }
 }

@@ -39,7 +39,10 @@ fn json_report_parses_and_carries_the_documented_fields() {
     assert_eq!(doc["triangles"], 108);
     assert!((doc["area"].as_f64().unwrap() - 6.0).abs() < 1e-9);
     assert_eq!(doc["tracer"], "rust");
-    assert_eq!(doc["lines"], 20000);
+    // Independent lines through the cube's box: 2/pi of the 20000 asked through the sphere.
+    assert_eq!(doc["lines_through"], "box");
+    assert_eq!(doc["lines"], 12733);
+    assert_eq!(doc["sphere_lines"], 20000);
     assert_eq!(doc["seed"], 1);
     assert_eq!(doc["threads"], 2);
     assert!(doc["seconds"].as_f64().unwrap() > 0.0);
@@ -249,7 +252,7 @@ fn budgets_stop_the_run_and_say_why() {
         doc["stop_reason"], "lines",
         "the line cap ends a run whose target is out of reach"
     );
-    assert_eq!(doc["lines"], 300_000);
+    assert_eq!(doc["sphere_lines"], 300_000);
 }
 
 #[test]

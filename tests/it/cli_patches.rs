@@ -578,11 +578,21 @@ fn enclosed_files_have_the_environment_row_and_add_up() {
 }
 
 /// A closed scene has no environment: `--enclose` changes nothing, and every per-patch file is the
-/// same bytes as without it.
+/// same bytes as without it (lines through the sphere both times: the environment is the sphere, so
+/// `--enclose` keeps it where `auto` would draw a cube's lines through its box).
 #[test]
 fn enclose_leaves_the_files_of_a_closed_scene_alone() {
     let (plain, enclosed) = (tempfile::tempdir().unwrap(), tempfile::tempdir().unwrap());
-    let args = ["analyze", "@cube:4", "--lines", "2e5", "--seed", "5"];
+    let args = [
+        "analyze",
+        "@cube:4",
+        "--lines",
+        "2e5",
+        "--seed",
+        "5",
+        "--lines-through",
+        "sphere",
+    ];
     let a = run_with_all_files(plain.path(), &args);
     let mut with = args.to_vec();
     with.push("--enclose");

@@ -62,7 +62,7 @@ fn durations_beyond_the_clock_are_no_limit() {
         let out = scx_in(dir.path(), &args);
         assert_eq!(code(&out), Some(0), "{extra:?}: {}", stderr(&out));
         let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
-        assert_eq!(report["lines"], 20_000, "{extra:?}");
+        assert_eq!(report["sphere_lines"], 20_000, "{extra:?}");
     }
     assert!(dir.path().join("c.scx").is_file());
 }
@@ -996,7 +996,7 @@ fn durations_take_units() {
         let out = scx_in(d, &args);
         assert_eq!(code(&out), Some(0), "{extra:?}: {}", stderr(&out));
         let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
-        assert_eq!(report["lines"], 20_000, "{extra:?}");
+        assert_eq!(report["sphere_lines"], 20_000, "{extra:?}");
     }
     for bad in ["abc", "0s", "-5", "5 parsecs"] {
         let out = scx_in(d, &["analyze", "@cube:2", "--seconds", bad]);
@@ -1063,7 +1063,9 @@ fn a_state_given_twice_is_refused() {
 fn merge_differences_read_as_words() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    shard_state(d, 1, "s1.scx", &[]);
+    // Through the sphere, as --enclose draws: the settings differ in one thing each time.
+    let sphere = ["--lines-through", "sphere"];
+    shard_state(d, 1, "s1.scx", &sphere);
     shard_state(d, 2, "enclosed.scx", &["--enclose"]);
     let out = scx_in(
         d,
@@ -1075,6 +1077,8 @@ fn merge_differences_read_as_words() {
             "--save",
             "whole.scx",
             "-q",
+            sphere[0],
+            sphere[1],
         ],
     );
     assert_eq!(code(&out), Some(0), "{}", stderr(&out));

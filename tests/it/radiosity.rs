@@ -51,7 +51,7 @@ fn table_8_constant_radiosity_gives_the_visibility_measures() {
             let a = analyze(
                 &scene,
                 tracer.as_ref(),
-                &config(60_000, 4),
+                &config(200_000, 4),
                 &RunControl::default(),
             )
             .unwrap();

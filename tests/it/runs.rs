@@ -268,7 +268,7 @@ fn bad_states_are_refused_by_name() {
         (&[&a, &other_seed], &["other_seed.scx", "a.scx", "seed"]),
         (&[&a, &a], &["a.scx", "given twice"]),
         (&[&a, &copy], &["copy.scx", "a.scx", "overlap"]),
-        (&[&a], &["missing", "..100000"]),
+        (&[&a], &["missing", "..63663"]),
     ];
     for (files, expected) in cases {
         let mut args = vec!["merge", "--format", "json"];
