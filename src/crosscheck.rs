@@ -26,7 +26,8 @@ use crate::analysis::{analyze, Analysis, AnalysisError};
 use crate::geom::DVec3;
 use crate::measure::{Estimate, Measure};
 use crate::run::{
-    all_batches, map_batches, BatchPlan, LineStream, LinesThrough, Measures, RunControl, RunSpec, TraceBuffers,
+    all_batches, map_batches, BatchPlan, LineStream, LinesThrough, Measures, RunControl, RunSpec,
+    TraceBuffers,
 };
 use crate::scene::Scene;
 use crate::trace::rust::bvh::margin;

@@ -10,8 +10,8 @@ use scene_complexity::report::{
     self, object_table, patch_table, Context, FormFactors, Table, Values,
 };
 use scene_complexity::{
-    Estimate, Family, Measure, RadiosityOutcome, Reliability, RunIdentity, RunState, Shard,
-    StopReason, Tracing,
+    Estimate, Family, LineBound, Measure, RadiosityOutcome, Reliability, RunIdentity, RunState,
+    Shard, StopReason, Tracing,
 };
 
 use crate::errors::{bad_argument, persist_error};
@@ -544,9 +544,14 @@ impl Analysis {
         } else {
             ""
         };
+        // The lines as `lines=` counts them (through the sphere), and those drawn when they differ.
+        let drawn = match self.inner.spec.bound {
+            LineBound::Sphere => String::new(),
+            bound => format!(" ({} drawn through the {})", self.inner.lines, bound.name()),
+        };
         Ok(format!(
-            "<scx.Analysis of {scene:?}: {} lines, seed {}{interrupted}; {}>",
-            self.inner.lines,
+            "<scx.Analysis of {scene:?}: {} lines{drawn}, seed {}{interrupted}; {}>",
+            self.sphere_lines(),
             self.inner.spec.seed,
             parts.join(", ")
         ))

@@ -101,13 +101,14 @@ def test_the_gil_is_released_while_lines_are_traced(cube4):
     worker.start()
     seen = []
     try:
-        scx.analyze(cube4, lines=2e6, threads=1, progress=lambda d, t: seen.append(d))
+        a = scx.analyze(cube4, lines=2e6, threads=1, progress=lambda d, t: seen.append(d))
     finally:
         done.set()
         worker.join()
     assert counts[0] > 10_000
-    # The callback saw the run end, with the lines in all.
-    assert seen[-1] == 2_000_000
+    # The callback saw the run end, with the lines in all: those drawn (through the cube's box), worth
+    # the 2e6 asked through the sphere.
+    assert seen[-1] == a.lines and a.sphere_lines == 2_000_000
 
 
 def test_trimesh_box_turned_inside_out_is_the_cube():

@@ -10,6 +10,7 @@ use super::suite::{Cell, CellMeasures};
 use crate::analysis::{analyze, Analysis, AnalysisError, Verdict};
 use crate::measure::{ByMeasure, Estimate, Measure};
 use crate::run::{Measures, RunControl, RunSpec, Target};
+use crate::sample::bounds::sphere_lines_of_drawn;
 use crate::scene::Scene;
 use crate::trace::Tracer;
 
@@ -36,7 +37,8 @@ pub struct Reading {
 pub struct SeedReadings {
     /// The run's seed.
     pub seed: u64,
-    /// The lines it cast.
+    /// The lines it cast, counted through the bounding sphere as the cell's lines are (what the lines
+    /// drawn through a box or polytope are worth).
     pub lines: u64,
     /// The standard-error groups that had lines: the interval's Student-t multiplier has one degree of
     /// freedom less (a standard error from G groups is itself estimated from G values).
@@ -85,7 +87,7 @@ pub fn run_seed(
 ) -> Result<SeedReadings, AnalysisError> {
     let spec = run_spec(cell, seed, scene);
     let analysis = analyze(scene, tracer, &spec, &RunControl::default())?;
-    Ok(readings_of(&analysis))
+    Ok(readings_of(&analysis, scene))
 }
 
 /// The run of `cell` with `seed` on `scene`: the cell's lines (a cap when it has a target; lines through
@@ -111,10 +113,10 @@ pub fn run_spec(cell: &Cell, seed: u64, scene: &Scene) -> RunSpec {
 
 /// The readings of a finished run: every measure with a value, its verdict, the groups behind the
 /// standard errors and whether a precision target was met.
-pub fn readings_of(a: &Analysis) -> SeedReadings {
+pub fn readings_of(a: &Analysis, scene: &Scene) -> SeedReadings {
     SeedReadings {
         seed: a.spec.seed,
-        lines: a.lines,
+        lines: sphere_lines_of_drawn(scene, a.spec.bound, a.lines),
         groups: a.groups,
         interval_quantile: a.interval_quantile(),
         target_met: a.target.map(|t| t.met()),

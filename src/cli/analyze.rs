@@ -76,9 +76,9 @@ pub struct AnalyzeArgs {
     /// with --sampler sobol, far smaller errors on solids whose faces it shares, such as the
     /// octahedron), or `auto`: for --sampler sobol the box when it is smaller than the sphere (rooms,
     /// most scenes built along the axes), else the polytope when the scene lies mostly in its faces,
-    /// else the sphere; the sphere for independent lines. Box and polytope not with --bundle or
-    /// --enclose. The report says which, how many lines were drawn and what they are worth.
-    /// docs/sampling.md.
+    /// else the sphere; for independent lines the smallest of the three (the same estimates, less
+    /// time); the sphere for --bundle and --enclose, with which box and polytope are refused. The
+    /// report says which, how many lines were drawn and what they are worth. docs/sampling.md.
     #[arg(long, default_value = "auto", value_parser = parse_bound)]
     lines_through: LinesThrough,
     /// Close an open scene with a virtual, absorbing environment patch (the bounding sphere, facing
@@ -119,7 +119,7 @@ pub struct AnalyzeArgs {
     #[arg(long, value_name = "DURATION", value_parser = parse_seconds, allow_negative_numbers = true)]
     checkpoint_every: Option<f64>,
     /// Continue the run saved in FILE (by --save or --checkpoint) with its own settings, up to --lines
-    /// (more lines than first asked are fine for a run of 262144 lines or more; a shorter one is cut
+    /// (more lines than first asked are fine for a run that drew 131072 lines or more; a shorter one is cut
     /// into smaller batches and continues only to a few lines more, as the message says), and save it
     /// back to FILE as it goes. --tracer, --query
     /// and --threads may differ from the first run's: they change no number.

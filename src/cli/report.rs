@@ -82,8 +82,9 @@ pub fn json(run: &RunInfo, a: &Analysis) -> String {
 
 /// One CSV row per reading, with the run's scene, lines, seed and tracer (and, last, the lines through
 /// the bounding sphere they are worth and where they were drawn, as JSON's `sphere_lines` and
-/// `lines_through`), so that files combine; a reading that breaks a bound of the theory says which in its `flags` (or `corrected_flags`) cell, and
-/// an `undersampled` one its estimated bias and the lines it would need, as the JSON report does.
+/// `lines_through`), so that files combine; a reading that breaks a bound of the theory says which in
+/// its `flags` (or `corrected_flags`) cell, and an `undersampled` one its estimated bias and the lines
+/// it would need, as the JSON report does.
 pub fn csv(run: &RunInfo, a: &Analysis) -> String {
     let mut w = csv::Writer::from_writer(Vec::new());
     let header = [

@@ -4,8 +4,8 @@ use std::sync::Arc;
 
 use scene_complexity::{analyze, Analysis};
 use scene_complexity::{make_tracer, Tracer};
-use scene_complexity::{ReadPolicy, Scene, SceneOptions};
 use scene_complexity::{LinesThrough, RunControl, RunSpec, Tracing};
+use scene_complexity::{ReadPolicy, Scene, SceneOptions};
 
 use super::args::RunOptions;
 use super::exit::{Exit, Failure};

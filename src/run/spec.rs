@@ -173,7 +173,9 @@ pub struct RunSpec {
 }
 
 impl RunSpec {
-    /// `lines` lines from `seed`, every measure, default groups and estimator, no budget.
+    /// `lines` lines from `seed`, every measure, default groups and estimator, no budget, independent
+    /// lines through the bounding sphere; [`RunSpec::through`] with [`LinesThrough::Auto`] draws them
+    /// where `scx analyze` does (the smallest container, the same estimates for less time).
     pub fn new(lines: u64, seed: u64) -> Self {
         RunSpec {
             lines,

@@ -148,7 +148,9 @@ fn the_table_says_whether_a_target_was_met_and_what_ended_the_run() {
         state.to_str().unwrap(),
     ]);
     assert!(
-        text.contains("of the run's 636622 (1000000 through the sphere), shard 1 of 2 (a partial run"),
+        text.contains(
+            "of the run's 636622 (1000000 through the sphere), shard 1 of 2 (a partial run"
+        ),
         "{text}"
     );
 }
@@ -361,7 +363,14 @@ fn impossible_readings_are_flagged_not_printed_bare() {
     // its (huge) error allows (seed 4: I_s^c's noise keeps some seeds' accuracy within it), and the
     // table stays aligned.
     let out = scx(&[
-        "analyze", "@sphere:5", "--lines", "1e5", "--seed", "4", "--tracer", "rust",
+        "analyze",
+        "@sphere:5",
+        "--lines",
+        "1e5",
+        "--seed",
+        "4",
+        "--tracer",
+        "rust",
     ]);
     let text = String::from_utf8_lossy(&out.stdout);
     let rows: Vec<&str> = text
@@ -615,7 +624,10 @@ fn reports_carry_units_and_their_run() {
     let header = reader.remove(0);
     assert_eq!(header[..4], ["scene", "lines", "seed", "tracer"]);
     assert!(header.contains(&"unit".to_string()));
-    assert_eq!(header[header.len() - 2..], ["sphere_lines", "lines_through"]);
+    assert_eq!(
+        header[header.len() - 2..],
+        ["sphere_lines", "lines_through"]
+    );
     // The cube's lines are drawn through its box: 2/pi of the 20000 asked, worth them.
     for row in &reader {
         assert_eq!(row[..3], ["@cube:3", "12733", "1000"], "{row:?}");
