@@ -160,7 +160,7 @@ pub fn csv(run: &RunInfo, a: &Analysis) -> String {
             needed(r.reliability),
             bias(r.corrected_reliability),
             needed(r.corrected_reliability),
-            sphere_lines_of_drawn(&run.scene, a.spec.bound, a.lines).to_string(),
+            sphere_lines_of_drawn(run.scene, a.spec.bound, a.lines).to_string(),
             a.spec.bound.name().to_string(),
         ])
         .expect("writing to memory");

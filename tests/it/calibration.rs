@@ -350,7 +350,7 @@ fn a_cells_runs_draw_their_lines_as_scx_analyze_does() {
     let built = scene_complexity::internals::scenes::load("@cube:4").unwrap();
     let cell = Cell::new(scene, 100_000, 3);
     for spec in [
-        run_spec(&cell.clone().with_sampler(Sampler::Sobol), 1, &built),
+        run_spec(&cell.with_sampler(Sampler::Sobol), 1, &built),
         run_spec(&cell, 1, &built),
     ] {
         assert_eq!(spec.bound, LineBound::Box);
