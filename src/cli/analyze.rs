@@ -410,6 +410,22 @@ fn check_tuning_options(args: &AnalyzeArgs) -> Result<(), Failure> {
     check_target_measure(args.target_measure, args.target_stderr).map_err(Failure::bad_input)
 }
 
+/// A state to resume that is not there is named as one that cannot be read (the resume file is also
+/// checked as an output, and a missing folder would read as an output that cannot be written).
+fn check_state_exists(file: &Path) -> Result<(), Failure> {
+    if file.exists() {
+        return Ok(());
+    }
+    Err(Failure {
+        code: Exit::Io,
+        message: format!(
+            "cannot read {}: there is no such file (--resume continues a run saved by --save or \
+             --checkpoint)",
+            file.display()
+        ),
+    })
+}
+
 /// Runs `scx analyze`.
 pub fn run(args: &AnalyzeArgs) -> Result<Exit, Failure> {
     check_tuning_options(args)?;
@@ -452,6 +468,9 @@ pub fn run(args: &AnalyzeArgs) -> Result<Exit, Failure> {
             ("--save", "--resume"),
         ],
     )?;
+    if let Some(file) = args.resume.as_deref() {
+        check_state_exists(file)?;
+    }
     output::check_all(args.out.output.as_deref())?;
     for path in save.into_iter().chain(checkpoint) {
         output::check_state(path)?;

@@ -322,8 +322,15 @@ fn exit_codes_mean_one_thing_everywhere() {
     let missing = missing.to_str().unwrap();
     let junk = dir.path().join("junk.scx");
     std::fs::write(&junk, "not a state").unwrap();
-    let cases: [(&[&str], i32, &str); 4] = [
+    let nowhere = dir.path().join("no-such-folder").join("x.scx");
+    let cases: [(&[&str], i32, &str); 5] = [
         (&["analyze", "--resume", missing], 3, "cannot read"),
+        // Not "cannot write": the state is missing before its folder is.
+        (
+            &["analyze", "--resume", nowhere.to_str().unwrap()],
+            3,
+            "cannot read",
+        ),
         (&["merge", missing], 3, "cannot read"),
         (
             &["merge", junk.to_str().unwrap()],
