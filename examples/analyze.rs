@@ -33,10 +33,11 @@ fn main() -> Result<(), Box<dyn Error>> {
     }
 
     println!(
-        "{}: {} patches, {} lines, {} tracer",
+        "{}: {} patches, {lines} lines ({} drawn through the bounding {}), {} tracer",
         scene.name,
         scene.patch_count(),
         analysis.lines,
+        analysis.spec.bound.name(),
         tracer.name()
     );
     for measure in [

@@ -29,6 +29,7 @@ use crate::run::{
     all_batches, map_batches, BatchPlan, LineStream, LinesThrough, Measures, RunControl, RunSpec,
     TraceBuffers,
 };
+use crate::sample::bounds::LineBound;
 use crate::scene::Scene;
 use crate::trace::rust::bvh::margin;
 use crate::trace::{Hit, Line, LineHits, TraceError, Tracer};
@@ -193,15 +194,21 @@ pub struct CrossCheckConfig {
     pub examples: usize,
 }
 
-/// Traces the run's lines with both tracers and compares their canonical hits line by line, in parallel
-/// over batches (results independent of the thread count).
+/// Traces the lines of `scx analyze --lines N --seed S` (`cfg.lines` counted through the bounding sphere,
+/// drawn through the container `auto` chooses: [`RunSpec::through`]) with both tracers and compares
+/// their canonical hits line by line, in parallel over batches (results independent of the thread
+/// count).
 pub fn compare_hits(
     scene: &Scene,
     a: &dyn Tracer,
     b: &dyn Tracer,
     cfg: &CrossCheckConfig,
 ) -> Result<HitComparison, TraceError> {
-    let stream = LineStream::independent(cfg.lines, cfg.seed);
+    let run = RunSpec::new(cfg.lines, cfg.seed).through(scene, LinesThrough::Auto);
+    let stream = LineStream {
+        bound: run.bound,
+        ..LineStream::independent(run.lines, cfg.seed)
+    };
     let (parts, _) = map_batches(
         &stream,
         scene,
@@ -498,6 +505,11 @@ pub struct CrossCheck {
     pub scene: String,
     /// Seed.
     pub seed: u64,
+    /// The lines asked for, through the bounding sphere ([`CrossCheckConfig::lines`]), and where they
+    /// were drawn (the hit comparison's `lines` counts those drawn).
+    pub sphere_lines: u64,
+    /// Where the lines were drawn.
+    pub bound: LineBound,
     /// The hit comparison.
     pub hits: HitComparison,
     /// The measure comparison.
@@ -524,6 +536,8 @@ pub fn crosscheck(
     Ok(CrossCheck {
         scene: scene.name.clone(),
         seed: cfg.seed,
+        sphere_lines: cfg.lines,
+        bound: analysis.bound,
         hits,
         measures,
     })
@@ -555,9 +569,13 @@ pub fn report(check: &CrossCheck, scene: &Scene) -> String {
     let h = &check.hits;
     let (na, nb) = h.names;
     let mut s = String::new();
+    let drawn = match check.bound {
+        LineBound::Sphere => String::new(),
+        bound => format!(" ({} drawn through the bounding {})", h.lines, bound.name()),
+    };
     s += &format!(
-        "crosscheck {} seed {}: {} lines, {na} {} hits, {nb} {} hits\n",
-        check.scene, check.seed, h.lines, h.hits.0, h.hits.1
+        "crosscheck {} seed {}: {} lines{drawn}, {na} {} hits, {nb} {} hits\n",
+        check.scene, check.seed, check.sphere_lines, h.hits.0, h.hits.1
     );
     s += &format!(
         "tolerance: same hit count, same patches, |t_a - t_b| <= {} ulps at max(t, 1)\n",

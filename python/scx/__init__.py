@@ -205,7 +205,9 @@ def analyze(
             (through the box with its edges and corners cut off; with ``sampler="sobol"`` far tighter on
             solids whose faces it shares, such as the octahedron) (neither with ``bundle`` or
             ``enclose``), or ``"auto"``: for ``sampler="sobol"`` the box when it is smaller than the
-            sphere, else the polytope when the scene lies mostly in its faces, else the sphere. ``lines`` counts lines through the sphere either way: through
+            sphere, else the polytope when the scene lies mostly in its faces, else the sphere; for
+            independent lines the smallest of the three (the same estimates for less time); the sphere
+            with ``bundle`` or ``enclose``. ``lines`` counts lines through the sphere either way: through
             the box fewer are drawn (``to_dict()["lines"]``), worth as many (``["sphere_lines"]``)
             (docs/sampling.md).
         per_patch: also share the measures out among the patches, for :meth:`Analysis.patches`,

@@ -11,7 +11,9 @@ use pyo3::prelude::*;
 use scene_complexity::render::{
     default_camera, noise_summary, trace_view, Camera, ColourScale, Quantity,
 };
-use scene_complexity::{make_tracer, Backend, PatchMaterials, PatchMeasure, Point, Query, Vector};
+use scene_complexity::{
+    make_tracer, sphere_lines_of_drawn, Backend, PatchMaterials, PatchMeasure, Point, Query, Vector,
+};
 
 use crate::analysis::Analysis;
 use crate::args::{self, repr};
@@ -251,7 +253,9 @@ pub fn render<'py>(
             let values = values_of(a, &scene, q, per_area)?;
             let areas: Vec<f64> = scene.patches.iter().map(|p| p.area).collect();
             if let Some(patches) = &a.inner.patches {
-                let noise = noise_summary(patches, &areas, q, a.inner.lines);
+                // In lines through the sphere, as `lines=` counts them and the advice gives them.
+                let lines = sphere_lines_of_drawn(&scene, a.inner.spec.bound, a.inner.lines);
+                let noise = noise_summary(patches, &areas, q, lines);
                 if let Some(message) = noise.warning(q.label()) {
                     let message = format!("{}: {message}", scene.name);
                     warn_all(py, std::iter::once(message.as_str()))?;

@@ -534,10 +534,20 @@ pub fn resume(
     let mut state = saved.state;
     let lines = lines.map(|n| identity.spec.lines_for(&lib_scene, n));
     if let Some(lines) = lines.filter(|&n| n != identity.spec.lines) {
-        identity.spec = identity
-            .spec
-            .extended_to(lines)
-            .map_err(|e| bad_argument(format!("{shown}: {e}")))?;
+        let bound = identity.spec.bound;
+        identity.spec = identity.spec.extended_to(lines).map_err(|e| {
+            // Counted as `lines=` counts them, through the bounding sphere.
+            let e = e.in_sphere_lines(&lib_scene, bound);
+            let unit = match bound {
+                scene_complexity::LineBound::Sphere => String::new(),
+                other => format!(
+                    " (line counts through the bounding sphere, as lines= counts them; the run draws \
+                     its lines through the bounding {}, and its batches hold lines drawn)",
+                    other.name()
+                ),
+            };
+            bad_argument(format!("{shown}: {e}{unit}"))
+        })?;
         state = state.extend(identity.spec.plan());
     }
     let cfg = RunSpec {

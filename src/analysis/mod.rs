@@ -79,7 +79,8 @@ impl AnalysisError {
 pub struct Analysis {
     /// What the run was asked to be (its seed, measures, estimator, ...).
     pub spec: RunSpec,
-    /// Lines cast.
+    /// Lines cast: those drawn, through the spec's bound (fewer than the sphere's lines asked through a box
+    /// or polytope smaller than the sphere; [`crate::sample::bounds::sphere_lines_of_drawn`]).
     pub lines: u64,
     /// Wall-clock seconds of tracing, counting and measuring.
     pub seconds: f64,

@@ -95,7 +95,8 @@ pub struct AnalyzeArgs {
     /// escape_fraction, seconds, family, measure, unit, value, stderr, reliability, corrected,
     /// corrected_stderr, corrected_reliability, then the bounds each reading breaks and the bias and
     /// lines behind an `undersampled` verdict: flags, corrected_flags, estimated_bias, lines_needed,
-    /// corrected_estimated_bias, corrected_lines_needed).
+    /// corrected_estimated_bias, corrected_lines_needed; last, what the lines drawn are worth through
+    /// the sphere and where they were drawn: sphere_lines, lines_through).
     #[arg(long, value_enum)]
     format: Option<Format>,
     #[command(flatten)]
@@ -334,7 +335,9 @@ fn resumed_run(args: &AnalyzeArgs, file: &Path) -> Result<Prepared, Failure> {
         .map(|n| identity.spec.lines_for(&runner.scene, n));
     if let Some(lines) = asked.filter(|&n| n != identity.spec.lines) {
         identity.spec = identity.spec.extended_to(lines).map_err(|e| {
-            let unit = drawn_lines_unit(&runner.scene, identity.spec.bound);
+            let bound = identity.spec.bound;
+            let e = e.in_sphere_lines(&runner.scene, bound);
+            let unit = drawn_lines_unit(&runner.scene, bound);
             Failure::bad_input(format!("{shown}: {e}{unit}"))
         })?;
         state = state.extend(identity.spec.plan());
@@ -347,14 +350,15 @@ fn resumed_run(args: &AnalyzeArgs, file: &Path) -> Result<Prepared, Failure> {
     })
 }
 
-/// For a run drawn through the box or the polytope, what its line counts in a message count: lines
-/// drawn, where `--lines` counts lines through the sphere.
+/// For a run drawn through the box or the polytope, what the counts of a message about its lines count:
+/// lines through the sphere, as `--lines` does, while its batches hold lines drawn.
 fn drawn_lines_unit(scene: &scene_complexity::Scene, bound: LineBound) -> String {
     match bound {
         LineBound::Sphere => String::new(),
         LineBound::Box | LineBound::Polytope => format!(
-            " (lines drawn through the bounding {}, each worth {:.4} through the sphere, the unit of \
-             --lines)",
+            " (line counts through the bounding sphere, as --lines counts them; the run draws its lines \
+             through the bounding {}, each worth {:.4} through the sphere, and its batches hold lines \
+             drawn)",
             bound.name(),
             sphere_lines(scene, bound, 1)
         ),
@@ -506,12 +510,7 @@ pub fn run(args: &AnalyzeArgs) -> Result<Exit, Failure> {
     };
     let total = (!cfg.budget.is_open_ended()).then(|| remaining_lines(&state, scope));
     let control = &runner.control;
-    // The bar counts the lines drawn: through a container, fewer than --lines asked, and it says so.
-    let label = match cfg.bound {
-        LineBound::Sphere => "",
-        LineBound::Box => "drawn through the box",
-        LineBound::Polytope => "drawn through the polytope",
-    };
+    let label = super::runner::drawn_label(cfg.bound);
     let stop_reason = runner
         .in_pool(total, label, || {
             cast(

@@ -59,9 +59,9 @@ pub struct CalibrateArgs {
     #[arg(long, default_value = "independent", value_parser = parse_sampler)]
     sampler: Sampler,
     /// Where the runs draw their lines, for every cell: `auto`, `sphere`, `box` or `polytope` (`scx
-    /// analyze --lines-through`; `auto` draws through the box or the polytope for --sampler sobol where
-    /// it is the tighter container). Line counts are lines through the sphere, as `scx analyze --lines`
-    /// counts them.
+    /// analyze --lines-through`; `auto` draws independent lines through the smallest container, and
+    /// --sampler sobol's through the box or the polytope where it is the tighter container). Line counts
+    /// are lines through the sphere, as `scx analyze --lines` counts them.
     #[arg(long, default_value = "auto", value_parser = parse_bound)]
     lines_through: LinesThrough,
     /// Print the cells and exit.

@@ -28,7 +28,8 @@ pub struct ConvergenceArgs {
     /// The scene: a file in OBJ, glTF/GLB, PLY or STL (told by its content), a built-in such as
     /// `@cube:30` (`scx scenes` lists them), or `-` for a scene on standard input.
     scene: String,
-    /// The line counts to run, comma separated (accepts `1e6`).
+    /// The line counts to run, comma separated (accepts `1e6`), counted through the bounding sphere as
+    /// `scx analyze --lines` counts them.
     #[arg(long, value_delimiter = ',', value_parser = parse_count, default_value = "1e4,1e5,1e6,1e7",
           allow_hyphen_values = true)]
     lines: Vec<u64>,
@@ -162,6 +163,8 @@ pub fn run(args: &ConvergenceArgs) -> Result<Exit, Failure> {
     counts.dedup();
     let mut levels = Vec::new();
     let mut interrupted = false;
+    // Each run's warnings, as `analyze` prints them, once each (the scene's own recur in every run).
+    let mut warned: Vec<String> = Vec::new();
     let total_runs = counts.len() as u32 * args.repeats;
     'counts: for (k, &lines) in counts.iter().enumerate() {
         let mut runs = Vec::new();
@@ -172,6 +175,12 @@ pub fn run(args: &ConvergenceArgs) -> Result<Exit, Failure> {
                 k as u32 * args.repeats + r + 1
             );
             let mut a = runner.analyze(args.run.spec(lines, seed), &label)?;
+            for w in &a.warnings {
+                if !warned.contains(&w.message) {
+                    warn(&format!("{lines} lines, seed {seed}: {}", w.message));
+                    warned.push(w.message.clone());
+                }
+            }
             // The counts are not needed any more; keep the measures only.
             a.tally.counts = None;
             let stopped = a.stop_reason != StopReason::Lines;
@@ -330,6 +339,7 @@ fn json_report(info: &report::RunInfo, levels: &[Level], repeats: u32) -> String
             json!({
                 "lines": a.lines,
                 "sphere_lines": sphere_lines,
+                "lines_through": a.spec.bound.name(),
                 "seed": a.spec.seed,
                 "seconds": a.seconds,
                 "stop_reason": a.stop_reason.name(),
@@ -473,7 +483,7 @@ fn table(info: &report::RunInfo, levels: &[Level], repeats: u32, plot_written: b
         let _ = writeln!(s, "{n}");
     }
     let poor = verdict_lines(levels);
-    if !notes.is_empty() || !poor.is_empty() {
+    if !notes.is_empty() {
         let _ = writeln!(
             s,
             "\nmarked !: a repeat's reading breaks a bound of the theory (the notes above say which); \
@@ -481,6 +491,9 @@ fn table(info: &report::RunInfo, levels: &[Level], repeats: u32, plot_written: b
         );
     }
     if !poor.is_empty() {
+        if notes.is_empty() {
+            s.push('\n');
+        }
         let _ = writeln!(
             s,
             "readings not ok (the worst verdict of the repeats; docs/results.md, \"Reading the \

@@ -26,7 +26,8 @@ pub struct CrosscheckArgs {
     scene: String,
     #[command(flatten)]
     input: SceneArgs,
-    /// Number of global lines (accepts `1e6`) [default: 1e6; with --aimed: 1e5 of each kind].
+    /// Number of global lines (accepts `1e6`), random ones counted through the bounding sphere as `scx
+    /// analyze --lines` counts them [default: 1e6; with --aimed: 1e5 of each kind].
     #[arg(long, value_parser = parse_count, allow_negative_numbers = true)]
     lines: Option<u64>,
     /// Instead of random lines, lines aimed where tracers could differ: at vertices, along and across

@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 
 use scene_complexity::{files, finish};
-use scene_complexity::{RunSpec, RunState, SavedRun, Scene, StateFile, StopReason};
+use scene_complexity::{LineBound, RunSpec, RunState, SavedRun, Scene, StateFile, StopReason};
 
 use super::analyze::persist_failure;
 use super::args::{ReadArgs, ReportOutput, Threads};
@@ -89,8 +89,15 @@ fn read_states(args: &MergeArgs) -> Result<Vec<StateFile>, Failure> {
     let first = &files[0];
     for file in &files[1..] {
         if let Some(d) = first.identity().difference(file.identity(), false) {
+            // Line counts are the lines drawn; through a container, --lines counted others.
+            let unit = match (d.setting.as_str(), first.identity().spec.bound) {
+                ("lines", bound) if bound != LineBound::Sphere => {
+                    format!(", lines drawn through the bounding {}", bound.name())
+                }
+                _ => String::new(),
+            };
             return Err(Failure::bad_input(format!(
-                "{} and {} are not parts of one run: they differ in {} ({} against {})",
+                "{} and {} are not parts of one run: they differ in {} ({} against {}{unit})",
                 file.path(),
                 first.path(),
                 d.setting,

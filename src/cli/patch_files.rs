@@ -19,6 +19,7 @@ use scene_complexity::PatchMeasure;
 use scene_complexity::RunIdentity;
 use scene_complexity::Scene;
 use scene_complexity::Wanted;
+use scene_complexity::{sphere_lines_of_drawn, LineBound};
 
 use super::exit::Failure;
 use super::file_kind::{check_csv, check_extension, extension};
@@ -274,9 +275,13 @@ fn matrix_market(
     writeln!(w, "%%MatrixMarket matrix coordinate real general")?;
     writeln!(
         w,
-        "% form factors F_ij = N_ij / N_i of {} from {} global lines (seed {}), written by scx {}",
+        "% form factors F_ij = N_ij / N_i of {} from {} global lines{} (seed {}), written by scx {}",
         scene.name.replace('\n', " "),
-        a.lines,
+        sphere_lines_of_drawn(scene, a.spec.bound, a.lines),
+        match a.spec.bound {
+            LineBound::Sphere => String::new(),
+            bound => format!(" ({} drawn through the bounding {})", a.lines, bound.name()),
+        },
         a.spec.seed,
         env!("CARGO_PKG_VERSION")
     )?;

@@ -45,7 +45,8 @@ pub struct RenderArgs {
     #[arg(long, value_enum, default_value_t = MeshFormat::Binary, value_name = "FORMAT",
           requires = "patches_mesh")]
     patches_mesh_format: MeshFormat,
-    /// Global lines of the run behind the colours (accepts `1e7`).
+    /// Global lines of the run behind the colours (accepts `1e7`), counted through the bounding sphere as
+    /// `scx analyze --lines` counts them.
     #[arg(long, default_value = "1e6", value_parser = parse_count, allow_hyphen_values = true)]
     lines: u64,
     #[command(flatten)]

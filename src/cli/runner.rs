@@ -4,7 +4,7 @@ use std::sync::Arc;
 
 use scene_complexity::{analyze, Analysis};
 use scene_complexity::{make_tracer, Tracer};
-use scene_complexity::{LinesThrough, RunControl, RunSpec, Tracing};
+use scene_complexity::{LineBound, LinesThrough, RunControl, RunSpec, Tracing};
 use scene_complexity::{ReadPolicy, Scene, SceneOptions};
 
 use super::args::RunOptions;
@@ -24,6 +24,16 @@ pub struct Runner {
     /// How long building the tracer's acceleration structure took, in seconds.
     pub build_seconds: f64,
     pub control: Arc<RunControl>,
+}
+
+/// What a progress bar adds to its label for a run drawn as `bound` says: it counts the lines drawn,
+/// through a container fewer than --lines asked, and says so.
+pub fn drawn_label(bound: LineBound) -> &'static str {
+    match bound {
+        LineBound::Sphere => "",
+        LineBound::Box => "drawn through the box",
+        LineBound::Polytope => "drawn through the polytope",
+    }
 }
 
 impl Runner {
@@ -80,7 +90,12 @@ impl Runner {
     /// every command.
     pub fn analyze(&self, cfg: RunSpec, label: &str) -> Result<Analysis, Failure> {
         let cfg = cfg.through(&self.scene, LinesThrough::Auto);
-        progress::while_running(&self.control, Some(cfg.lines), label, || {
+        let label = match (label, drawn_label(cfg.bound)) {
+            (label, "") => label.to_string(),
+            ("", drawn) => drawn.to_string(),
+            (label, drawn) => format!("{label}, {drawn}"),
+        };
+        progress::while_running(&self.control, Some(cfg.lines), &label, || {
             self.pool
                 .install(|| analyze(&self.scene, self.tracer(), &cfg, &self.control))
         })

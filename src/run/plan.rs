@@ -45,7 +45,8 @@ impl BatchPlan {
         BatchPlan { lines, batch_size }
     }
 
-    /// The fewest lines (as `--lines` counts them, before rounding to whole bundles) whose plan for
+    /// The fewest lines drawn (before rounding to whole bundles; through the sphere, as `--lines` counts
+    /// them, or through a box or polytope: `sample::bounds::sphere_lines_for_drawn`) whose plan for
     /// `source` has at least `batches` batches, the standard-error groups a run can have: the plan of
     /// [`BatchPlan::for_source`], or with `open_ended` [`BatchPlan::open_ended`]'s full batches.
     pub fn lines_for_batches(batches: u64, source: LineSource, open_ended: bool) -> u64 {

@@ -14,7 +14,10 @@ use super::errors::ErrorMethod;
 use super::plan::BatchPlan;
 use crate::measure::estimators::EntropyEstimator;
 use crate::measure::radiosity::SolveOptions;
-use crate::sample::bounds::{lines_to_draw, smallest_container, tightest_container, LineBound};
+use crate::sample::bounds::{
+    lines_to_draw, smallest_container, sphere_lines_for_drawn, sphere_lines_of_drawn,
+    tightest_container, LineBound,
+};
 use crate::sample::lines::{LineSource, Sampler};
 use crate::scene::Scene;
 
@@ -132,8 +135,9 @@ impl SamplerChoice {
 /// for [`RunSpec::lines`] and [`RunSpec::per_patch`] ([`RunSpec::common`]).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct RunSpec {
-    /// Global lines to cast (a cap when a budget is set). Parts of one run may differ: a resumed run goes
-    /// on to more lines.
+    /// Global lines to cast (a cap when a budget is set): the lines drawn, through [`RunSpec::bound`]
+    /// (as many as asked through the sphere; [`RunSpec::through`] turns the sphere's lines asked into
+    /// those to draw). Parts of one run may differ: a resumed run goes on to more lines.
     pub lines: u64,
     /// Seed of the line streams.
     pub seed: u64,
@@ -325,6 +329,7 @@ impl RunSpec {
                 asked: lines,
                 asked_batch_size: new.batch_size,
                 asked_groups: longer.group_count(),
+                full_from: BatchPlan::FULL_FROM,
             });
         }
         Ok(longer)
@@ -483,9 +488,9 @@ pub enum ExtendError {
     #[error(
         "a run of {lines} lines is cut into batches of {batch_size}, and a run can be continued only to \
          line counts cut the same way, here at most {most}: {asked} lines would be batches of \
-         {asked_batch_size} in {asked_groups} groups. Runs of {} lines or more all have batches of {} and \
-         can be continued to any count: start a run with at least that many lines to continue it freely",
-        BatchPlan::FULL_FROM,
+         {asked_batch_size} in {asked_groups} groups. Runs of {full_from} lines or more all have batches of \
+         {} and can be continued to any count: start a run with at least that many lines to continue it \
+         freely",
         BatchPlan::MAX_BATCH
     )]
     CutDifferently {
@@ -501,7 +506,45 @@ pub enum ExtendError {
         asked_batch_size: u64,
         /// Their groups.
         asked_groups: usize,
+        /// The lines from which every run has full batches ([`BatchPlan::FULL_FROM`] lines drawn).
+        full_from: u64,
     },
+}
+
+impl ExtendError {
+    /// This error with its line counts given as `--lines` (and Python's `lines=`) counts them, in lines
+    /// through `scene`'s bounding sphere, for a run drawn as `bound` says; its batch sizes stay in lines
+    /// drawn.
+    pub fn in_sphere_lines(self, scene: &Scene, bound: LineBound) -> ExtendError {
+        let worth = |n: u64| sphere_lines_of_drawn(scene, bound, n);
+        match self {
+            ExtendError::Fewer { lines, asked } => ExtendError::Fewer {
+                lines: worth(lines),
+                asked: worth(asked),
+            },
+            ExtendError::CutDifferently {
+                lines,
+                most,
+                batch_size,
+                asked,
+                asked_batch_size,
+                asked_groups,
+                full_from,
+            } => ExtendError::CutDifferently {
+                lines: worth(lines),
+                // The most sphere lines that draw no more than `most`.
+                most: match most {
+                    u64::MAX => most,
+                    _ => sphere_lines_for_drawn(scene, bound, most + 1).saturating_sub(1),
+                },
+                batch_size,
+                asked: worth(asked),
+                asked_batch_size,
+                asked_groups,
+                full_from: sphere_lines_for_drawn(scene, bound, full_from),
+            },
+        }
+    }
 }
 
 #[cfg(test)]

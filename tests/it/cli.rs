@@ -524,6 +524,52 @@ fn convergence_marks_the_readings_analyze_flags_and_no_other() {
 
 /// One flat quad sees nothing of itself: `convergence` names the undefined measures and says why (the
 /// `no-pairs` warning, which knows the scene is flat), writes no plot and says so, and exits 0.
+/// `convergence` passes on each run's warnings as `analyze` gives them (once each, after the run's lines
+/// and seed), and says what `!` marks only when a reading is marked.
+#[test]
+fn convergence_warns_as_analyze_does_and_explains_only_the_marks_it_shows() {
+    let warning = |out: &std::process::Output, code: &str| -> Vec<String> {
+        String::from_utf8_lossy(&out.stderr)
+            .lines()
+            .filter(|l| l.contains(code))
+            .map(str::to_string)
+            .collect()
+    };
+    let analyze = scx(&["analyze", "@cube:10", "--lines", "2e3", "--threads", "1"]);
+    let convergence = scx(&[
+        "convergence",
+        "@cube:10",
+        "--lines",
+        "2e3,1e6",
+        "--threads",
+        "1",
+    ]);
+    assert!(convergence.status.success());
+    let (a, c) = (
+        warning(&analyze, "fill 5 groups"),
+        warning(&convergence, "fill 5 groups"),
+    );
+    assert_eq!((a.len(), c.len()), (1, 1), "{a:?} {c:?}");
+    let message = a[0].trim_start_matches("scx: warning: ");
+    assert_eq!(c[0], format!("scx: warning: 2000 lines, seed 1: {message}"));
+    // At 10^6 lines no reading of @cube:10 breaks a bound: no `!` and no legend for it, but the
+    // readings that are not ok are still listed.
+    let table = support::text_of(scx(&[
+        "convergence",
+        "@cube:10",
+        "--lines",
+        "1e6",
+        "--threads",
+        "1",
+        "-q",
+    ]));
+    assert!(
+        !table.contains(" !") && !table.contains("marked !"),
+        "{table}"
+    );
+    assert!(table.contains("\nreadings not ok"), "{table}");
+}
+
 #[test]
 fn convergence_on_a_scene_with_undefined_measures_says_so_and_draws_nothing() {
     let dir = tempfile::tempdir().unwrap();
