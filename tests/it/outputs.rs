@@ -1285,3 +1285,85 @@ fn file_options_take_their_extension_only() {
         assert!(!d.join("x.txt").exists(), "{args:?}: nothing written");
     }
 }
+
+/// A resume refused for its line count says so in the unit of `--lines`, the sphere's lines, though the
+/// run draws its lines through the cube's box: the most it names is the most it takes, and the count it
+/// names for full batches is the least that draws them.
+#[test]
+fn resume_refusals_count_lines_as_lines_does() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let first = scx_in(
+        d,
+        &[
+            "analyze",
+            "@cube:4",
+            "--lines",
+            "1e5",
+            "--save",
+            "s.scx",
+            "-q",
+            "--threads",
+            "1",
+        ],
+    );
+    assert_eq!(code(&first), Some(0), "{}", stderr(&first));
+    let number_after = |text: &str, words: &str| -> u64 {
+        let at = text
+            .find(words)
+            .unwrap_or_else(|| panic!("`{words}` not in: {text}"))
+            + words.len();
+        let digits: String = text[at..]
+            .chars()
+            .take_while(char::is_ascii_digit)
+            .collect();
+        digits.parse().unwrap()
+    };
+    let refused = scx_in(d, &["analyze", "--resume", "s.scx", "--lines", "2e5", "-q"]);
+    assert_eq!(code(&refused), Some(2));
+    let err = stderr(&refused);
+    assert!(
+        err.contains("a run of 100000 lines") && err.contains("200000 lines would be"),
+        "{err}"
+    );
+    assert!(err.contains("as --lines counts them"), "{err}");
+    let most = number_after(&err, "here at most ");
+    let full = number_after(&err, "Runs of ");
+    for (lines, ok) in [(most, true), (most + 1, false)] {
+        std::fs::copy(d.join("s.scx"), d.join("t.scx")).unwrap();
+        let args = [
+            "analyze",
+            "--resume",
+            "t.scx",
+            "--lines",
+            &lines.to_string(),
+            "-q",
+        ];
+        let out = scx_in(d, &args);
+        assert_eq!(code(&out) == Some(0), ok, "{lines}: {}", stderr(&out));
+    }
+    let drawn = |lines: u64| {
+        let out = scx_in(
+            d,
+            &[
+                "analyze",
+                "@cube:4",
+                "--lines",
+                &lines.to_string(),
+                "--format",
+                "json",
+                "-q",
+            ],
+        );
+        let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        doc["lines"].as_u64().unwrap()
+    };
+    // Full batches (4096 lines) from 131072 lines drawn on: `full` draws them, one line fewer does not.
+    assert!(drawn(full) >= 131_072 && drawn(full - 1) < 131_072);
+    let fewer = scx_in(d, &["analyze", "--resume", "s.scx", "--lines", "5e4", "-q"]);
+    assert!(
+        stderr(&fewer).contains("to fewer lines (50000)"),
+        "{}",
+        stderr(&fewer)
+    );
+}
