@@ -23,12 +23,9 @@
 //! low-discrepancy sequence integrates far better than the curved regions of the sphere's
 //! parametrisation (docs/sampling.md).
 
-use rand::RngCore;
-
-use super::lines::{batch_rng, concentric_discs, lines_with_discs};
+use super::lines::{batch_units, concentric_discs, lines_with_discs};
 use super::polytope::{share_of_area_on_faces, BoundingPolytope, CONTAINER_MARGIN};
 use super::sobol::ScrambledSobol;
-use crate::geom::uniform01;
 use crate::scene::Scene;
 use crate::trace::Line;
 
@@ -264,7 +261,7 @@ impl UnitLines for BoundingPolytope {
 }
 
 /// Appends `count` independent lines through `bounds` to `out`, four draws of batch `batch`'s stream
-/// ([`batch_rng`]) per line: a batch's lines depend on `seed` and its index only.
+/// ([`super::lines::batch_rng`]) per line: a batch's lines depend on `seed` and its index only.
 pub fn batch_lines_through(
     seed: u64,
     batch: u64,
@@ -272,14 +269,8 @@ pub fn batch_lines_through(
     bounds: &impl UnitLines,
     out: &mut Vec<Line>,
 ) {
-    let mut rng = batch_rng(seed, batch);
     out.reserve(count);
-    let units: Vec<[f64; 4]> = (0..count).map(|_| draw4(&mut rng)).collect();
-    bounds.lines(&units, out);
-}
-
-fn draw4(rng: &mut impl RngCore) -> [f64; 4] {
-    [(); 4].map(|_| uniform01(rng))
+    batch_units(seed, batch, count, |units| bounds.lines(units, out));
 }
 
 /// Appends the lines through `bounds` of points `first..first + count` of group `group`'s randomised
@@ -454,6 +445,48 @@ impl LineRegion {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::geom::uniform01;
+    use crate::sample::lines::batch_rng;
+    use rand::RngCore;
+
+    fn draw4(rng: &mut impl RngCore) -> [f64; 4] {
+        [(); 4].map(|_| uniform01(rng))
+    }
+
+    /// A batch's lines through a box or a polytope are those of its stream's draws four at a time,
+    /// [`BoundingBox::line`] and [`BoundingPolytope::line`] of each, bit for bit: for counts that fill no
+    /// chunk of points, one, and several with a partial last one.
+    #[test]
+    fn batch_lines_are_the_lines_of_the_streams_draws() {
+        let cube = BoundingBox::new(LO, HI);
+        let octahedron = BoundingPolytope::of(&crate::scenes::load("@octahedron").unwrap());
+        let bits = |l: &Line| {
+            (
+                l.origin.map(f32::to_bits),
+                l.dir.map(f32::to_bits),
+                l.t_max.to_bits(),
+            )
+        };
+        for count in [0, 1, 3, 63, 64, 65, 1000] {
+            for (seed, batch) in [(1, 0), (7, 12345)] {
+                let mut rng = batch_rng(seed, batch);
+                let units: Vec<[f64; 4]> = (0..count).map(|_| draw4(&mut rng)).collect();
+                let (mut through_box, mut through_polytope) = (Vec::new(), Vec::new());
+                batch_lines_through(seed, batch, count, &cube, &mut through_box);
+                batch_lines_through(seed, batch, count, &octahedron, &mut through_polytope);
+                assert_eq!(through_box.len(), count);
+                assert_eq!(through_polytope.len(), count);
+                for (k, u) in units.iter().enumerate() {
+                    assert_eq!(bits(&through_box[k]), bits(&cube.line(*u)), "{count} {k}");
+                    assert_eq!(
+                        bits(&through_polytope[k]),
+                        bits(&octahedron.line(*u)),
+                        "{count} {k}"
+                    );
+                }
+            }
+        }
+    }
 
     const LO: [f64; 3] = [-0.5, -1.0, 0.25];
     const HI: [f64; 3] = [0.5, 1.0, 3.25];

@@ -63,6 +63,35 @@ pub fn batch_lines(seed: u64, batch: u64, count: usize, radius: f64, out: &mut V
     }
 }
 
+/// Calls `visit` with the unit points of batch `batch`'s stream, `count` in all and [`UNIT_CHUNK`] at a
+/// time (the last chunk shorter): four draws per point, each [`unit_from_draw`]. Bit for bit the points
+/// of `[uniform01(rng); 4]` called point after point on [`batch_rng`], only drawn in blocks (`pcg_lanes`)
+/// and without a buffer of the whole batch.
+pub(super) fn batch_units(seed: u64, batch: u64, count: usize, mut visit: impl FnMut(&[[f64; 4]])) {
+    let (state, stream) = batch_stream(seed, batch);
+    let mut lanes = PcgLanes::new(state, stream);
+    let mut draws = [0u64; 4 * UNIT_CHUNK];
+    let mut units = [[0.0f64; 4]; UNIT_CHUNK];
+    let mut left = count;
+    while left > 0 {
+        let n = left.min(UNIT_CHUNK);
+        // Four draws per point: always whole rounds of the lanes.
+        lanes.fill(&mut draws[..4 * n]);
+        for (unit, d) in units.iter_mut().zip(draws.chunks_exact(4)).take(n) {
+            *unit = std::array::from_fn(|k| unit_from_draw(d[k]));
+        }
+        visit(&units[..n]);
+        left -= n;
+    }
+}
+
+/// Unit points made at a time by [`batch_units`]: a whole number of [`lines_with_discs`]' chunks, few
+/// enough that the draws and points stay in L1.
+pub(super) const UNIT_CHUNK: usize = 64;
+
+// A point's four draws are whole rounds of the lanes, and the chunks are whole chunks of the discs'.
+const _: () = assert!(4 % LANES == 0 && UNIT_CHUNK % 16 == 0);
+
 /// Appends the lines of consecutive pairs of disc points ([`line_from_discs`]). A function of its own,
 /// called once per [`CHUNK_LINES`] lines, so that profiles name the drawing's arithmetic.
 #[inline(never)]
