@@ -124,25 +124,28 @@ pub fn segments_and_ends(
     hits: &[Hit],
     visit: impl FnMut(Segment),
 ) -> LineEnds {
-    let plane = |patch: u32| {
+    let patch_plane = |triangle: u32| {
+        let patch = scene.triangle_patch[triangle as usize];
         let p = &scene.patches[patch as usize];
-        (p.normal, p.offset)
+        (patch, (p.normal, p.offset))
     };
-    ends_of(scene, plane, line, hits, visit)
+    ends_of(scene, patch_plane, line, hits, visit)
 }
 
 /// The patch planes of a scene (normal and offset, `n . x = offset`), for the pairing of many lines: a
 /// crossing reads its patch's plane, and in a large mesh those reads miss the cache. The planes are kept
 /// 32 bytes each (one cache line holds a plane), and when many patches share a plane bit for bit, as the
-/// patches of a wall meshed for radiosity do, each distinct plane is kept once with a 4-byte index per
-/// patch: the index table and the few planes stay in cache where the full table did not. Either way it
-/// holds the scene's own numbers: pairing with it gives the same segments, to the bit.
+/// patches of a wall meshed for radiosity do, each distinct plane is kept once, and each triangle's patch
+/// and plane index side by side: one read of 8 bytes per crossing, where the patch of the triangle and
+/// then the plane of the patch were two dependent reads, each missing the cache in a large mesh. Either
+/// way it holds the scene's own numbers: pairing with it gives the same segments, to the bit.
 #[derive(Clone, Debug)]
 pub struct PatchPlanes {
-    /// The distinct planes (or every patch's, when `index` is empty).
+    /// The distinct planes (or every patch's, when `by_triangle` is empty).
     planes: Vec<[f64; 4]>,
-    /// Each patch's plane in `planes`; empty when `planes` holds one plane per patch.
-    index: Vec<u32>,
+    /// Each triangle's patch and that patch's plane in `planes`; empty when `planes` holds one plane
+    /// per patch.
+    by_triangle: Vec<[u32; 2]>,
 }
 
 impl PatchPlanes {
@@ -151,13 +154,13 @@ impl PatchPlanes {
     const CACHED_BYTES: usize = 256 << 10;
 
     /// The planes of `scene`'s patches, shared when the full table would not fit in a core's cache
-    /// (256 KiB, `CACHED_BYTES`) and at most a quarter of them are distinct. Otherwise the index
-    /// would only add a dependent read to every crossing.
+    /// (256 KiB, `CACHED_BYTES`) and at most a quarter of them are distinct. Otherwise the shared table
+    /// would only add to what a crossing reads.
     pub fn of(scene: &Scene) -> Self {
         let plane = |p: &crate::scene::Patch| [p.normal.x, p.normal.y, p.normal.z, p.offset];
         let every = || PatchPlanes {
             planes: scene.patches.iter().map(plane).collect(),
-            index: Vec::new(),
+            by_triangle: Vec::new(),
         };
         let n = scene.patch_count();
         if n * std::mem::size_of::<[f64; 4]>() <= Self::CACHED_BYTES {
@@ -180,16 +183,24 @@ impl PatchPlanes {
                 return every();
             }
         }
-        PatchPlanes { planes, index }
+        let by_triangle = scene
+            .triangle_patch
+            .iter()
+            .map(|&patch| [patch, index[patch as usize]])
+            .collect();
+        PatchPlanes {
+            planes,
+            by_triangle,
+        }
     }
 
-    /// Whether patches share their planes behind an index (see [`PatchPlanes::of`]).
+    /// Whether patches share their planes (see [`PatchPlanes::of`]).
     pub fn shares_planes(&self) -> bool {
-        !self.index.is_empty()
+        !self.by_triangle.is_empty()
     }
 
     /// [`segments_and_ends`] with the planes read from this table (made from `scene`). The two layouts
-    /// get a pairing loop each, so the direct one pays nothing for the index.
+    /// get a pairing loop each, so the direct one pays nothing for the shared one.
     pub fn segments_and_ends(
         &self,
         scene: &Scene,
@@ -198,21 +209,27 @@ impl PatchPlanes {
         visit: impl FnMut(Segment),
     ) -> LineEnds {
         let as_plane = |[x, y, z, offset]: [f64; 4]| (DVec3::new(x, y, z), offset);
-        let (planes, index) = (&self.planes, &self.index);
-        if index.is_empty() {
-            let plane = |patch: u32| as_plane(planes[patch as usize]);
-            ends_of(scene, plane, line, hits, visit)
+        let (planes, by_triangle) = (&self.planes, &self.by_triangle);
+        if by_triangle.is_empty() {
+            let patch_plane = |triangle: u32| {
+                let patch = scene.triangle_patch[triangle as usize];
+                (patch, as_plane(planes[patch as usize]))
+            };
+            ends_of(scene, patch_plane, line, hits, visit)
         } else {
-            let plane = |patch: u32| as_plane(planes[index[patch as usize] as usize]);
-            ends_of(scene, plane, line, hits, visit)
+            let patch_plane = |triangle: u32| {
+                let [patch, plane] = by_triangle[triangle as usize];
+                (patch, as_plane(planes[plane as usize]))
+            };
+            ends_of(scene, patch_plane, line, hits, visit)
         }
     }
 }
 
-/// [`segments_and_ends`], with each patch's plane from `plane`.
+/// [`segments_and_ends`], with each triangle's patch and that patch's plane from `patch_plane`.
 fn ends_of(
     scene: &Scene,
-    plane: impl Fn(u32) -> (Normal, f64),
+    patch_plane: impl Fn(u32) -> (u32, (Normal, f64)),
     line: &Line,
     hits: &[Hit],
     mut visit: impl FnMut(Segment),
@@ -222,8 +239,8 @@ fn ends_of(
     }
     let l = LineF64::from(line);
     let crossing = |h: &Hit| {
-        let patch = scene.triangle_patch[h.triangle as usize];
-        crossing(patch, plane(patch), &l, h)
+        let (patch, plane) = patch_plane(h.triangle);
+        crossing(patch, plane, &l, h)
     };
     if !order::has_close_hits(hits) {
         return pair_crossings(hits.iter().map(crossing), &mut visit);
