@@ -149,12 +149,13 @@ pub struct PatchPlanes {
 }
 
 impl PatchPlanes {
-    /// A table of planes this large is read from a core's second-level cache (256 KiB and more on
-    /// current x86 and ARM cores).
-    const CACHED_BYTES: usize = 256 << 10;
+    /// A table of planes this large stays in a core's first-level data cache (32 KiB and more on
+    /// current x86 and ARM cores); a larger one is read from the second level or beyond at every
+    /// crossing.
+    const CACHED_BYTES: usize = 32 << 10;
 
     /// The planes of `scene`'s patches, shared when the full table would not fit in a core's cache
-    /// (256 KiB, `CACHED_BYTES`) and at most a quarter of them are distinct. Otherwise the shared table
+    /// (32 KiB, `CACHED_BYTES`: more than 1,024 patches) and at most a quarter of them are distinct. Otherwise the shared table
     /// would only add to what a crossing reads.
     pub fn of(scene: &Scene) -> Self {
         let plane = |p: &crate::scene::Patch| [p.normal.x, p.normal.y, p.normal.z, p.offset];
