@@ -47,8 +47,8 @@ impl Sampling {
         let thin_rows = rows.iter().filter(|r| r.n() < 2.0).count();
         for (&a_i, row) in a.iter().zip(rows) {
             weight += a_i;
-            seen += row.seen;
-            singletons += row.singletons;
+            seen += u64::from(row.seen);
+            singletons += u64::from(row.singletons);
             if row.segments == 0 {
                 continue;
             }
@@ -153,7 +153,7 @@ fn row_coverage(row: &RowSums, more: f64) -> f64 {
 mod tests {
     use super::*;
 
-    fn row(segments: u64, singletons: u64, doubletons: u64) -> RowSums {
+    fn row(segments: u64, singletons: u32, doubletons: u32) -> RowSums {
         RowSums {
             segments,
             singletons,
