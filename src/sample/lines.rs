@@ -87,7 +87,7 @@ pub(super) fn batch_units(seed: u64, batch: u64, count: usize, mut visit: impl F
 
 /// Unit points made at a time by [`batch_units`]: a whole number of [`lines_with_discs`]' chunks, few
 /// enough that the draws and points stay in L1.
-pub(super) const UNIT_CHUNK: usize = 64;
+const UNIT_CHUNK: usize = 64;
 
 // A point's four draws are whole rounds of the lanes, and the chunks are whole chunks of the discs'.
 const _: () = assert!(4 % LANES == 0 && UNIT_CHUNK % 16 == 0);
