@@ -104,6 +104,7 @@ pub fn run_spec(cell: &Cell, seed: u64, scene: &Scene) -> RunSpec {
         },
     };
     spec.sampler = cell.sampler;
+    spec.groups = cell.groups;
     spec.budget.target = cell.target.map(|t| Target {
         measure: t.measure,
         stderr: t.stderr,

@@ -52,6 +52,8 @@ pub struct Cell {
     /// Where the runs draw their lines (`scx analyze --lines-through`), the line count read as lines
     /// through the sphere, as `scx analyze --lines` reads it.
     pub through: LinesThrough,
+    /// The independent groups of lines behind each run's standard errors (`scx analyze --groups`).
+    pub groups: usize,
 }
 
 impl Cell {
@@ -66,6 +68,7 @@ impl Cell {
             target: None,
             sampler: Sampler::Independent,
             through: LinesThrough::Auto,
+            groups: crate::run::DEFAULT_GROUPS,
         }
     }
 
@@ -77,6 +80,11 @@ impl Cell {
     /// The same cell with lines drawn through `through`.
     pub fn with_bound(self, through: LinesThrough) -> Cell {
         Cell { through, ..self }
+    }
+
+    /// The same cell with `groups` independent groups behind each run's standard errors.
+    pub fn with_groups(self, groups: usize) -> Cell {
+        Cell { groups, ..self }
     }
 
     /// The same cell with a precision target on `measure` (and `lines` as the cap).

@@ -8,10 +8,10 @@ use scene_complexity::calibrate::{
     self, check_computable, report, suite, CalibrationScene, Cell, CellMeasures, CellReport,
     CellTarget, SuiteLevel,
 };
-use scene_complexity::{LinesThrough, Measure, Sampler};
+use scene_complexity::{LinesThrough, Measure, Sampler, DEFAULT_GROUPS};
 
 use super::args::{
-    check_target_measure, parse_count, parse_positive, parse_seed, parse_whole_in,
+    check_target_measure, parse_count, parse_groups, parse_positive, parse_seed, parse_whole_in,
     target_measure_parser, ReportOutput, Threads, Tracer, TracerArg, MAX_WHOLE,
 };
 use super::exit::{Exit, Failure};
@@ -64,6 +64,11 @@ pub struct CalibrateArgs {
     /// are lines through the sphere, as `scx analyze --lines` counts them.
     #[arg(long, default_value = "auto", value_parser = parse_bound)]
     lines_through: LinesThrough,
+    /// Independent groups of lines behind each run's standard errors, for every cell (2 to 1024; `scx
+    /// analyze --groups`): the table's `runs` column names the degrees of freedom of any other count
+    /// than the default's.
+    #[arg(long, default_value_t = DEFAULT_GROUPS as u16, value_parser = parse_groups)]
+    groups: u16,
     /// Print the cells and exit.
     #[arg(long)]
     list: bool,
@@ -116,7 +121,11 @@ fn cells(args: &CalibrateArgs) -> Vec<Cell> {
     if args.scene.is_empty() {
         return suite(args.suite.unwrap_or(SuiteLevel::Small))
             .into_iter()
-            .map(|c| c.with_sampler(args.sampler).with_bound(args.lines_through))
+            .map(|c| {
+                c.with_sampler(args.sampler)
+                    .with_bound(args.lines_through)
+                    .with_groups(usize::from(args.groups))
+            })
             .collect();
     }
     let target = args.target_stderr.map(|stderr| CellTarget {
@@ -135,6 +144,7 @@ fn cells(args: &CalibrateArgs) -> Vec<Cell> {
                 target,
                 sampler: args.sampler,
                 through: args.lines_through,
+                groups: usize::from(args.groups),
             })
         })
         .collect()

@@ -252,6 +252,68 @@ fn precision_targets_are_met_and_the_runs_that_meet_them_cover() {
     }
 }
 
+/// `scx calibrate --groups G` runs what `scx analyze --groups G` runs: each seed's I_s^c is analyze's,
+/// to the bit, the readings name the groups, and the table names the degrees of freedom they give.
+#[cfg(feature = "cli")]
+#[test]
+fn calibration_runs_take_the_groups_asked_for() {
+    let dir = tempfile::tempdir().unwrap();
+    let readings = dir.path().join("r.csv");
+    let common = [
+        "--lines",
+        "2e4",
+        "--sampler",
+        "sobol",
+        "--measures",
+        "continuous",
+    ];
+    let out = crate::support::scx(
+        &[
+            &["calibrate", "--scene", "@octahedron", "--seeds", "2"][..],
+            &common[..],
+            &["--groups", "4", "--readings", readings.to_str().unwrap()][..],
+        ]
+        .concat(),
+    );
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(stdout.contains("| 2 (3 dof) | I_s^c |"), "{stdout}");
+    let rows = std::fs::read_to_string(&readings).unwrap();
+    for seed in ["1", "2"] {
+        let row: Vec<&str> = rows
+            .lines()
+            .map(|l| l.split(',').collect::<Vec<_>>())
+            .find(|r| r[2] == seed && r[6] == "continuous_mutual_information")
+            .unwrap_or_else(|| panic!("seed {seed}: {rows}"));
+        assert_eq!(row[4], "4", "groups of seed {seed}: {row:?}");
+        let analyze = crate::support::scx(
+            &[
+                &["analyze", "@octahedron", "--seed", seed, "--groups", "4"][..],
+                &common[..],
+                &["--format", "csv"][..],
+            ]
+            .concat(),
+        );
+        let report = String::from_utf8_lossy(&analyze.stdout);
+        let value: f64 = report
+            .lines()
+            .find(|l| l.contains(",continuous_mutual_information,"))
+            .and_then(|l| l.split(',').nth(10))
+            .and_then(|v| v.parse().ok())
+            .unwrap_or_else(|| panic!("{report}"));
+        let reading: f64 = row[7].parse().unwrap();
+        assert_eq!(
+            reading.to_bits(),
+            value.to_bits(),
+            "seed {seed}: {row:?} against {report}"
+        );
+    }
+}
+
 /// `scx calibrate` prints the table with its multipliers and writes the CSV files; a scene without exact
 /// values is bad input (exit code 2).
 #[cfg(feature = "cli")]
