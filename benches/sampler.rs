@@ -1,5 +1,6 @@
 //! Do randomised quasi-Monte Carlo lines pay? For each scene, runs the whole analysis (`scx analyze`'s
-//! defaults: every measure, 16 groups, Embree single lines, 2 threads) with independent lines and with
+//! defaults: every measure, 16 groups for independent lines and 8 for Sobol' ones, Embree single lines,
+//! 2 threads) with independent lines and with
 //! the Sobol' sampler, each through the bounding sphere and through the bounding box, and the Sobol'
 //! sampler through the bounding polytope (`--lines-through`), over the same seeds (seed outermost, so
 //! that a drift of the machine's speed falls on every series alike), and prints per measure and series:
@@ -22,7 +23,7 @@
 //! `cargo bench --bench sampler [-- SCENE... [LINES]]`, default `@cube:30 @cubes512` and 10^6 lines;
 //! `SCX_SAMPLER_SEEDS=N` seeds (default 30); `SCX_SAMPLER_MEASURES=continuous` runs I_s^c alone
 //! (`scx analyze --measures continuous`: no pair is counted, the runs `--sampler auto` draws with Sobol'
-//! lines).
+//! lines); `SCX_SAMPLER_GROUPS=G` gives every series G standard-error groups (`scx analyze --groups`).
 
 mod common;
 
@@ -74,9 +75,16 @@ fn main() -> anyhow::Result<()> {
         Err(_) => Measures::ALL,
     };
     let pool = rayon::ThreadPoolBuilder::new().num_threads(2).build()?;
-    println!("{lines} lines per run (through the sphere, or worth as many through the box), 2 threads, Embree single lines, 16 groups, {seeds} seeds per sampler");
+    let groups: Option<usize> = match std::env::var("SCX_SAMPLER_GROUPS") {
+        Ok(g) => Some(g.parse()?),
+        Err(_) => None,
+    };
+    let group_text = groups.map_or("16 groups (8 for sobol)".to_string(), |g| {
+        format!("{g} groups")
+    });
+    println!("{lines} lines per run (through the sphere, or worth as many through the box), 2 threads, Embree single lines, {group_text}, {seeds} seeds per sampler");
     for spec in &specs {
-        pool.install(|| compare(spec, lines, seeds, measures))?;
+        pool.install(|| compare(spec, lines, seeds, measures, groups))?;
     }
     Ok(())
 }
@@ -93,7 +101,13 @@ struct Runs {
     f_errors: Vec<f64>,
 }
 
-fn compare(spec: &str, lines: u64, seeds: u64, measures: Measures) -> anyhow::Result<()> {
+fn compare(
+    spec: &str,
+    lines: u64,
+    seeds: u64,
+    measures: Measures,
+    groups: Option<usize>,
+) -> anyhow::Result<()> {
     let scene = scenes::load(spec)?;
     let tracer = make_tracer(Backend::Embree, &scene, Query::Single)
         .or_else(|_| make_tracer(Backend::Rust, &scene, Query::Single))?;
@@ -119,6 +133,7 @@ fn compare(spec: &str, lines: u64, seeds: u64, measures: Measures) -> anyhow::Re
                 measures,
                 ..RunSpec::new(lines, seed)
             }
+            .grouped(groups)
             .through(&scene, LinesThrough::Bound(bound));
             let (w0, c0) = (Instant::now(), common::cpu_seconds());
             let a = analyze(&scene, tracer.as_ref(), &cfg, &RunControl::default())?;

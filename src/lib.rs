@@ -104,10 +104,11 @@ pub use run::persist::{
     StateFile,
 };
 pub use run::{
-    remaining_lines, start, Budget, CastOptions, ErrorMethod, ExtendError, LinesThrough, Measures,
-    MergeError, MissingLines, PersistError, RunControl, RunIdentity, RunSpec, RunState,
-    SamplerChoice, SavedRun, SceneRef, Scope, Shard, SpecDifference, SpecError, StartError,
-    StopReason, Target, Tracing, DEFAULT_ESTIMATOR, DEFAULT_GROUPS,
+    default_groups, remaining_lines, start, Budget, CastOptions, ErrorMethod, ExtendError,
+    LinesThrough, Measures, MergeError, MissingLines, PersistError, RunControl, RunIdentity,
+    RunSpec, RunState, SamplerChoice, SavedRun, SceneRef, Scope, Shard, SpecDifference, SpecError,
+    StartError, StopReason, Target, Tracing, DEFAULT_ESTIMATOR, DEFAULT_GROUPS,
+    DEFAULT_SOBOL_GROUPS,
 };
 pub use sample::bounds::{
     lines_to_draw, sphere_lines, sphere_lines_for_drawn, sphere_lines_of_drawn, LineBound,

@@ -155,7 +155,7 @@ def analyze(
     target_measure: str = "mutual_information_corrected",
     seconds: Optional[float] = None,
     enclose: bool = False,
-    groups: int = 16,
+    groups: Optional[int] = None,
     estimator: str = "chao-wang-jost",
     errors: str = "groups",
     bundle: int = 0,
@@ -189,7 +189,8 @@ def analyze(
             ``target`` is true).
         seconds: stop after this many seconds.
         enclose: close an open scene with a virtual absorbing sphere (``scx analyze --enclose``).
-        groups: independent groups behind each standard error (2 to 1024).
+        groups: independent groups behind each standard error (2 to 1024); default 16, or 8 for
+            ``sobol`` lines (each group one randomised sequence, tighter when longer).
         estimator: the bias-corrected entropies' estimator: ``plug-in``, ``miller-madow``,
             ``grassberger``, ``chao-shen``, ``chao-wang-jost``.
         errors: standard errors of the count-based measures: ``"groups"`` (batch means) or

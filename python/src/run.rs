@@ -378,10 +378,6 @@ pub fn analyze(
         },
         enclose,
         per_patch,
-        groups: match given(groups) {
-            Some(g) => args::groups(&g)?,
-            None => scene_complexity::DEFAULT_GROUPS,
-        },
         estimator: args::estimator(estimator)?,
         errors: args::errors(errors)?,
         bound: match through {
@@ -391,7 +387,8 @@ pub fn analyze(
         },
         ..RunSpec::new(lines, seed)
     }
-    .drawn_by(args::sampler(sampler)?);
+    .drawn_by(args::sampler(sampler)?)
+    .grouped(given(groups).map(|g| args::groups(&g)).transpose()?);
     spec.check().map_err(bad_argument)?;
     let (state, identity, spec) = {
         let s = scene.get();

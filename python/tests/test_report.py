@@ -198,9 +198,18 @@ def test_the_default_sampler_draws_sobol_lines_for_i_s_c_alone():
         "analyze", "@cube:4", "--lines", "2e5", "--seed", "3", "--tracer", "rust", "--measures", "continuous"
     )
     assert without_process(alone) == without_process(cli)
+    # Sobol' runs take 8 groups unless told otherwise, as the command line's; independent ones 16.
+    assert alone["groups"] == 8
+    sixteen = scx.analyze("@cube:4", lines=2e5, seed=3, threads=1, measures=["continuous"], groups=16)
+    cli16 = run_cli(
+        "analyze", "@cube:4", "--lines", "2e5", "--seed", "3", "--tracer", "rust", "--measures", "continuous",
+        "--groups", "16",
+    )
+    assert sixteen.to_dict()["groups"] == 16
+    assert without_process(sixteen.to_dict()) == without_process(cli16)
     for kwargs in ({}, {"measures": ["continuous"], "sampler": "independent"}):
         d = scx.analyze("@cube:4", lines=2e5, seed=3, threads=1, **kwargs).to_dict()
-        assert (d["sampler"], d["lines_through"]) == ("independent", "box")
+        assert (d["sampler"], d["lines_through"], d["groups"]) == ("independent", "box", 16)
 
 
 def test_an_enclosed_run_has_the_environment_as_its_last_patch(tmp_path):

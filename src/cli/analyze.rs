@@ -251,7 +251,8 @@ fn spec_of(args: &AnalyzeArgs) -> Result<RunSpec, Failure> {
         per_patch: args.files.wants_per_patch(),
         ..args.run.spec(lines, args.run.seed.value)
     }
-    .drawn_by(args.sampler))
+    .drawn_by(args.sampler)
+    .grouped(args.run.groups_asked()))
 }
 
 /// A run about to be cast: its runner, identity (with its spec) and state, and the seconds it took

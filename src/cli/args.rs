@@ -5,9 +5,7 @@ use std::path::PathBuf;
 
 use clap::ValueEnum;
 use scene_complexity::{Backend, EntropyEstimator, Measure, Query};
-use scene_complexity::{
-    ErrorMethod, Measures, RunSpec, Tracing, DEFAULT_ESTIMATOR, DEFAULT_GROUPS,
-};
+use scene_complexity::{ErrorMethod, Measures, RunSpec, Tracing, DEFAULT_ESTIMATOR};
 use scene_complexity::{ObjectSet, Planarity, Reach, ReadPolicy, SceneOptions, DEFAULT_PLANARITY};
 
 /// How a scene file is read: non-planar polygons, and objects to flip or make two-sided.
@@ -133,10 +131,10 @@ pub struct RunOptions {
     /// Ray query: `single`, or `packet4`/`packet8`/`packet16` (Embree, native widths only).
     #[arg(long, default_value = "single", value_parser = parse_query)]
     pub query: Query,
-    /// Independent groups of lines behind each standard error (2 to 1024).
-    #[arg(long, default_value_t = DEFAULT_GROUPS as u16, value_parser = parse_groups,
-          allow_negative_numbers = true)]
-    pub groups: u16,
+    /// Independent groups of lines behind each standard error, 2 to 1024 [default: 16, or 8 for sobol
+    /// lines, whose groups are each one randomised sequence and tighter when longer].
+    #[arg(long, value_parser = parse_groups, allow_negative_numbers = true)]
+    pub groups: Option<u16>,
     /// Estimator of the bias-corrected H_s and I_s: plug-in, miller-madow, grassberger, chao-shen,
     /// chao-wang-jost.
     #[arg(long, default_value = DEFAULT_ESTIMATOR.name(), value_parser = parse_estimator)]
@@ -155,11 +153,16 @@ impl RunOptions {
     pub fn spec(&self, lines: u64, seed: u64) -> RunSpec {
         RunSpec {
             measures: Measures::VISIBILITY,
-            groups: usize::from(self.groups),
             estimator: self.estimator,
             errors: self.errors,
             ..RunSpec::new(lines, seed)
         }
+        .grouped(self.groups_asked())
+    }
+
+    /// The standard-error groups asked for, if any (else the sampler's default, [`RunSpec::grouped`]).
+    pub fn groups_asked(&self) -> Option<usize> {
+        self.groups.map(usize::from)
     }
 
     /// The tracer these options ask for.

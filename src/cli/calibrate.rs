@@ -8,7 +8,7 @@ use scene_complexity::calibrate::{
     self, check_computable, report, suite, CalibrationScene, Cell, CellMeasures, CellReport,
     CellTarget, SuiteLevel,
 };
-use scene_complexity::{LinesThrough, Measure, Sampler, DEFAULT_GROUPS};
+use scene_complexity::{default_groups, LinesThrough, Measure, Sampler};
 
 use super::args::{
     check_target_measure, parse_count, parse_groups, parse_positive, parse_seed, parse_whole_in,
@@ -66,9 +66,9 @@ pub struct CalibrateArgs {
     lines_through: LinesThrough,
     /// Independent groups of lines behind each run's standard errors, for every cell (2 to 1024; `scx
     /// analyze --groups`): the table's `runs` column names the degrees of freedom of any other count
-    /// than the default's.
-    #[arg(long, default_value_t = DEFAULT_GROUPS as u16, value_parser = parse_groups)]
-    groups: u16,
+    /// than the default's [default: 16, or 8 with --sampler sobol].
+    #[arg(long, value_parser = parse_groups)]
+    groups: Option<u16>,
     /// Print the cells and exit.
     #[arg(long)]
     list: bool,
@@ -116,6 +116,13 @@ fn parse_bound(s: &str) -> Result<LinesThrough, String> {
         .ok_or_else(|| format!("`{s}`: expected auto, sphere, box or polytope"))
 }
 
+/// The standard-error groups of every cell's runs: those asked for, or the sampler's default (as `scx
+/// analyze` chooses them).
+fn groups_of(args: &CalibrateArgs) -> usize {
+    args.groups
+        .map_or(default_groups(args.sampler), usize::from)
+}
+
 /// The cells the arguments ask for.
 fn cells(args: &CalibrateArgs) -> Vec<Cell> {
     if args.scene.is_empty() {
@@ -124,7 +131,7 @@ fn cells(args: &CalibrateArgs) -> Vec<Cell> {
             .map(|c| {
                 c.with_sampler(args.sampler)
                     .with_bound(args.lines_through)
-                    .with_groups(usize::from(args.groups))
+                    .with_groups(groups_of(args))
             })
             .collect();
     }
@@ -144,7 +151,7 @@ fn cells(args: &CalibrateArgs) -> Vec<Cell> {
                 target,
                 sampler: args.sampler,
                 through: args.lines_through,
-                groups: usize::from(args.groups),
+                groups: groups_of(args),
             })
         })
         .collect()

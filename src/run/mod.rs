@@ -36,7 +36,7 @@ pub use errors::{ErrorMethod, Spread};
 pub use persist::{PersistError, RunIdentity, SavedRun, SceneRef, Tracing};
 pub use plan::{BatchPlan, BatchSet};
 pub use spec::{
-    ExtendError, LinesThrough, Measures, RunSpec, SamplerChoice, SpecDifference, SpecError,
-    DEFAULT_ESTIMATOR, DEFAULT_GROUPS,
+    default_groups, ExtendError, LinesThrough, Measures, RunSpec, SamplerChoice, SpecDifference,
+    SpecError, DEFAULT_ESTIMATOR, DEFAULT_GROUPS, DEFAULT_SOBOL_GROUPS,
 };
 pub use state::{FinishedRun, MergeError, MissingLines, RunState, StateParts, TracedBatches};

@@ -21,8 +21,22 @@ use crate::sample::bounds::{
 use crate::sample::lines::{LineSource, Sampler};
 use crate::scene::Scene;
 
-/// Default number of independent groups of lines behind every standard error.
+/// Default number of independent groups of lines behind every standard error of a run of independent
+/// lines.
 pub const DEFAULT_GROUPS: usize = 16;
+
+/// Default number of standard-error groups of a run of randomised quasi-Monte Carlo lines: each group is
+/// one scrambled Sobol' sequence, which converges faster than independent draws, so fewer and longer
+/// sequences give a tighter estimate (docs/sampling.md, "The number of groups").
+pub const DEFAULT_SOBOL_GROUPS: usize = 8;
+
+/// The standard-error groups of a run drawn by `sampler` when none are asked for.
+pub fn default_groups(sampler: Sampler) -> usize {
+    match sampler {
+        Sampler::Independent => DEFAULT_GROUPS,
+        Sampler::Sobol => DEFAULT_SOBOL_GROUPS,
+    }
+}
 
 /// The entropy estimator behind the bias-corrected H_s and I_s, chosen by measurement against the exact
 /// I_s of `@cube:N` (docs/results.md, "The default estimator").
@@ -239,6 +253,15 @@ impl RunSpec {
             SamplerChoice::Given(s) => s,
         };
         RunSpec { sampler, ..self }
+    }
+
+    /// This spec with the standard-error groups asked for, or its sampler's default ones
+    /// ([`default_groups`]) when none are; settled after its sampler ([`RunSpec::drawn_by`]).
+    pub fn grouped(self, asked: Option<usize>) -> RunSpec {
+        RunSpec {
+            groups: asked.unwrap_or(default_groups(self.sampler)),
+            ..self
+        }
     }
 
     /// The bound `--lines-through auto` chooses for `scene`: for the Sobol' sampler, the tightest

@@ -345,8 +345,8 @@ fn auto_draws_sobol_lines_only_for_runs_that_count_no_pairs() {
 /// The CLI's default sampler: `--measures continuous` runs Sobol' lines (through the box on a cube, the
 /// bound `auto` chooses for them), the report says so, and its I_s^c is the one of `--sampler sobol`
 /// with every measure, bit for bit (the measures asked for do not change the lines), within 4.5
-/// standard errors of the exact value; the default measures, `--patches` and `--bundle` keep independent
-/// lines, and `--sampler independent` gives them back for I_s^c alone.
+/// standard errors of the exact value, from 8 groups unless told otherwise; the default measures, `--patches` and `--bundle` keep independent
+/// lines (and 16 groups), and `--sampler independent` gives them back for I_s^c alone.
 #[test]
 fn the_cli_draws_sobol_lines_by_default_for_i_s_c_alone() {
     use scene_complexity::calibrate::{truth, Basis, CalibrationScene};
@@ -368,6 +368,18 @@ fn the_cli_draws_sobol_lines_by_default_for_i_s_c_alone() {
     );
     let all_sobol = run(&["--sampler", "sobol"]);
     assert_eq!(isc(&alone), isc(&all_sobol));
+    // Sobol' runs default to 8 groups (`DEFAULT_SOBOL_GROUPS`), `--groups` overrides it, and the
+    // groups asked for are the ones run: 16 of them give other numbers.
+    let sixteen = run(&["--measures", "continuous", "--groups", "16"]);
+    assert_eq!(
+        (&alone["groups"], &all_sobol["groups"], &sixteen["groups"]),
+        (&8.into(), &8.into(), &16.into())
+    );
+    assert_eq!(
+        isc(&alone),
+        isc(&run(&["--measures", "continuous", "--groups", "8"]))
+    );
+    assert_ne!(isc(&alone)["value"], isc(&sixteen)["value"]);
     let exact = truth::truth(&CalibrationScene::parse("@cube:6").unwrap())
         .unwrap()
         .value(Measure::ContinuousMutualInformation, Basis::Closed)
@@ -400,8 +412,8 @@ fn the_cli_draws_sobol_lines_by_default_for_i_s_c_alone() {
             "box"
         };
         assert_eq!(
-            (&v["sampler"], &v["lines_through"]),
-            (&"independent".into(), &bound.into()),
+            (&v["sampler"], &v["lines_through"], &v["groups"]),
+            (&"independent".into(), &bound.into(), &16.into()),
             "{more:?}"
         );
     }
