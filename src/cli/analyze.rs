@@ -61,8 +61,8 @@ pub struct AnalyzeArgs {
     #[arg(long, default_value_t = 0, value_parser = parse_bundle)]
     bundle: u32,
     /// How the lines are drawn: `independent` (each line on its own), `sobol` (randomised quasi-Monte
-    /// Carlo: one Owen-scrambled Sobol' sequence per standard-error group, lines that cover the space
-    /// of lines more evenly; not with --bundle), or `auto`: `sobol` for a run that counts no patch
+    /// Carlo: one Owen-scrambled Sobol' sequence per standard-error group, 8 groups unless --groups
+    /// says otherwise, lines that cover the space of lines more evenly; not with --bundle), or `auto`: `sobol` for a run that counts no patch
     /// pairs (`--measures continuous` without --patches: I_s^c alone, several times tighter at the same
     /// cost), `independent` otherwise (the bias-corrected readings need independent lines to be honest
     /// without a looser debiasing). The report says which. docs/sampling.md says for which measures
