@@ -124,8 +124,8 @@ pub fn segments_and_ends(
     hits: &[Hit],
     visit: impl FnMut(Segment),
 ) -> LineEnds {
-    let patch_plane = |triangle: u32| {
-        let patch = scene.triangle_patch[triangle as usize];
+    let patch_plane = |_: usize, h: &Hit| {
+        let patch = scene.triangle_patch[h.triangle as usize];
         let p = &scene.patches[patch as usize];
         (patch, (p.normal, p.offset))
     };
@@ -209,28 +209,72 @@ impl PatchPlanes {
         hits: &[Hit],
         visit: impl FnMut(Segment),
     ) -> LineEnds {
-        let as_plane = |[x, y, z, offset]: [f64; 4]| (DVec3::new(x, y, z), offset);
-        let (planes, by_triangle) = (&self.planes, &self.by_triangle);
-        if by_triangle.is_empty() {
-            let patch_plane = |triangle: u32| {
-                let patch = scene.triangle_patch[triangle as usize];
+        let planes = &self.planes;
+        if self.by_triangle.is_empty() {
+            let patch_plane = |_: usize, h: &Hit| {
+                let patch = scene.triangle_patch[h.triangle as usize];
                 (patch, as_plane(planes[patch as usize]))
             };
             ends_of(scene, patch_plane, line, hits, visit)
         } else {
-            let patch_plane = |triangle: u32| {
-                let [patch, plane] = by_triangle[triangle as usize];
+            let by_triangle = &self.by_triangle;
+            let patch_plane = |_: usize, h: &Hit| {
+                let [patch, plane] = by_triangle[h.triangle as usize];
                 (patch, as_plane(planes[plane as usize]))
             };
             ends_of(scene, patch_plane, line, hits, visit)
         }
     }
+
+    /// Each hit's triangle record (its patch and plane index), read for a whole batch of hits in one
+    /// pass into `out` (emptied first), when patches share planes and the records outgrow half a
+    /// core's second-level cache (`GATHERED_BYTES`); left empty otherwise. The reads are independent, so
+    /// their cache misses overlap, where read one crossing at a time, between the pairing's arithmetic,
+    /// each waits alone; [`PatchPlanes::segments_and_ends_of_records`] then reads them in order. A
+    /// smaller table is read from the cache at each crossing for less than the extra pass costs.
+    pub fn records_of(&self, hits: &[Hit], out: &mut Vec<[u32; 2]>) {
+        out.clear();
+        if std::mem::size_of_val(self.by_triangle.as_slice()) > Self::GATHERED_BYTES {
+            out.extend(hits.iter().map(|h| self.by_triangle[h.triangle as usize]));
+        }
+    }
+
+    /// Half the second-level data cache of one core of current x86 cores (512 KiB and more).
+    const GATHERED_BYTES: usize = 256 << 10;
+
+    /// [`PatchPlanes::segments_and_ends`] with the line's triangle records already read
+    /// ([`PatchPlanes::records_of`], `records[i]` that of `hits[i]`; empty when it read none): the
+    /// same segments, to the bit.
+    pub fn segments_and_ends_of_records(
+        &self,
+        scene: &Scene,
+        line: &Line,
+        hits: &[Hit],
+        records: &[[u32; 2]],
+        visit: impl FnMut(Segment),
+    ) -> LineEnds {
+        if records.is_empty() {
+            return self.segments_and_ends(scene, line, hits, visit);
+        }
+        let planes = &self.planes;
+        let records = &records[..hits.len()];
+        let patch_plane = |i: usize, _: &Hit| {
+            let [patch, plane] = records[i];
+            (patch, as_plane(planes[plane as usize]))
+        };
+        ends_of(scene, patch_plane, line, hits, visit)
+    }
 }
 
-/// [`segments_and_ends`], with each triangle's patch and that patch's plane from `patch_plane`.
+/// A plane as the table keeps it, `[x, y, z, offset]`, as a normal and an offset.
+fn as_plane([x, y, z, offset]: [f64; 4]) -> (Normal, f64) {
+    (DVec3::new(x, y, z), offset)
+}
+
+/// [`segments_and_ends`], with the patch of hit `i` and that patch's plane from `patch_plane(i, hit)`.
 fn ends_of(
     scene: &Scene,
-    patch_plane: impl Fn(u32) -> (u32, (Normal, f64)),
+    patch_plane: impl Fn(usize, &Hit) -> (u32, (Normal, f64)),
     line: &Line,
     hits: &[Hit],
     mut visit: impl FnMut(Segment),
@@ -239,14 +283,14 @@ fn ends_of(
         return LineEnds::default();
     }
     let l = LineF64::from(line);
-    let crossing = |h: &Hit| {
-        let (patch, plane) = patch_plane(h.triangle);
+    let crossing = |(i, h): (usize, &Hit)| {
+        let (patch, plane) = patch_plane(i, h);
         crossing(patch, plane, &l, h)
     };
     if !order::has_close_hits(hits) {
-        return pair_crossings(hits.iter().map(crossing), &mut visit);
+        return pair_crossings(hits.iter().enumerate().map(crossing), &mut visit);
     }
-    let mut crossings: Vec<Crossing> = hits.iter().map(crossing).collect();
+    let mut crossings: Vec<Crossing> = hits.iter().enumerate().map(crossing).collect();
     let overlaps = order::reorder(&mut crossings, hits, |c| on_its_triangle(scene, &l, c));
     LineEnds {
         overlaps,

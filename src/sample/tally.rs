@@ -643,8 +643,15 @@ fn tally_batch(prepared: &LineTally, lines: &[Line], hits: &LineHits) -> BatchTa
     let (miss_cos, miss_chord) = environment::miss(scene.bounding_radius());
     let c = &mut t.counters;
     let exchange = wanted.continuous && prepared.last_cosine == LastCosine::FirstEntry;
+    let mut records = Vec::new();
+    prepared.planes.records_of(&hits.hits, &mut records);
     for (k, line) in lines.iter().enumerate() {
         let line_hits = hits.of_line(k);
+        let line_records = if records.is_empty() {
+            &[][..]
+        } else {
+            &records[hits.start[k] as usize..hits.start[k + 1] as usize]
+        };
         if line_hits.is_empty() {
             c.misses += 1;
             env_sum.add(miss_cos, miss_chord);
@@ -656,9 +663,12 @@ fn tally_batch(prepared: &LineTally, lines: &[Line], hits: &LineHits) -> BatchTa
         let sides = &mut t.sides;
         let pair_terms = &mut t.pair_terms;
         let escape_terms = &mut t.escape_terms;
-        let ends = prepared
-            .planes
-            .segments_and_ends(scene, line, line_hits, |s| match s {
+        let ends = prepared.planes.segments_and_ends_of_records(
+            scene,
+            line,
+            line_hits,
+            line_records,
+            |s| match s {
                 Segment::Pair {
                     from,
                     to,
@@ -710,7 +720,8 @@ fn tally_batch(prepared: &LineTally, lines: &[Line], hits: &LineHits) -> BatchTa
                     sides.count(objects.object(patch), 3);
                 }
                 Segment::Unpaired => c.unpaired += 1,
-            });
+            },
+        );
         if let (Some(held), Some(first)) = (last, first) {
             c.degenerate_pairs += u64::from(!add_last_pair(&mut log2_sum, held, first));
         }

@@ -215,8 +215,9 @@ fn hits_per_patch_follow_crofton() {
 }
 
 /// Pairing from the run's plane table ([`PatchPlanes`], shared planes behind an index on a large mesh of
-/// walls, one plane per patch on a curved mesh) gives the segments of pairing from the patch records
-/// themselves, to the bit, line by line.
+/// walls, one plane per patch on a curved mesh), and from the triangle records of a batch's hits read
+/// beforehand (as the tally reads them on a large mesh), gives the segments of pairing from the patch
+/// records themselves, to the bit, line by line.
 #[test]
 fn the_plane_table_pairs_every_line_as_the_patch_records_do() {
     use scene_complexity::internals::sample::pairs::{segments_and_ends, PatchPlanes};
@@ -230,14 +231,36 @@ fn the_plane_table_pairs_every_line_as_the_patch_records_do() {
         let mut lines = Vec::new();
         batch_lines(11, 0, 20_000, scene.bounding_radius(), &mut lines);
         let hits = trace(tracer.as_ref(), &lines);
+        // The fine cube's 43,200 triangle records (345 KB) are read for the batch beforehand.
+        let mut records = Vec::new();
+        planes.records_of(&hits.hits, &mut records);
+        assert_eq!(
+            records.len(),
+            if name == "@cube:60" {
+                hits.hits.len()
+            } else {
+                0
+            }
+        );
         let mut pairs = 0;
         for (k, line) in lines.iter().enumerate() {
-            let (mut direct, mut tabled) = (Vec::new(), Vec::new());
+            let (mut direct, mut tabled, mut gathered) = (Vec::new(), Vec::new(), Vec::new());
             let ends = segments_and_ends(&scene, line, hits.of_line(k), |s| direct.push(s));
             let ends_tabled =
                 planes.segments_and_ends(&scene, line, hits.of_line(k), |s| tabled.push(s));
+            let of_line = if records.is_empty() {
+                &[][..]
+            } else {
+                &records[hits.start[k] as usize..hits.start[k + 1] as usize]
+            };
+            let ends_gathered =
+                planes.segments_and_ends_of_records(&scene, line, hits.of_line(k), of_line, |s| {
+                    gathered.push(s)
+                });
             assert_eq!(direct, tabled, "{name}, line {k}");
+            assert_eq!(direct, gathered, "{name}, line {k}");
             assert_eq!(ends, ends_tabled, "{name}, line {k}");
+            assert_eq!(ends, ends_gathered, "{name}, line {k}");
             pairs += direct
                 .iter()
                 .filter(|s| matches!(s, Segment::Pair { .. }))
