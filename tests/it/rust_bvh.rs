@@ -314,3 +314,36 @@ fn grazing_crossings_of_slivers_match_the_brute_force_tracer_and_first_hits() {
         "{crossing_several} lines cross 3 slivers or more"
     );
 }
+
+/// `all_hits` finds the grid cells of a chunk of lines, and reads their packets, before it tests any of
+/// them: on meshes of walls in grids (`@cube:60`, the turned meshed room) its rows are those of the
+/// line-by-line raw hits canonicalised, to the bit, over batches that end inside a chunk; and a line that
+/// cannot be traced in a later chunk is named by its index in the batch, with nothing returned.
+#[test]
+fn chunked_grid_lookups_give_the_line_by_line_hits() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("turned.obj");
+    std::fs::write(&path, turned_meshed_room(12, 0.2, true, 1.0)).unwrap();
+    let room = scenes::load(path.to_str().unwrap()).unwrap();
+    for scene in [scenes::load("@cube:60").unwrap(), room] {
+        let bvh = BvhTracer::new(&scene).unwrap();
+        assert!(bvh.planes_in_grids() > 0, "{}", scene.name);
+        let lines = test_lines(&scene, 5);
+        for count in [1, 31, 33, 100, lines.len()] {
+            let got = trace(&bvh, &lines[..count]);
+            let mut raw = Vec::new();
+            bvh.raw_hits(&lines[..count], &mut raw).unwrap();
+            let mut expected = LineHits::default();
+            expected.fill_from_raw(count, &raw);
+            bvh.rules().canonicalize(&lines[..count], &mut expected);
+            assert_eq!(got.start, expected.start, "{} {count}", scene.name);
+            assert_eq!(got.hits, expected.hits, "{} {count}", scene.name);
+        }
+        let mut bad = lines[..100].to_vec();
+        bad[70].t_max = -1.0;
+        let (mut raw, mut hits) = (Vec::new(), LineHits::default());
+        let err = bvh.all_hits(&bad, &mut raw, &mut hits).unwrap_err();
+        assert!(err.to_string().contains("line 70 "), "{err}");
+        assert!(hits.hits.is_empty() && hits.start.is_empty());
+    }
+}

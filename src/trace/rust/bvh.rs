@@ -403,11 +403,25 @@ impl BvhTracer {
         leaves: &mut Vec<(u32, u32)>,
         mut visit: impl FnMut(f32, u32),
     ) {
-        leaves.clear();
         let ray = BoxRay::new(line);
         let sheared = ShearedRay::new(line.origin, line.dir);
         self.grid_hits(line, &ray, &sheared, line.t_max, &mut visit);
-        self.traverse(line, &ray, stack, |first, count| {
+        self.leaf_hits(line, &ray, &sheared, stack, leaves, visit);
+    }
+
+    /// Calls `visit(t, triangle)` for every hit of the line in the tree's triangles (those of no grid).
+    #[inline(always)]
+    fn leaf_hits(
+        &self,
+        line: &Line,
+        ray: &BoxRay,
+        sheared: &ShearedRay,
+        stack: &mut Vec<u32>,
+        leaves: &mut Vec<(u32, u32)>,
+        mut visit: impl FnMut(f32, u32),
+    ) {
+        leaves.clear();
+        self.traverse(line, ray, stack, |first, count| {
             leaves.push((first as u32, count as u32));
             line.t_max
         });
@@ -419,6 +433,39 @@ impl BvhTracer {
                 }
             }
         }
+    }
+
+    /// The grids' runs of packets that each line of `chunk` may cross, `(line in chunk, first, end)` in
+    /// the order of the lines, into `runs` (emptied first), and the first bytes of each run's packets
+    /// and ids read: on a large mesh those are cache misses, and read here, for a chunk of lines in one
+    /// tight pass of independent loads, they overlap, where a line's tests would wait for each in turn.
+    /// The lines' hits are the same whichever order their runs are tested in (a row is sorted).
+    fn chunk_grid_runs(&self, chunk: &[Line], runs: &mut Vec<(u32, u32, u32)>) {
+        runs.clear();
+        if self.grids.is_empty() {
+            return;
+        }
+        for (i, line) in chunk.iter().enumerate() {
+            let ray = BoxRay::new(line);
+            let origin = DVec3::from_array(line.origin.map(f64::from));
+            let dir = DVec3::from_array(line.dir.map(f64::from));
+            for (four, boxes) in self.grids.boxes.iter().enumerate() {
+                let mut mask = ray.crossed(boxes, Vec4::splat(line.t_max));
+                while mask != 0 {
+                    let k = mask.trailing_zeros() as usize;
+                    mask &= mask - 1;
+                    let grid = &self.grids.grids[4 * four + k];
+                    grid.candidates(origin, dir, f64::from(line.t_max), |first, end| {
+                        runs.push((i as u32, first as u32, end as u32));
+                    });
+                }
+            }
+        }
+        let warm = runs.iter().fold(0u32, |warm, &(_, first, _)| {
+            let first = first as usize;
+            warm ^ self.grids.packets[first].first_bits() ^ self.grids.ids[first][0]
+        });
+        std::hint::black_box(warm);
     }
 
     /// The nearest hit of one line: the least `t`, ties to the lower triangle index (the first hit of the
@@ -514,6 +561,10 @@ impl BvhTracer {
         }
     }
 }
+
+/// Lines whose grid runs are found, and their packets' first bytes read, before any of them is tested
+/// ([`BvhTracer::chunk_grid_runs`]).
+const RUN_CHUNK: usize = 32;
 
 /// Triangles per leaf, at most (obvhs's CWBVH allows 1 to 3).
 const LEAF_PRIMITIVES: u32 = 3;
@@ -614,21 +665,44 @@ impl Tracer for BvhTracer {
         out.start.clear();
         out.start.push(0);
         let (mut stack, mut leaves, mut kept) = (Vec::new(), Vec::new(), Vec::new());
-        for (k, line) in lines.iter().enumerate() {
-            if !traceable(line) {
+        let mut runs = Vec::new();
+        for (c, chunk) in lines.chunks(RUN_CHUNK).enumerate() {
+            if let Some(i) = chunk.iter().position(|line| !traceable(line)) {
                 out.hits.clear();
                 out.start.clear();
-                return Err(bad_line(k, line));
+                let k = c * RUN_CHUNK + i;
+                return Err(bad_line(k, &lines[k]));
             }
-            let from = out.hits.len();
-            self.line_hits(line, &mut stack, &mut leaves, |t, triangle| {
-                out.hits.push(Hit { t, triangle })
-            });
-            let kept_hits = self
-                .rules
-                .canonicalize_row(line, &mut out.hits[from..], &mut kept);
-            out.hits.truncate(from + kept_hits);
-            out.start.push(out.hits.len() as u32);
+            self.chunk_grid_runs(chunk, &mut runs);
+            let mut next_run = 0;
+            for (i, line) in chunk.iter().enumerate() {
+                let from = out.hits.len();
+                let mut visit = |t, triangle| out.hits.push(Hit { t, triangle });
+                let sheared = ShearedRay::new(line.origin, line.dir);
+                while let Some(&(_, first, end)) = runs.get(next_run).filter(|r| r.0 == i as u32) {
+                    self.test_packets(
+                        &sheared,
+                        first as usize,
+                        end as usize,
+                        line.t_max,
+                        &mut visit,
+                    );
+                    next_run += 1;
+                }
+                self.leaf_hits(
+                    line,
+                    &BoxRay::new(line),
+                    &sheared,
+                    &mut stack,
+                    &mut leaves,
+                    visit,
+                );
+                let kept_hits = self
+                    .rules
+                    .canonicalize_row(line, &mut out.hits[from..], &mut kept);
+                out.hits.truncate(from + kept_hits);
+                out.start.push(out.hits.len() as u32);
+            }
         }
         Ok(())
     }
