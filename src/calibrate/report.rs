@@ -60,8 +60,8 @@ pub fn markdown_header() -> String {
         "Each row: the runs of one cell (scene, lines, seeds 1..=n) against one exact value. `cover`: \
          share of readings whose stated 95% interval, value ± t se, holds the exact value, with t \
          Student's 97.5% quantile for the run's groups with lines less one ({:.3} for the default {GROUPS} \
-         groups, {dof} degrees of freedom; `runs` names other degrees of freedom when a run had fewer \
-         groups); `cover 1.96`: the same with the normal {:.2}; `ok`: share of readings marked ok; \
+         groups of independent lines, {dof} degrees of freedom; `runs` names the degrees of freedom of \
+         runs with other group counts: sobol's 8, --groups, or too few lines); `cover 1.96`: the same with the normal {:.2}; `ok`: share of readings marked ok; \
          `cover if ok`: share of the ok readings that cover; `z`: (value - exact) / se, its mean and \
          standard deviation (near 1 when the standard errors are right: {:.2} for t with {dof} degrees of \
          freedom; below 1 when too wide); `met`: runs declaring their precision target met, and the share \
