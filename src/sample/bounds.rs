@@ -23,11 +23,15 @@
 //! low-discrepancy sequence integrates far better than the curved regions of the sphere's
 //! parametrisation (docs/sampling.md).
 
-use super::lines::{batch_units, concentric_discs, lines_with_discs};
+use super::lines::{batch_units, concentric_discs};
 use super::polytope::{share_of_area_on_faces, BoundingPolytope, CONTAINER_MARGIN};
 use super::sobol::ScrambledSobol;
 use crate::scene::Scene;
 use crate::trace::Line;
+
+/// Lines a box makes at a time ([`BoundingBox::lines`]): enough for each stage's operations to overlap,
+/// few enough that the chunk's lanes stay in L1.
+const CHUNK: usize = 16;
 
 /// How far the box reaches beyond the scene on every side, in bounding radii ([`CONTAINER_MARGIN`]): a
 /// flat scene still gets a box with six faces of positive area. The traced segments start further
@@ -196,10 +200,73 @@ impl BoundingBox {
         self.line_with_disc(u[0], u[1], (dx[0], dy[0]))
     }
 
-    /// The lines of `units`, [`BoundingBox::line`] of each, the disc points made 16 at a time (their
-    /// polynomial chains overlap), appended to `out`.
+    /// The lines of `units`, [`BoundingBox::line`] of each bit for bit, appended to `out`: made
+    /// [`CHUNK`] at a time, stage by stage across the chunk (disc points, faces, entries, directions,
+    /// exits), so that each stage's divisions, square roots and polynomial chains run side by side
+    /// rather than one line's waiting on the last.
     pub fn lines(&self, units: &[[f64; 4]], out: &mut Vec<Line>) {
-        lines_with_discs(units, out, |u0, u1, disc| self.line_with_disc(u0, u1, disc));
+        out.reserve(units.len());
+        for chunk in units.chunks(CHUNK) {
+            self.chunk_lines(chunk, out);
+        }
+    }
+
+    /// [`BoundingBox::lines`] of at most [`CHUNK`] points: the arithmetic of
+    /// [`BoundingBox::line_with_disc`], operation for operation, on every lane (lanes past the
+    /// chunk's end compute from zeros and are not kept).
+    #[inline(never)]
+    fn chunk_lines(&self, chunk: &[[f64; 4]], out: &mut Vec<Line>) {
+        const N: usize = CHUNK;
+        let mut u: [[f64; N]; 4] = [[0.0; N]; 4];
+        for (i, p) in chunk.iter().enumerate() {
+            for d in 0..4 {
+                u[d][i] = p[d];
+            }
+        }
+        let (dx, dy) = concentric_discs(&u[2].map(|x| 2.0 * x - 1.0), &u[3].map(|x| 2.0 * x - 1.0));
+        let area = self.surface_area();
+        let at = u[0].map(|x| x * area);
+        let mut face = [0usize; N];
+        for i in 0..N {
+            face[i] = self.cumulative[..5].iter().filter(|&&c| c <= at[i]).count();
+        }
+        let mut s = [0.0; N];
+        for i in 0..N {
+            let f = &self.faces[face[i]];
+            s[i] = ((at[i] - f.start) / f.area).clamp(0.0, 1.0);
+        }
+        let mut dz = [0.0; N];
+        for i in 0..N {
+            dz[i] = (1.0 - dx[i] * dx[i] - dy[i] * dy[i]).max(0.0).sqrt();
+        }
+        let (mut origin, mut dir) = ([[0.0; N]; 3], [[0.0; N]; 3]);
+        for i in 0..N {
+            let f = &self.faces[face[i]];
+            for k in 0..3 {
+                origin[k][i] = f.corner[k] + s[i] * f.side_b[k] + u[1][i] * f.side_c[k];
+                dir[k][i] = dz[i] * f.inward[k] + dx[i] * f.unit_b[k] + dy[i] * f.unit_c[k];
+            }
+        }
+        let mut exit = [f64::INFINITY; N];
+        for k in 0..3 {
+            for i in 0..N {
+                let end = if dir[k][i] > 0.0 {
+                    self.hi[k]
+                } else {
+                    self.lo[k]
+                };
+                let t = (end - origin[k][i]) / dir[k][i];
+                exit[i] = exit[i].min(if t >= 0.0 { t } else { f64::INFINITY });
+            }
+        }
+        let back = self.lead;
+        for i in 0..chunk.len() {
+            out.push(Line {
+                origin: std::array::from_fn(|k| (origin[k][i] - back * dir[k][i]) as f32),
+                dir: std::array::from_fn(|k| dir[k][i] as f32),
+                t_max: (exit[i] + 2.0 * back) as f32,
+            });
+        }
     }
 
     /// [`BoundingBox::line`] once its direction's disc point is known.

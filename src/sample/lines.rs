@@ -332,11 +332,10 @@ pub(super) fn concentric_discs<const N: usize>(a: &[f64; N], b: &[f64; N]) -> ([
     let mut a_major = [false; N];
     for i in 0..N {
         a_major[i] = a[i].abs() > b[i].abs();
-        let (big, small) = if a_major[i] {
-            (a[i], b[i])
-        } else {
-            (b[i], a[i])
-        };
+        let (big, small) = (
+            select(a_major[i], a[i], b[i]),
+            select(a_major[i], b[i], a[i]),
+        );
         major[i] = big;
         x[i] = FRAC_PI_4 * (small / big);
     }
@@ -344,17 +343,24 @@ pub(super) fn concentric_discs<const N: usize>(a: &[f64; N], b: &[f64; N]) -> ([
     let (mut px, mut py) = ([0.0; N], [0.0; N]);
     for i in 0..N {
         // For |b| >= |a| the angle is pi/2 - x: its cosine is sin x, its sine cos x.
-        let (cos, sin) = if a_major[i] {
-            (c[i], s[i])
-        } else {
-            (s[i], c[i])
-        };
+        let (cos, sin) = (
+            select(a_major[i], c[i], s[i]),
+            select(a_major[i], s[i], c[i]),
+        );
         // The centre (0 / 0 above) maps to itself.
         let centre = a[i] == 0.0 && b[i] == 0.0;
         px[i] = if centre { 0.0 } else { major[i] * cos };
         py[i] = if centre { 0.0 } else { major[i] * sin };
     }
     (px, py)
+}
+
+/// `if take_a { a } else { b }` by masks on the bits rather than a branch: a side chosen by a random
+/// point's octant is mispredicted half the time, and the masks keep the lanes of a chunk in step.
+#[inline(always)]
+pub(super) fn select(take_a: bool, a: f64, b: f64) -> f64 {
+    let mask = (take_a as u64).wrapping_neg();
+    f64::from_bits((a.to_bits() & mask) | (b.to_bits() & !mask))
 }
 
 /// [`sin_cos_small`] of each of `x`.
