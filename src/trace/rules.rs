@@ -96,9 +96,20 @@ impl HitRules {
         match row {
             [] | [_] => return row.len(),
             [a, b] => {
-                if order(a, b).is_gt() {
-                    std::mem::swap(a, b);
-                }
+                // The two come in the order a traversal met them, at random: swapped by masks, as a
+                // branch would be mispredicted half the time.
+                let mask = u32::from(order(a, b).is_gt()).wrapping_neg();
+                let pick = |x: u32, y: u32| (x & mask) | (y & !mask);
+                let (ta, tb) = (a.t.to_bits(), b.t.to_bits());
+                let (ia, ib) = (a.triangle, b.triangle);
+                *a = Hit {
+                    t: f32::from_bits(pick(tb, ta)),
+                    triangle: pick(ib, ia),
+                };
+                *b = Hit {
+                    t: f32::from_bits(pick(ta, tb)),
+                    triangle: pick(ia, ib),
+                };
                 if b.t - a.t > tolerance(a.t) {
                     return 2;
                 }
@@ -301,5 +312,37 @@ mod tests {
         let kept_count = rules.canonicalize_row(&line, &mut row, &mut kept);
         assert_eq!(kept_count, 1);
         assert_eq!(row[0].triangle, 0, "the first by (t, triangle)");
+    }
+
+    /// A row of two hits comes out ordered by `(t, triangle)` whichever order they came in: apart, at
+    /// one distance (ordered by triangle), and close enough to be one crossing (the first kept).
+    #[test]
+    fn two_hits_are_ordered_whichever_comes_first() {
+        let rules = HitRules {
+            normals: vec![DVec3::new(0.0, 0.0, 1.0); 4],
+            vertices: vec![[0, 1, 2], [0, 2, 3], [4, 5, 6], [7, 8, 9]],
+        };
+        let line = Line {
+            origin: [0.1, 0.1, -1.0],
+            dir: [0.0, 0.0, 1.0],
+            t_max: 4.0,
+        };
+        let hit = |t: f32, triangle: u32| Hit { t, triangle };
+        let mut kept = Vec::new();
+        let cases = [
+            // Far apart: both kept, nearer first.
+            (hit(0.5, 3), hit(2.5, 2), vec![hit(0.5, 3), hit(2.5, 2)]),
+            // At one distance on unconnected triangles: both kept, the lower index first.
+            (hit(1.0, 2), hit(1.0, 3), vec![hit(1.0, 2), hit(1.0, 3)]),
+            // At one distance on two triangles sharing an edge, facing alike: one crossing.
+            (hit(1.0, 0), hit(1.0, 1), vec![hit(1.0, 0)]),
+        ];
+        for (x, y, want) in cases {
+            for row in [[x, y], [y, x]] {
+                let mut row = row;
+                let n = rules.canonicalize_row(&line, &mut row, &mut kept);
+                assert_eq!(row[..n], want[..], "{x:?} {y:?}");
+            }
+        }
     }
 }
