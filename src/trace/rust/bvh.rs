@@ -440,11 +440,19 @@ impl BvhTracer {
     /// and ids read: on a large mesh those are cache misses, and read here, for a chunk of lines in one
     /// tight pass of independent loads, they overlap, where a line's tests would wait for each in turn.
     /// The lines' hits are the same whichever order their runs are tested in (a row is sorted).
-    fn chunk_grid_runs(&self, chunk: &[Line], runs: &mut Vec<(u32, u32, u32)>) {
+    fn chunk_grid_runs(
+        &self,
+        chunk: &[Line],
+        cells: &mut Vec<(u32, u32, [u32; 2])>,
+        runs: &mut Vec<(u32, u32, u32)>,
+    ) {
         runs.clear();
+        cells.clear();
         if self.grids.is_empty() {
             return;
         }
+        // The rows of cells first, arithmetic alone; then their packet ranges, loads alone, so that the
+        // loads of the chunk's lines are in flight together.
         for (i, line) in chunk.iter().enumerate() {
             let ray = BoxRay::new(line);
             let origin = DVec3::from_array(line.origin.map(f64::from));
@@ -454,11 +462,22 @@ impl BvhTracer {
                 while mask != 0 {
                     let k = mask.trailing_zeros() as usize;
                     mask &= mask - 1;
-                    let grid = &self.grids.grids[4 * four + k];
-                    grid.candidates(origin, dir, f64::from(line.t_max), |first, end| {
-                        runs.push((i as u32, first as u32, end as u32));
-                    });
+                    let g = 4 * four + k;
+                    self.grids.grids[g].candidate_cells(
+                        origin,
+                        dir,
+                        f64::from(line.t_max),
+                        |row| {
+                            cells.push((i as u32, g as u32, row));
+                        },
+                    );
                 }
+            }
+        }
+        for &(i, g, row) in cells.iter() {
+            let (first, end) = self.grids.grids[g as usize].run_of(row);
+            if first < end {
+                runs.push((i, first as u32, end as u32));
             }
         }
         let warm = runs.iter().fold(0u32, |warm, &(_, first, _)| {
@@ -665,7 +684,7 @@ impl Tracer for BvhTracer {
         out.start.clear();
         out.start.push(0);
         let (mut stack, mut leaves, mut kept) = (Vec::new(), Vec::new(), Vec::new());
-        let mut runs = Vec::new();
+        let (mut cells, mut runs) = (Vec::new(), Vec::new());
         for (c, chunk) in lines.chunks(RUN_CHUNK).enumerate() {
             if let Some(i) = chunk.iter().position(|line| !traceable(line)) {
                 out.hits.clear();
@@ -673,7 +692,7 @@ impl Tracer for BvhTracer {
                 let k = c * RUN_CHUNK + i;
                 return Err(bad_line(k, &lines[k]));
             }
-            self.chunk_grid_runs(chunk, &mut runs);
+            self.chunk_grid_runs(chunk, &mut cells, &mut runs);
             let mut next_run = 0;
             for (i, line) in chunk.iter().enumerate() {
                 let from = out.hits.len();

@@ -320,6 +320,36 @@ impl Grid {
         t_max: f64,
         mut visit: impl FnMut(usize, usize),
     ) {
+        self.candidate_cells(origin, dir, t_max, |cells| {
+            let (first, end) = self.run_of(cells);
+            if first < end {
+                visit(first, end);
+            }
+        });
+    }
+
+    /// The run of packets `(first, end)` of a row's cells `[from, to]` ([`Grid::candidate_cells`]);
+    /// empty when the cells hold no triangle.
+    #[inline(always)]
+    pub fn run_of(&self, [from, to]: [u32; 2]) -> (usize, usize) {
+        (
+            self.packets[from as usize][0] as usize,
+            self.packets[to as usize][1] as usize,
+        )
+    }
+
+    /// [`Grid::candidates`] before the cells' packets are read: calls `visit([from, to])` with the
+    /// first and last cell (row-major indices) of every row of cells the query covers. The arithmetic
+    /// of a chunk of lines can so be done before any of their cells is read
+    /// (`BvhTracer::chunk_grid_runs`).
+    #[inline(always)]
+    pub fn candidate_cells(
+        &self,
+        origin: DVec3,
+        dir: DVec3,
+        t_max: f64,
+        mut visit: impl FnMut([u32; 2]),
+    ) {
         let along = self.normal.dot(dir);
         let height = self.normal.dot(origin) - self.offset;
         let (mut t0, mut t1) = (0.0f64, t_max);
@@ -352,11 +382,10 @@ impl Grid {
         }
         let row = self.cells[0];
         for j in range[1][0]..=range[1][1] {
-            let first = self.packets[j * row + range[0][0]][0] as usize;
-            let end = self.packets[j * row + range[0][1]][1] as usize;
-            if first < end {
-                visit(first, end);
-            }
+            visit([
+                (j * row + range[0][0]) as u32,
+                (j * row + range[0][1]) as u32,
+            ]);
         }
     }
 }
