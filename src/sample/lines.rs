@@ -85,7 +85,8 @@ pub(super) fn batch_units(seed: u64, batch: u64, count: usize, mut visit: impl F
     }
 }
 
-/// Unit points made at a time by [`batch_units`]: a whole number of [`lines_with_discs`]' chunks, few
+/// Unit points made at a time by [`batch_units`]: a whole number of the containers' chunks of 16 lines
+/// ([`super::bounds::BoundingBox::lines`], [`super::polytope::BoundingPolytope::lines`]), few
 /// enough that the draws and points stay in L1.
 const UNIT_CHUNK: usize = 64;
 
@@ -299,29 +300,6 @@ fn turns<const N: usize>(t: &[f64; N]) -> ([f64; N], [f64; N]) {
         sin[i] = f64::from_bits(second.to_bits() ^ negate_second);
     }
     (cos, sin)
-}
-
-/// The lines of the unit points `units` through a container, appended to `out`: `(u[2], u[3])` of each
-/// mapped onto the unit disc ([`concentric_discs`], 16 points at a time, whose polynomial chains
-/// overlap), and `line(u[0], u[1], disc point)` making the line (the box's and the polytope's faces).
-#[inline(always)]
-pub(super) fn lines_with_discs(
-    units: &[[f64; 4]],
-    out: &mut Vec<Line>,
-    line: impl Fn(f64, f64, (f64, f64)) -> Line,
-) {
-    const N: usize = 16;
-    for chunk in units.chunks(N) {
-        let (mut a, mut b) = ([0.0; N], [0.0; N]);
-        for (k, u) in chunk.iter().enumerate() {
-            a[k] = 2.0 * u[2] - 1.0;
-            b[k] = 2.0 * u[3] - 1.0;
-        }
-        let (dx, dy) = concentric_discs(&a, &b);
-        for (k, u) in chunk.iter().enumerate() {
-            out.push(line(u[0], u[1], (dx[k], dy[k])));
-        }
-    }
 }
 
 /// [`concentric_disc_polynomial`] of each `(a[i], b[i])`.

@@ -18,7 +18,7 @@
 //! area lies in its faces' planes ([`share_of_area_on_faces`]): on curved objects, and on solids or
 //! rooms turned off its 13 directions, the Sobol' lines through the sphere measured better.
 
-use super::lines::lines_with_discs;
+use super::lines::concentric_discs;
 use crate::geom::DVec3;
 use crate::scene::Scene;
 use crate::trace::Line;
@@ -56,6 +56,9 @@ fn directions() -> [DVec3; 13] {
         DVec3::new(-t, t, t),
     ]
 }
+
+/// Lines a polytope makes at a time ([`BoundingPolytope::lines`]).
+const CHUNK: usize = 16;
 
 /// A half-space `normal . x <= offset` (`normal` a unit vector pointing out of the polytope).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -285,29 +288,61 @@ impl BoundingPolytope {
         out[0]
     }
 
-    /// The lines of `units`, [`BoundingPolytope::line`] of each, appended to `out`.
+    /// The lines of `units`, [`BoundingPolytope::line`] of each, appended to `out`: made
+    /// [`CHUNK`] at a time, stage by stage across the chunk (disc points, triangles, distances from
+    /// their corners, lines), so that one line's search, division and square roots overlap the
+    /// next's rather than wait for them.
     pub fn lines(&self, units: &[[f64; 4]], out: &mut Vec<Line>) {
-        lines_with_discs(units, out, |u0, u1, disc| self.line_with_disc(u0, u1, disc));
-    }
-
-    fn line_with_disc(&self, u0: f64, u1: f64, (dx, dy): (f64, f64)) -> Line {
-        let at = u0 * self.area;
-        let k = self
-            .triangles
-            .partition_point(|t| t.start + t.area <= at)
-            .min(self.triangles.len().saturating_sub(1));
-        let Some(t) = self.triangles.get(k) else {
-            return Line {
+        out.reserve(units.len());
+        if self.triangles.is_empty() {
+            let none = Line {
                 origin: [0.0; 3],
                 dir: [0.0, 0.0, 1.0],
                 t_max: 0.0,
             };
-        };
-        let s = ((at - t.start) / t.area).clamp(0.0, 1.0).sqrt();
-        let entry = t.a + (t.ab * (1.0 - u1) + t.ac * u1) * s;
-        let dz = (1.0 - dx * dx - dy * dy).max(0.0).sqrt();
-        let dir = t.inward * dz + t.across_b * dx + t.across_c * dy;
-        self.chord(entry, dir)
+            out.extend(units.iter().map(|_| none));
+            return;
+        }
+        for chunk in units.chunks(CHUNK) {
+            self.chunk_lines(chunk, out);
+        }
+    }
+
+    /// [`BoundingPolytope::lines`] of at most [`CHUNK`] points (the polytope has triangles): `u[0]`
+    /// picks a triangle by area and, rescaled within its share, the distance from its first corner
+    /// (as `sqrt`), `u[1]` the way across; `(u[2], u[3])` the direction.
+    #[inline(never)]
+    fn chunk_lines(&self, chunk: &[[f64; 4]], out: &mut Vec<Line>) {
+        const N: usize = CHUNK;
+        let (mut a, mut b) = ([0.0; N], [0.0; N]);
+        for (k, u) in chunk.iter().enumerate() {
+            a[k] = 2.0 * u[2] - 1.0;
+            b[k] = 2.0 * u[3] - 1.0;
+        }
+        let (dx, dy) = concentric_discs(&a, &b);
+        let last = self.triangles.len() - 1;
+        let mut triangle = [0usize; N];
+        for (k, u) in chunk.iter().enumerate() {
+            let at = u[0] * self.area;
+            triangle[k] = self
+                .triangles
+                .partition_point(|t| t.start + t.area <= at)
+                .min(last);
+        }
+        let mut s = [0.0; N];
+        for (k, u) in chunk.iter().enumerate() {
+            let t = &self.triangles[triangle[k]];
+            s[k] = ((u[0] * self.area - t.start) / t.area)
+                .clamp(0.0, 1.0)
+                .sqrt();
+        }
+        for (k, u) in chunk.iter().enumerate() {
+            let t = &self.triangles[triangle[k]];
+            let entry = t.a + (t.ab * (1.0 - u[1]) + t.ac * u[1]) * s[k];
+            let dz = (1.0 - dx[k] * dx[k] - dy[k] * dy[k]).max(0.0).sqrt();
+            let dir = t.inward * dz + t.across_b * dx[k] + t.across_c * dy[k];
+            out.push(self.chord(entry, dir));
+        }
     }
 
     /// The line through `entry` along the unit `dir`, from where it enters the sphere of the
@@ -425,5 +460,68 @@ mod tests {
             (mean_cos - 2.0 / 3.0).abs() < 4.5 * (1.0 / 18.0 / f64::from(n)).sqrt(),
             "{mean_cos}"
         );
+    }
+
+    /// The straightforward construction of one line: the triangle by a linear search of the running
+    /// areas, its entry point and direction, and the chord of the reach's sphere through them.
+    fn reference_line(p: &BoundingPolytope, u: [f64; 4]) -> Line {
+        let at = u[0] * p.area;
+        let k = (0..p.triangles.len())
+            .find(|&k| p.triangles[k].start + p.triangles[k].area > at)
+            .unwrap_or(p.triangles.len() - 1);
+        let t = &p.triangles[k];
+        let s = ((at - t.start) / t.area).clamp(0.0, 1.0).sqrt();
+        let entry = t.a + (t.ab * (1.0 - u[1]) + t.ac * u[1]) * s;
+        let (dx, dy) = concentric_discs(&[2.0 * u[2] - 1.0], &[2.0 * u[3] - 1.0]);
+        let (dx, dy) = (dx[0], dy[0]);
+        let dz = (1.0 - dx * dx - dy * dy).max(0.0).sqrt();
+        let dir = t.inward * dz + t.across_b * dx + t.across_c * dy;
+        p.chord(entry, dir)
+    }
+
+    /// Lines made 16 at a time are the reference construction's one at a time, bit for bit: full and
+    /// partial chunks, the ends of [0, 1), every triangle's share, the disc's centre and diagonals, on
+    /// the octahedron's polytope and a cube's (whose 26 planes cut corners and edges of area zero).
+    #[test]
+    fn lines_made_in_chunks_are_the_reference_lines() {
+        let cube: Vec<DVec3> = (0..8)
+            .map(|k| DVec3::from([0, 1, 2].map(|i| if k >> i & 1 == 1 { 1.0 } else { -1.0 })))
+            .collect();
+        let mut rng = 0x2545_f491_4f6c_dd1du64;
+        let mut next = || {
+            rng ^= rng << 13;
+            rng ^= rng >> 7;
+            rng ^= rng << 17;
+            (rng >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for points in [octahedron(), cube] {
+            let p = BoundingPolytope::of_points(points.into_iter(), 1e-6, 1.0);
+            let mut units: Vec<[f64; 4]> = (0..3001)
+                .map(|_| [next(), next(), next(), next()])
+                .collect();
+            let below_one = 1.0 - f64::EPSILON / 2.0;
+            let n = p.triangles.len() as f64;
+            for edge in [0.0, 0.5, below_one] {
+                for k in 0..p.triangles.len() {
+                    let u0 = (k as f64 + edge.min(0.999)) / n;
+                    units.push([u0, edge, edge, 0.5]);
+                    units.push([u0, 1.0 - edge, 0.5, edge]);
+                    units.push([u0, 0.5, edge, 1.0 - edge]);
+                }
+            }
+            let mut chunked = Vec::new();
+            p.lines(&units, &mut chunked);
+            assert_eq!(chunked.len(), units.len());
+            let bits = |l: &Line| {
+                (
+                    l.origin.map(f32::to_bits),
+                    l.dir.map(f32::to_bits),
+                    l.t_max.to_bits(),
+                )
+            };
+            for (u, line) in units.iter().zip(&chunked) {
+                assert_eq!(bits(line), bits(&reference_line(&p, *u)), "{u:?}");
+            }
+        }
     }
 }
