@@ -372,6 +372,16 @@ impl BoundingPolytope {
 mod tests {
     use super::*;
 
+    /// Uniform numbers in [0, 1) from a xorshift stream seeded with `seed` (non-zero).
+    fn uniforms(mut seed: u64) -> impl FnMut() -> f64 {
+        move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        }
+    }
+
     fn octahedron() -> Vec<DVec3> {
         vec![
             DVec3::X,
@@ -421,13 +431,7 @@ mod tests {
         let n = 1 << 16;
         let mut cos_sum = 0.0;
         let mut seen = [0u32; 8];
-        let mut rng = 0x9e37_79b9_7f4a_7c15u64;
-        let mut next = || {
-            rng ^= rng << 13;
-            rng ^= rng >> 7;
-            rng ^= rng << 17;
-            (rng >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut next = uniforms(0x9e37_79b9_7f4a_7c15u64);
         for _ in 0..n {
             let u = [next(), next(), next(), next()];
             let line = p.line(u);
@@ -487,13 +491,7 @@ mod tests {
         let cube: Vec<DVec3> = (0..8)
             .map(|k| DVec3::from([0, 1, 2].map(|i| if k >> i & 1 == 1 { 1.0 } else { -1.0 })))
             .collect();
-        let mut rng = 0x2545_f491_4f6c_dd1du64;
-        let mut next = || {
-            rng ^= rng << 13;
-            rng ^= rng >> 7;
-            rng ^= rng << 17;
-            (rng >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut next = uniforms(0x2545_f491_4f6c_dd1du64);
         for points in [octahedron(), cube] {
             let p = BoundingPolytope::of_points(points.into_iter(), 1e-6, 1.0);
             let mut units: Vec<[f64; 4]> = (0..3001)
