@@ -197,15 +197,20 @@ fn grazing_lines(scene: &Scene, rng: &mut Pcg64, count: usize) -> Vec<Line> {
         .collect()
 }
 
+/// The room of [`turned_meshed_room`] loaded as a scene, through an OBJ file as a user's would be.
+fn turned_room_scene(cells: usize, turn: f64, inner_box: bool, grading: f64) -> Scene {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("turned.obj");
+    std::fs::write(&path, turned_meshed_room(cells, turn, inner_box, grading)).unwrap();
+    scenes::load(path.to_str().unwrap()).unwrap()
+}
+
 /// A wall turned off the axes and meshed finely: its small triangles' normals carry the rounding of
 /// their f32 vertices, and their rounded planes fall on both sides of a rounding boundary; the grids
 /// still take each wall whole (before neighbouring plane keys were joined, this room had 12 grids).
 #[test]
 fn a_finely_meshed_turned_wall_is_one_grid() {
-    let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("turned.obj");
-    std::fs::write(&path, turned_meshed_room(40, 0.2, false, 1.0)).unwrap();
-    let scene = scenes::load(path.to_str().unwrap()).unwrap();
+    let scene = turned_room_scene(40, 0.2, false, 1.0);
     assert_eq!(BvhTracer::new(&scene).unwrap().planes_in_grids(), 6);
 }
 
@@ -216,7 +221,6 @@ fn a_finely_meshed_turned_wall_is_one_grid() {
 /// and grazing a wall.
 #[test]
 fn grids_find_the_brute_force_tracers_hits_to_the_bit() {
-    let dir = tempfile::tempdir().unwrap();
     let mut scenes = vec![scenes::load("@cube:10").unwrap()];
     let rooms = [
         (0.0, true, 1.0),
@@ -224,10 +228,8 @@ fn grids_find_the_brute_force_tracers_hits_to_the_bit() {
         (0.05, true, 1.0),
         (0.2, true, 1.05),
     ];
-    for (k, &(turn, inner_box, grading)) in rooms.iter().enumerate() {
-        let path = dir.path().join(format!("room{k}.obj"));
-        std::fs::write(&path, turned_meshed_room(12, turn, inner_box, grading)).unwrap();
-        scenes.push(scenes::load(path.to_str().unwrap()).unwrap());
+    for &(turn, inner_box, grading) in &rooms {
+        scenes.push(turned_room_scene(12, turn, inner_box, grading));
     }
     for (k, scene) in scenes.iter().enumerate() {
         let tracer = BvhTracer::new(scene).unwrap();
@@ -321,10 +323,7 @@ fn grazing_crossings_of_slivers_match_the_brute_force_tracer_and_first_hits() {
 /// cannot be traced in a later chunk is named by its index in the batch, with nothing returned.
 #[test]
 fn chunked_grid_lookups_give_the_line_by_line_hits() {
-    let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("turned.obj");
-    std::fs::write(&path, turned_meshed_room(12, 0.2, true, 1.0)).unwrap();
-    let room = scenes::load(path.to_str().unwrap()).unwrap();
+    let room = turned_room_scene(12, 0.2, true, 1.0);
     for scene in [scenes::load("@cube:60").unwrap(), room] {
         let bvh = BvhTracer::new(&scene).unwrap();
         assert!(bvh.planes_in_grids() > 0, "{}", scene.name);
